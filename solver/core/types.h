@@ -1,0 +1,28 @@
+// Value types shared by every solver stage: points, polylines, drawings, triangles.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+namespace inbetween::solver {
+
+using Point = Eigen::Vector2d;
+using Points = std::vector<Point>;
+// Orientation convention, used everywhere: "positive" means positive signed area by the usual
+// formula 0.5 * sum(x_i * y_{i+1} - x_{i+1} * y_i) in the drawing's own coordinates (SVG user
+// units, y pointing down, so positive looks clockwise on screen). Every triangle of every shape
+// is positive; outer outlines are positive, holes negative.
+using Triangle = std::array<int, 3>;  // vertex indices
+
+// A closed oriented polyline (the last point connects back to the first; it is not repeated).
+struct Outline {
+  Points points;
+};
+
+// One key drawing: its outlines in the drawing's user units (SVG y-down coordinates as given).
+struct Drawing {
+  std::vector<Outline> outlines;
+};
+
+}  // namespace inbetween::solver

@@ -1,0 +1,21 @@
+// The multimesh: one triangle list shared by every shape, one geometry per shape.
+#pragma once
+
+#include <vector>
+
+#include "solver/core/types.h"
+
+namespace inbetween::solver {
+
+struct Multimesh {
+  std::vector<Triangle> triangles;  // shared topology, CCW in every shape
+  std::vector<Points> shapes;       // shapes[i][v] = position of vertex v in drawing i
+  std::vector<int> boundary;        // boundary vertex indices, in boundary order
+  // Cohesive edge pairs {a, b, c, d}: a-b on one side, c-d its collocated twin (later issues).
+  std::vector<std::array<int, 4>> cohesive_edges;
+
+  int num_vertices() const { return shapes.empty() ? 0 : static_cast<int>(shapes[0].size()); }
+  int num_shapes() const { return static_cast<int>(shapes.size()); }
+};
+
+}  // namespace inbetween::solver
