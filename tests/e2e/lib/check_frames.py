@@ -1,0 +1,48 @@
+#!/usr/bin/env python3
+"""Checks a frames.json written by `inbetween animate`.
+
+Usage: check_frames.py FRAMES_JSON EXPECTED_FRAMES EXPECTED_KEYS(comma-separated)
+Asserts: frame count and order, keys, one vertex per mesh vertex in every frame, finite
+coordinates, and zero inverted (non-positive signed area) triangles in every frame.
+"""
+import json
+import math
+import sys
+
+
+def fail(msg):
+    print(f"check_frames: FAIL: {msg}", file=sys.stderr)
+    sys.exit(1)
+
+
+def main():
+    path, n_frames, keys = sys.argv[1], int(sys.argv[2]), [int(k) for k in sys.argv[3].split(",")]
+    with open(path) as f:
+        doc = json.load(f)
+    tris, frames = doc["triangles"], doc["frames"]
+    if len(frames) != n_frames:
+        fail(f"{len(frames)} frames, expected {n_frames}")
+    if doc["keys"] != keys:
+        fail(f"keys {doc['keys']}, expected {keys}")
+    if not tris:
+        fail("no triangles")
+    n_vertices = len(frames[0]["vertices"])
+    for i, fr in enumerate(frames):
+        if fr["index"] != i:
+            fail(f"frame {i} has index {fr['index']}")
+        v = fr["vertices"]
+        if len(v) != n_vertices:
+            fail(f"frame {i} has {len(v)} vertices, frame 0 has {n_vertices}")
+        if not all(math.isfinite(c) for p in v for c in p):
+            fail(f"frame {i} has a non-finite coordinate")
+        for t, (a, b, c) in enumerate(tris):
+            area2 = (v[b][0] - v[a][0]) * (v[c][1] - v[a][1]) - (v[b][1] - v[a][1]) * (v[c][0] - v[a][0])
+            if not area2 > 0:
+                fail(f"frame {i}: triangle {t} is inverted or degenerate (2*area={area2})")
+    if not 0.0 <= frames[0]["time"] < frames[-1]["time"] <= 1.0:
+        fail("frame times are not increasing within [0, 1]")
+    print(f"check_frames: ok: {len(frames)} frames, {len(tris)} triangles, {n_vertices} vertices")
+
+
+if __name__ == "__main__":
+    main()
