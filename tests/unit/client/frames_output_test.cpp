@@ -1,0 +1,78 @@
+// Tests client/frames_output.cpp and the CLI's exit-code mapping.
+#include "client/frames_output.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "client/animate_command.h"
+
+namespace inbetween::client {
+namespace {
+
+FramesResult TwoFrames() {
+  FramesResult r;
+  auto* t = r.header.add_triangles();
+  t->set_a(0);
+  t->set_b(1);
+  t->set_c(2);
+  r.header.add_keys(0);
+  r.header.add_keys(1);
+  r.header.set_frames(2);
+  for (int i = 0; i < 2; ++i) {
+    v1::InbetweenFrame f;
+    f.set_index(i);
+    f.set_time(i);
+    f.add_weights(1.0 - i);
+    f.add_weights(i);
+    for (auto [x, y] : {std::pair{0.0, 0.0}, {1.0 + i, 0.0}, {0.0, 1.0}}) {
+      auto* p = f.add_vertices();
+      p->set_x(x);
+      p->set_y(y);
+    }
+    r.frames.push_back(f);
+  }
+  return r;
+}
+
+TEST(FramesOutputTest, JsonHasTheDocumentedShape) {
+  nlohmann::json j = FramesToJson(TwoFrames());
+  EXPECT_EQ(j["triangles"], nlohmann::json::parse("[[0,1,2]]"));
+  EXPECT_EQ(j["keys"], nlohmann::json::parse("[0,1]"));
+  ASSERT_EQ(j["frames"].size(), 2u);
+  EXPECT_EQ(j["frames"][1]["index"], 1);
+  EXPECT_DOUBLE_EQ(j["frames"][1]["time"].get<double>(), 1.0);
+  EXPECT_EQ(j["frames"][1]["vertices"][1], nlohmann::json::parse("[2.0, 0.0]"));
+  EXPECT_EQ(j["frames"][0]["weights"], nlohmann::json::parse("[1.0, 0.0]"));
+}
+
+TEST(FramesOutputTest, WritesOneSvgPerFrameAndTheJson) {
+  const auto dir = std::filesystem::temp_directory_path() / "inbetween_frames_output_test";
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(WriteFrames(dir, TwoFrames(), {.mesh_overlay = true}).ok());
+  EXPECT_TRUE(std::filesystem::exists(dir / "frame_0000.svg"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "frame_0001.svg"));
+  std::ifstream in(dir / "frames.json");
+  EXPECT_EQ(nlohmann::json::parse(in)["frames"].size(), 2u);
+  std::ifstream svg(dir / "frame_0001.svg");
+  std::string text((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("viewBox"), std::string::npos);
+  EXPECT_NE(text.find("M0 0L2 0L0 1Z"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(FramesOutputTest, ReportsAnUnwritableDirectory) {
+  EXPECT_FALSE(WriteFrames("/proc/definitely/not/here", TwoFrames()).ok());
+}
+
+TEST(AnimateCommandTest, ExitCodesAreDocumentedOnes) {
+  EXPECT_EQ(ExitCodeFor(absl::OkStatus()), 0);
+  EXPECT_EQ(ExitCodeFor(absl::InvalidArgumentError("x")), 3);
+  EXPECT_EQ(ExitCodeFor(absl::UnavailableError("x")), 4);
+  EXPECT_EQ(ExitCodeFor(absl::InternalError("x")), 5);
+  EXPECT_EQ(ExitCodeFor(absl::CancelledError("x")), 130);
+}
+
+}  // namespace
+}  // namespace inbetween::client
