@@ -1,0 +1,31 @@
+// Basic predicates on closed polygons (an Outline's points): signed area, point containment and
+// the first self-intersection. Shared by SVG import, correspondence and the mesh builder.
+#pragma once
+
+#include <optional>
+
+#include "solver/core/types.h"
+
+namespace inbetween::solver {
+
+// Signed area 0.5 * sum(x_i * y_{i+1} - x_{i+1} * y_i); positive = the convention of types.h.
+double PolygonSignedArea(const Points& polygon);
+
+// Even-odd point-in-polygon test (points exactly on the boundary may go either way).
+bool PolygonContains(const Points& polygon, const Point& q);
+
+// True when the closed polygon is convex (collinear vertices allowed) with positive area.
+bool IsConvexPositive(const Points& polygon);
+
+struct SelfIntersection {
+  int segment_a = 0;  // segment i joins polygon[i] and polygon[(i + 1) % n]
+  int segment_b = 0;
+  Point location;  // a point where the two segments meet
+};
+
+// Returns a pair of segments of the closed polygon that cross, touch or overlap (other than
+// consecutive segments meeting at their shared vertex), or nullopt for a simple polygon.
+// Sweep over x-sorted segment bounding boxes; worst case O(n^2).
+std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon);
+
+}  // namespace inbetween::solver

@@ -1,0 +1,376 @@
+// SVG in: parses a document with libxml2 (no network, no entity expansion, no DTD loading) and
+// walks it with SVG++, which resolves relative/shorthand path commands, arcs and quadratics to
+// absolute cubic Beziers, turns basic shapes into paths and composes `transform` attributes.
+// Filled subpaths are flattened adaptively and oriented by even-odd nesting depth.
+//
+// This is the only translation unit that instantiates SVG++ templates (compile time).
+#include "solver/io/svg_import.h"
+
+#include <libxml/parser.h>
+#include <libxml/tree.h>
+#include <libxml/xmlerror.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+// SVG++'s arc-to-Bezier iterator trips GCC's -Wmaybe-uninitialized at -O2 (false positive in the
+// library's own code, reported at instantiation in this file).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+#include <svgpp/policy/xml/libxml2.hpp>
+#include <svgpp/svgpp.hpp>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "solver/geometry/polygon.h"
+
+namespace inbetween::solver {
+namespace {
+
+namespace sv = ::svgpp;
+using Affine = Eigen::Matrix<double, 2, 3>;  // [A | t]
+
+constexpr char kSvgNamespace[] = "http://www.w3.org/2000/svg";
+constexpr int kMaxSubdivisionDepth = 18;
+
+// Our own error raised from inside SVG++ callbacks; SVG++ attaches the element to it.
+struct ImportError : virtual boost::exception, virtual std::exception {
+  explicit ImportError(std::string m) : message(std::move(m)) {}
+  const char* what() const noexcept override { return message.c_str(); }
+  std::string message;
+};
+
+using ElementInfo = boost::error_info<sv::tag::error_info::xml_element, xmlNode*>;
+
+std::string Describe(const xmlNode* node) {
+  if (node == nullptr) return "document";
+  std::string out = absl::StrCat("<", reinterpret_cast<const char*>(node->name));
+  if (xmlChar* id = xmlGetProp(node, reinterpret_cast<const xmlChar*>("id"))) {
+    absl::StrAppend(&out, " id=\"", reinterpret_cast<const char*>(id), "\"");
+    xmlFree(id);
+  }
+  absl::StrAppend(&out, "> (line ", xmlGetLineNo(node), ")");
+  return out;
+}
+
+Point Apply(const Affine& m, double x, double y) {
+  return m.leftCols<2>() * Point(x, y) + m.col(2);
+}
+
+// Appends the flattening of a cubic Bezier (p0 excluded) to `out`: subdivide until the control
+// points are within `tolerance` of the chord (the curve lies in their convex hull).
+void FlattenCubic(const Point& p0, const Point& p1, const Point& p2, const Point& p3,
+                  double tolerance, int depth, Points* out) {
+  const Point chord = p3 - p0;
+  const double len = chord.norm();
+  auto distance = [&](const Point& p) {
+    if (len < 1e-300) return (p - p0).norm();
+    return std::abs(chord.x() * (p.y() - p0.y()) - chord.y() * (p.x() - p0.x())) / len;
+  };
+  if (depth >= kMaxSubdivisionDepth || std::max(distance(p1), distance(p2)) <= tolerance) {
+    out->push_back(p3);
+    return;
+  }
+  const Point p01 = 0.5 * (p0 + p1), p12 = 0.5 * (p1 + p2), p23 = 0.5 * (p2 + p3);
+  const Point p012 = 0.5 * (p01 + p12), p123 = 0.5 * (p12 + p23);
+  const Point mid = 0.5 * (p012 + p123);
+  FlattenCubic(p0, p01, p012, mid, tolerance, depth + 1, out);
+  FlattenCubic(mid, p123, p23, p3, tolerance, depth + 1, out);
+}
+
+// Where finished outlines go, in document order.
+struct Collector {
+  double tolerance = 0.05;
+  std::vector<Outline> outlines;
+};
+
+// A subpath as the pen drew it, in the element's local coordinates. A cubic segment is stored
+// as its three points, the two control points flagged.
+struct Subpath {
+  Points points;
+  std::vector<bool> is_control;
+};
+
+// One context per SVG element (created on the stack by SVG++): inherits the transform and the
+// fill state of its parent. Shape data is buffered and emitted in on_exit_element, because the
+// attributes (d, transform, fill) may come in any order.
+class Context {
+ public:
+  Context(Collector* collector, xmlNode* node) : collector_(collector), node_(node) {
+    ctm_.setZero();
+    ctm_(0, 0) = ctm_(1, 1) = 1.0;
+  }
+  Context(const Context& parent, xmlNode* node)
+      : collector_(parent.collector_), node_(node), ctm_(parent.ctm_), filled_(parent.filled_) {}
+
+  // Transform (SVG++ composes the attribute's list into one matrix [a b c d e f]).
+  void transform_matrix(const boost::array<double, 6>& m) {
+    for (double v : m) CheckFinite(v, "transform");
+    Affine local;
+    local << m[0], m[2], m[4], m[1], m[3], m[5];
+    Affine composed;
+    composed.leftCols<2>() = ctm_.leftCols<2>() * local.leftCols<2>();
+    composed.col(2) = ctm_.leftCols<2>() * local.col(2) + ctm_.col(2);
+    ctm_ = composed;
+  }
+
+  // Paint: only "none" matters; any colour, paint server or currentColor fills.
+  void set(sv::tag::attribute::fill, sv::tag::value::none) { filled_ = false; }
+  template <class... Args>
+  void set(sv::tag::attribute::fill, Args&&...) {
+    filled_ = true;
+  }
+
+  // Path events, absolute coordinates only (policy::path::minimal).
+  void path_move_to(double x, double y, sv::tag::coordinate::absolute) {
+    CheckFinite(x, "path data"), CheckFinite(y, "path data");
+    subpaths_.emplace_back();
+    Add(x, y, false);
+    open_ = true;
+  }
+  void path_line_to(double x, double y, sv::tag::coordinate::absolute) {
+    CheckFinite(x, "path data"), CheckFinite(y, "path data");
+    StartIfNeeded();
+    Add(x, y, false);
+  }
+  void path_cubic_bezier_to(double x1, double y1, double x2, double y2, double x, double y,
+                            sv::tag::coordinate::absolute) {
+    for (double v : {x1, y1, x2, y2, x, y}) CheckFinite(v, "path data");
+    StartIfNeeded();
+    Add(x1, y1, true);
+    Add(x2, y2, true);
+    Add(x, y, false);
+  }
+  void path_close_subpath() {
+    // The pen returns to the subpath start; a further drawing command starts a new subpath.
+    if (!subpaths_.empty()) pen_ = subpaths_.back().points.front();
+    open_ = false;
+  }
+  void path_exit() {}
+
+  void on_exit_element() {
+    if (!filled_) return;
+    for (const Subpath& subpath : subpaths_) Emit(subpath);
+  }
+
+ private:
+  void CheckFinite(double v, const char* what) const {
+    if (!std::isfinite(v)) throw ImportError(absl::StrCat(what, " has a non-finite coordinate"));
+  }
+  void StartIfNeeded() {
+    if (!open_) {  // after 'Z' a new subpath begins where the previous one started
+      subpaths_.emplace_back();
+      subpaths_.back().points.push_back(pen_);
+      subpaths_.back().is_control.push_back(false);
+      open_ = true;
+    }
+  }
+  void Add(double x, double y, bool control) {
+    subpaths_.back().points.emplace_back(x, y);
+    subpaths_.back().is_control.push_back(control);
+    if (!control) pen_ = Point(x, y);
+  }
+
+  // Transforms, flattens and closes one subpath; keeps it when it encloses some area.
+  void Emit(const Subpath& subpath) const {
+    const Points& raw = subpath.points;
+    Points flat = {Apply(ctm_, raw[0].x(), raw[0].y())};
+    for (size_t i = 1; i < raw.size();) {
+      if (subpath.is_control[i] && i + 2 < raw.size()) {
+        const Point p0 = flat.back();
+        FlattenCubic(p0, Apply(ctm_, raw[i].x(), raw[i].y()),
+                     Apply(ctm_, raw[i + 1].x(), raw[i + 1].y()),
+                     Apply(ctm_, raw[i + 2].x(), raw[i + 2].y()), collector_->tolerance, 0, &flat);
+        i += 3;
+      } else {
+        flat.push_back(Apply(ctm_, raw[i].x(), raw[i].y()));
+        ++i;
+      }
+    }
+    // A fill closes every subpath implicitly; drop the repeated closing point and duplicates.
+    Outline outline;
+    for (const Point& p : flat) {
+      if (!p.allFinite()) throw ImportError("the transformed coordinates are not finite");
+      if (outline.points.empty() || p != outline.points.back()) outline.points.push_back(p);
+    }
+    while (outline.points.size() > 1 && outline.points.back() == outline.points.front()) {
+      outline.points.pop_back();
+    }
+    if (outline.points.size() >= 3 && PolygonSignedArea(outline.points) != 0.0) {
+      collector_->outlines.push_back(std::move(outline));
+    }
+  }
+
+  Collector* collector_;
+  xmlNode* node_;
+  Affine ctm_;
+  bool filled_ = true;  // SVG's initial fill is black
+  std::vector<Subpath> subpaths_;
+  Point pen_ = Point::Zero();
+  bool open_ = false;
+};
+
+struct ContextFactories {
+  template <class ParentContext, class ElementTag>
+  struct apply {
+    using type = sv::factory::context::on_stack_with_xml_element<Context>;
+  };
+};
+
+// Raise SVG++'s exceptions for bad values, but skip elements and attributes it does not know
+// (editor metadata such as data-* attributes or sodipodi:* elements).
+struct ErrorPolicy : sv::policy::error::raise_exception<Context> {
+  template <class XMLElement, class ElementName>
+  static bool unknown_element(const Context&, const XMLElement&, const ElementName&) {
+    return true;  // continue with the next sibling
+  }
+  template <class XMLAttribute, class AttributeName>
+  static bool unknown_attribute(const Context&, const XMLAttribute&, const AttributeName&,
+                                BOOST_SCOPED_ENUM(sv::detail::namespace_id),
+                                sv::tag::source::attribute) {
+    return true;
+  }
+  template <class XMLAttribute, class AttributeName>
+  static bool unknown_attribute(const Context&, const XMLAttribute&, const AttributeName&,
+                                sv::tag::source::css) {
+    return true;
+  }
+};
+
+using ProcessedElements =
+    boost::mpl::set<sv::tag::element::svg, sv::tag::element::g, sv::tag::element::path,
+                    sv::tag::element::rect, sv::tag::element::circle, sv::tag::element::ellipse,
+                    sv::tag::element::polygon, sv::tag::element::polyline>::type;
+using ProcessedAttributes =
+    boost::mpl::insert<boost::mpl::insert<sv::traits::shapes_attributes_by_element,
+                                          sv::tag::attribute::transform>::type,
+                       sv::tag::attribute::fill>::type;
+
+using Traversal = sv::document_traversal<
+    sv::processed_elements<ProcessedElements>, sv::processed_attributes<ProcessedAttributes>,
+    sv::context_factories<ContextFactories>, sv::path_policy<sv::policy::path::minimal>,
+    sv::basic_shapes_policy<sv::policy::basic_shapes::all_to_path>, sv::error_policy<ErrorPolicy>>;
+
+struct DocDeleter {
+  void operator()(xmlDoc* doc) const { xmlFreeDoc(doc); }
+};
+struct ParserDeleter {
+  void operator()(xmlParserCtxt* ctxt) const { xmlFreeParserCtxt(ctxt); }
+};
+
+// Entities are never expanded (XML_PARSE_NOENT is off), but libxml2 would still substitute them
+// when SVG++ reads an attribute value; refuse any reference instead of reading it.
+const xmlNode* FindEntityReference(const xmlNode* node) {
+  for (; node != nullptr; node = node->next) {
+    if (node->type == XML_ENTITY_REF_NODE) return node;
+    if (node->type == XML_ELEMENT_NODE) {
+      for (const xmlAttr* attr = node->properties; attr != nullptr; attr = attr->next) {
+        for (const xmlNode* child = attr->children; child; child = child->next) {
+          if (child->type == XML_ENTITY_REF_NODE) return node;
+        }
+      }
+      if (const xmlNode* found = FindEntityReference(node->children)) return found;
+    }
+  }
+  return nullptr;
+}
+
+// Documents written without xmlns still mean SVG; SVG++ only reads elements in its namespace.
+void AdoptSvgNamespace(xmlNode* root) {
+  if (root->ns != nullptr) return;
+  xmlNs* ns = xmlNewNs(root, reinterpret_cast<const xmlChar*>(kSvgNamespace), nullptr);
+  std::vector<xmlNode*> stack = {root};
+  while (!stack.empty()) {
+    xmlNode* node = stack.back();
+    stack.pop_back();
+    if (node->type != XML_ELEMENT_NODE || node->ns != nullptr) continue;
+    xmlSetNs(node, ns);
+    for (xmlNode* child = node->children; child; child = child->next) stack.push_back(child);
+  }
+}
+
+// Outlines nested inside an odd number of others are holes (negative), the rest positive.
+void OrientByNesting(std::vector<Outline>* outlines) {
+  const size_t n = outlines->size();
+  std::vector<bool> hole(n, false);
+  for (size_t i = 0; i < n; ++i) {
+    int depth = 0;
+    // Test a point just inside the first edge to avoid vertices shared with other outlines.
+    const Points& p = (*outlines)[i].points;
+    const Point probe = p[0] + 1e-9 * (p[1] - p[0]);
+    for (size_t j = 0; j < n; ++j) {
+      if (j != i && PolygonContains((*outlines)[j].points, probe)) ++depth;
+    }
+    hole[i] = depth % 2 == 1;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    Points& p = (*outlines)[i].points;
+    const bool positive = PolygonSignedArea(p) > 0;
+    if (positive == hole[i]) std::reverse(p.begin() + 1, p.end());  // keep the first point
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOptions& options) {
+  if (!(options.tolerance > 0) || !std::isfinite(options.tolerance)) {
+    return absl::InvalidArgumentError("SVG import: tolerance must be a positive number");
+  }
+  std::unique_ptr<xmlParserCtxt, ParserDeleter> ctxt(xmlNewParserCtxt());
+  if (ctxt == nullptr) return absl::ResourceExhaustedError("SVG import: out of memory");
+  // No network, no entity substitution, no DTD loading or validation; keep errors quiet.
+  const int flags = XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING;
+  std::unique_ptr<xmlDoc, DocDeleter> doc(xmlCtxtReadMemory(ctxt.get(), svg_text.data(),
+                                                            static_cast<int>(svg_text.size()),
+                                                            "drawing.svg", nullptr, flags));
+  if (doc == nullptr) {
+    const xmlError* error = xmlCtxtGetLastError(ctxt.get());
+    std::string reason = error && error->message ? error->message : "unknown error";
+    while (!reason.empty() && (reason.back() == '\n' || reason.back() == ' ')) reason.pop_back();
+    return absl::InvalidArgumentError(
+        absl::StrCat("SVG is not well-formed XML (line ", error ? error->line : 0, "): ", reason));
+  }
+  xmlNode* root = xmlDocGetRootElement(doc.get());
+  if (root == nullptr || xmlStrcmp(root->name, reinterpret_cast<const xmlChar*>("svg")) != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("SVG root element must be <svg>, found ", Describe(root)));
+  }
+  if (const xmlNode* ref = FindEntityReference(root)) {
+    const xmlNode* element = ref->type == XML_ELEMENT_NODE ? ref : ref->parent;
+    return absl::InvalidArgumentError(
+        absl::StrCat("SVG element ", Describe(element),
+                     ": entity references are not supported (never expanded)"));
+  }
+  AdoptSvgNamespace(root);
+
+  Collector collector;
+  collector.tolerance = options.tolerance;
+  try {
+    Context context(&collector, root);
+    Traversal::load_document(root, context);
+  } catch (const boost::exception& e) {
+    xmlNode* const* element = boost::get_error_info<ElementInfo>(e);
+    const auto* std_error = dynamic_cast<const std::exception*>(&e);
+    return absl::InvalidArgumentError(
+        absl::StrCat("SVG element ", Describe(element ? *element : nullptr), ": ",
+                     std_error ? std_error->what() : "invalid content"));
+  } catch (const std::exception& e) {
+    return absl::InvalidArgumentError(absl::StrCat("SVG import failed: ", e.what()));
+  }
+  if (collector.outlines.empty()) {
+    return absl::InvalidArgumentError(
+        "SVG has no filled shape (elements with fill=\"none\" and empty paths are ignored)");
+  }
+  OrientByNesting(&collector.outlines);
+  Drawing drawing;
+  drawing.outlines = std::move(collector.outlines);
+  return drawing;
+}
+
+}  // namespace inbetween::solver

@@ -1,0 +1,124 @@
+// Quality triangulation of a simple polygon: CGAL Constrained_Delaunay_triangulation_2 of the
+// boundary, refined by CGAL::refine_Delaunay_mesh_2 with Delaunay_mesh_size_criteria_2. The
+// faces inside the polygon (the bounded domain) are returned with positive orientation, and
+// every Steiner point that landed on a boundary segment is reported with its segment parameter.
+//
+// THE ONLY FILE IN THE PROJECT THAT INCLUDES CGAL.
+#include "solver/mesh/cgal_triangulate.h"
+
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Delaunay_mesh_face_base_2.h>
+#include <CGAL/Delaunay_mesh_size_criteria_2.h>
+#include <CGAL/Delaunay_mesh_vertex_base_2.h>
+#include <CGAL/Delaunay_mesher_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <map>
+
+#include "absl/strings/str_cat.h"
+
+namespace inbetween::solver {
+namespace {
+
+// The kernel and data structures, named once.
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb = CGAL::Delaunay_mesh_vertex_base_2<K>;
+using Fb = CGAL::Delaunay_mesh_face_base_2<K>;
+using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+using Cdt = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+using Criteria = CGAL::Delaunay_mesh_size_criteria_2<Cdt>;
+using CgalPoint = K::Point_2;
+using VertexHandle = Cdt::Vertex_handle;
+
+double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+}  // namespace
+
+absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
+                                                     const TriangulateOptions& options) {
+  const int n = static_cast<int>(boundary.size());
+  if (n < 3) return absl::InvalidArgumentError("triangulate: polygon has fewer than 3 points");
+  double area2 = 0.0;
+  for (int i = 0; i < n; ++i) area2 += Cross(boundary[i], boundary[(i + 1) % n]);
+  if (!(area2 > 0)) {
+    return absl::InvalidArgumentError("triangulate: polygon must have positive signed area");
+  }
+  if (!(options.shape_bound > 0)) {
+    return absl::InvalidArgumentError("triangulate: shape_bound must be > 0");
+  }
+
+  PolygonTriangulation out;
+  try {
+    Cdt cdt;
+    std::vector<VertexHandle> handles(n);
+    for (int i = 0; i < n; ++i) {
+      handles[i] = cdt.insert(CgalPoint(boundary[i].x(), boundary[i].y()));
+    }
+    if (static_cast<int>(cdt.number_of_vertices()) != n) {
+      return absl::InvalidArgumentError("triangulate: polygon has repeated points");
+    }
+    for (int i = 0; i < n; ++i) cdt.insert_constraint(handles[i], handles[(i + 1) % n]);
+    if (static_cast<int>(cdt.number_of_vertices()) != n) {
+      // Constraint intersections add vertices: the polygon was not simple.
+      return absl::InvalidArgumentError("triangulate: polygon boundary crosses itself");
+    }
+
+    const double size = options.max_edge > 0 ? options.max_edge : 0.0;
+    CGAL::refine_Delaunay_mesh_2(cdt, Criteria(options.shape_bound, size));
+
+    std::map<VertexHandle, int> index;
+    for (int i = 0; i < n; ++i) index[handles[i]] = i;
+    out.vertices = boundary;
+    // Steiner points in a deterministic order: CGAL's vertex iteration order (insertion order).
+    for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
+      if (index.count(v)) continue;
+      index[v] = static_cast<int>(out.vertices.size());
+      out.vertices.emplace_back(v->point().x(), v->point().y());
+    }
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+      if (!f->is_in_domain()) continue;
+      Triangle t = {index.at(f->vertex(0)), index.at(f->vertex(1)), index.at(f->vertex(2))};
+      const Point e1 = out.vertices[t[1]] - out.vertices[t[0]];
+      const Point e2 = out.vertices[t[2]] - out.vertices[t[0]];
+      if (Cross(e1, e2) < 0) std::swap(t[1], t[2]);
+      out.triangles.push_back(t);
+    }
+    // Steiner vertices on a constrained edge lie on the boundary: find their segment.
+    for (auto e = cdt.finite_edges_begin(); e != cdt.finite_edges_end(); ++e) {
+      if (!cdt.is_constrained(*e)) continue;
+      for (int k : {1, 2}) {
+        const VertexHandle v = e->first->vertex((e->second + k) % 3);
+        const int vi = index.at(v);
+        if (vi < n) continue;
+        if (std::any_of(out.boundary_steiner.begin(), out.boundary_steiner.end(),
+                        [&](const BoundarySteiner& b) { return b.vertex == vi; })) {
+          continue;
+        }
+        const Point p = out.vertices[vi];
+        BoundarySteiner best{vi, -1, 0.0};
+        double best_distance = std::numeric_limits<double>::infinity();
+        for (int s = 0; s < n; ++s) {
+          const Point a = boundary[s], d = boundary[(s + 1) % n] - a;
+          const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+          const double dist = (a + t * d - p).norm();
+          if (dist < best_distance) best_distance = dist, best.segment = s, best.t = t;
+        }
+        out.boundary_steiner.push_back(best);
+      }
+    }
+    std::sort(out.boundary_steiner.begin(), out.boundary_steiner.end(),
+              [](const BoundarySteiner& a, const BoundarySteiner& b) {
+                return a.segment < b.segment || (a.segment == b.segment && a.t < b.t);
+              });
+  } catch (const std::exception& e) {
+    return absl::InternalError(absl::StrCat("triangulate: CGAL failed: ", e.what()));
+  }
+  if (out.triangles.empty()) return absl::InternalError("triangulate: no triangle inside");
+  return out;
+}
+
+}  // namespace inbetween::solver

@@ -1,0 +1,39 @@
+// Quality triangulation of a simple polygon (CGAL constrained Delaunay + Delaunay refinement).
+// The only CGAL user in the project is cgal_triangulate.cpp; this header is CGAL-free.
+#pragma once
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "solver/core/types.h"
+
+namespace inbetween::solver {
+
+struct TriangulateOptions {
+  // Upper bound on triangle edge length, in the polygon's units (<= 0: no size bound).
+  double max_edge = 0.0;
+  // Delaunay_mesh_size_criteria_2 shape bound B = 1 / (4 sin^2(min angle)); 0.125 ~ 20.7 deg,
+  // the smallest value for which refinement is guaranteed to terminate.
+  double shape_bound = 0.125;
+};
+
+// A Steiner vertex the mesher put on the polygon boundary, on segment `segment` (from
+// boundary[segment] to boundary[(segment + 1) % n]) at parameter t in (0, 1).
+struct BoundarySteiner {
+  int vertex = 0;
+  int segment = 0;
+  double t = 0.0;
+};
+
+struct PolygonTriangulation {
+  Points vertices;                  // the n boundary points in the given order, then Steiner
+  std::vector<Triangle> triangles;  // all positive (types.h)
+  std::vector<BoundarySteiner> boundary_steiner;  // sorted by (segment, t)
+};
+
+// `boundary` must be a simple polygon of positive signed area with distinct points.
+// Errors: INVALID_ARGUMENT for fewer than 3 points or non-positive area, INTERNAL if CGAL fails.
+absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
+                                                     const TriangulateOptions& options = {});
+
+}  // namespace inbetween::solver

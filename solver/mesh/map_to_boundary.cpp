@@ -1,0 +1,392 @@
+// Injective map of shape 1's mesh into another boundary.
+//
+// Convex target: Tutte embedding with mean-value weights (Floater 2003), injective for a convex
+// boundary once boundary chords are split (see split_boundary_chords.h).
+// Otherwise, in the spirit of LIM (Schueller et al. 2013): start from the identity (shape 1's
+// own, valid geometry), pull the boundary vertices towards their targets with a quadratic
+// penalty whose weight grows stage by stage, while minimising the symmetric Dirichlet energy
+// relative to shape 1's triangles, SD(J) = |J|^2 + |J^-1|^2, which is infinite at a fold. Each
+// iteration solves the SLIM proxy (Rabinovich et al. 2017: reweighted local-global system) and
+// line-searches towards it, never beyond the first step at which some det(J) reaches zero
+// (smallest positive root of a quadratic per triangle). At the end the boundary is placed
+// exactly, checked to invert nothing, and the interior polished with the boundary fixed.
+#include "solver/mesh/map_to_boundary.h"
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <Eigen/Sparse>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "absl/strings/str_cat.h"
+#include "solver/geometry/polygon.h"
+#include "solver/mesh/validate.h"
+
+namespace inbetween::solver {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+struct TriangleFrame {
+  double area = 0.0;                 // source area (weight)
+  Eigen::Matrix<double, 3, 2> grad;  // J(r, c) = sum_j x_j(r) * grad(j, c)
+};
+
+// Which vertices move in a solve and where the fixed ones sit.
+struct Constraints {
+  std::vector<int> free_index;  // -1 = fixed at `fixed_at`
+  int free_count = 0;
+  Points fixed_at;       // positions used for fixed vertices (size n)
+  double penalty = 0.0;  // weight of |x_b - y_b|^2 for free boundary vertices
+};
+
+class Mapper {
+ public:
+  Mapper(const Points& source, const std::vector<Triangle>& triangles,
+         const std::vector<int>& boundary, const Points& target)
+      : triangles_(triangles), boundary_(boundary), target_(target) {
+    frames_.reserve(triangles.size());
+    for (const Triangle& t : triangles) {
+      Eigen::Matrix2d edges;
+      edges.col(0) = source[t[1]] - source[t[0]];
+      edges.col(1) = source[t[2]] - source[t[0]];
+      const Eigen::Matrix2d inv = edges.inverse();
+      TriangleFrame f;
+      f.area = 0.5 * edges.determinant();
+      f.grad.row(1) = inv.row(0);
+      f.grad.row(2) = inv.row(1);
+      f.grad.row(0) = -(inv.row(0) + inv.row(1));
+      total_area_ += f.area;
+      frames_.push_back(f);
+    }
+  }
+
+  double total_area() const { return total_area_; }
+
+  Eigen::Matrix2d Jacobian(size_t t, const Points& x) const {
+    Eigen::Matrix2d j = Eigen::Matrix2d::Zero();
+    for (int k = 0; k < 3; ++k) j += x[triangles_[t][k]] * frames_[t].grad.row(k);
+    return j;
+  }
+
+  // Sum of area * SD(J); infinite if any triangle is folded or degenerate.
+  double Distortion(const Points& x) const {
+    double e = 0.0;
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+      const Eigen::Matrix2d j = Jacobian(t, x);
+      const double det = j.determinant();
+      if (!(det > 0)) return kInf;
+      const double f2 = j.squaredNorm();
+      e += frames_[t].area * (f2 + f2 / (det * det));
+    }
+    return e;
+  }
+
+  double Energy(const Points& x, const Constraints& c) const {
+    double e = Distortion(x);
+    if (c.penalty > 0) {
+      for (size_t k = 0; k < boundary_.size(); ++k) {
+        e += c.penalty * (x[boundary_[k]] - target_[k]).squaredNorm();
+      }
+    }
+    return e;
+  }
+
+  // Minimiser of the SLIM proxy sum_t area |W_t (J_t - R_t)|^2 (+ boundary penalty).
+  bool ProxySolve(const Points& x, const Constraints& c, Points* out) const {
+    const int nf = c.free_count;
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(triangles_.size() * 4 * 36 + 2 * boundary_.size());
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * nf);
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+      const Eigen::Matrix2d j = Jacobian(t, x);
+      Eigen::JacobiSVD<Eigen::Matrix2d> svd(j, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      Eigen::Matrix2d u = svd.matrixU(), v = svd.matrixV();
+      Eigen::Vector2d s = svd.singularValues();
+      if (u.determinant() * v.determinant() < 0) {  // only for det(J) <= 0, kept for safety
+        u.col(1) *= -1;
+        s(1) *= -1;
+      }
+      Eigen::Vector2d w;
+      for (int i = 0; i < 2; ++i) {
+        const double si = std::max(s(i), 1e-8);
+        w(i) = std::sqrt((si + 1) * (si * si + 1) / (si * si * si));
+      }
+      const Eigen::Matrix2d weight = u * w.asDiagonal() * u.transpose();
+      const Eigen::Matrix2d target = weight * (u * v.transpose());
+      const double a = frames_[t].area;
+      for (int r = 0; r < 2; ++r) {
+        for (int col = 0; col < 2; ++col) {
+          int index[6];
+          double coef[6];
+          double constant = target(r, col);
+          int m = 0;
+          for (int sdim = 0; sdim < 2; ++sdim) {
+            for (int k = 0; k < 3; ++k) {
+              const int vtx = triangles_[t][k];
+              const double cf = weight(r, sdim) * frames_[t].grad(k, col);
+              if (c.free_index[vtx] < 0) {
+                constant -= cf * c.fixed_at[vtx](sdim);
+              } else {
+                index[m] = sdim * nf + c.free_index[vtx];
+                coef[m++] = cf;
+              }
+            }
+          }
+          for (int p = 0; p < m; ++p) {
+            rhs(index[p]) += a * coef[p] * constant;
+            for (int q = 0; q < m; ++q)
+              entries.emplace_back(index[p], index[q], a * coef[p] * coef[q]);
+          }
+        }
+      }
+    }
+    if (c.penalty > 0) {
+      for (size_t k = 0; k < boundary_.size(); ++k) {
+        const int fi = c.free_index[boundary_[k]];
+        if (fi < 0) continue;
+        for (int sdim = 0; sdim < 2; ++sdim) {
+          entries.emplace_back(sdim * nf + fi, sdim * nf + fi, c.penalty);
+          rhs(sdim * nf + fi) += c.penalty * target_[k](sdim);
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> h(2 * nf, 2 * nf);
+    h.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(h);
+    if (solver.info() != Eigen::Success) return false;
+    const Eigen::VectorXd sol = solver.solve(rhs);
+    if (solver.info() != Eigen::Success || !sol.allFinite()) return false;
+    *out = x;
+    for (size_t v = 0; v < x.size(); ++v) {
+      const int fi = c.free_index[v];
+      (*out)[v] = fi < 0 ? c.fixed_at[v] : Point(sol(fi), sol(nf + fi));
+    }
+    return true;
+  }
+
+  // Largest alpha such that x + a * d keeps every triangle positive for all a in [0, alpha).
+  double MaxStep(const Points& x, const Points& d) const {
+    double best = kInf;
+    for (const Triangle& t : triangles_) {
+      const Point e1 = x[t[1]] - x[t[0]], e2 = x[t[2]] - x[t[0]];
+      const Point f1 = d[t[1]] - d[t[0]], f2 = d[t[2]] - d[t[0]];
+      const double c0 = Cross(e1, e2), c1 = Cross(e1, f2) + Cross(f1, e2), c2 = Cross(f1, f2);
+      double root = kInf;
+      if (std::abs(c2) <= 1e-14 * std::abs(c0)) {
+        if (c1 < 0) root = -c0 / c1;
+      } else {
+        const double disc = c1 * c1 - 4 * c2 * c0;
+        if (disc >= 0) {
+          const double q = -0.5 * (c1 + std::copysign(std::sqrt(disc), c1));
+          for (double r : {q / c2, q != 0 ? c0 / q : kInf}) {
+            if (r > 0) root = std::min(root, r);
+          }
+        }
+      }
+      best = std::min(best, root);
+    }
+    return best;
+  }
+
+  // One iteration: proxy solve, flip-free backtracking line search on the true energy. Returns
+  // the relative energy decrease (0 when no progress), or -1 if the solve failed.
+  double Iterate(Points* x, const Constraints& c) const {
+    Points proxy;
+    if (!ProxySolve(*x, c, &proxy)) return -1;
+    Points d(x->size());
+    for (size_t v = 0; v < x->size(); ++v) d[v] = proxy[v] - (*x)[v];
+    double alpha = std::min(1.0, 0.9 * MaxStep(*x, d));
+    const double e0 = Energy(*x, c);
+    for (int tries = 0; tries < 40; ++tries, alpha *= 0.5) {
+      Points trial(x->size());
+      for (size_t v = 0; v < x->size(); ++v) trial[v] = (*x)[v] + alpha * d[v];
+      const double e1 = Energy(trial, c);
+      if (e1 < e0) {
+        *x = std::move(trial);
+        return (e0 - e1) / e0;
+      }
+    }
+    return 0.0;
+  }
+
+  double MaxBoundaryDistance(const Points& x) const {
+    double m = 0.0;
+    for (size_t k = 0; k < boundary_.size(); ++k) {
+      m = std::max(m, (x[boundary_[k]] - target_[k]).norm());
+    }
+    return m;
+  }
+
+ private:
+  const std::vector<Triangle>& triangles_;
+  const std::vector<int>& boundary_;
+  const Points& target_;
+  std::vector<TriangleFrame> frames_;
+  double total_area_ = 0.0;
+};
+
+// Mean-value Tutte embedding with the boundary pinned to `target`.
+bool TutteEmbedding(const Points& source, const std::vector<Triangle>& triangles,
+                    const std::vector<int>& boundary, const Points& target, Points* out) {
+  const int n = static_cast<int>(source.size());
+  std::vector<int> interior(n, -1);
+  std::vector<bool> pinned(n, false);
+  for (int b : boundary) pinned[b] = true;
+  int ni = 0;
+  for (int v = 0; v < n; ++v) {
+    if (!pinned[v]) interior[v] = ni++;
+  }
+  *out = source;
+  for (size_t k = 0; k < boundary.size(); ++k) (*out)[boundary[k]] = target[k];
+  if (ni == 0) return true;
+  std::vector<Eigen::Triplet<double>> entries;
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(ni, 2);
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int i = t[k], j = t[(k + 1) % 3], l = t[(k + 2) % 3];
+      if (interior[i] < 0) continue;
+      const Point a = source[j] - source[i], b = source[l] - source[i];
+      const double half_tan = std::tan(0.5 * std::atan2(std::abs(Cross(a, b)), a.dot(b)));
+      for (const auto& [other, len] : {std::pair<int, double>{j, a.norm()}, {l, b.norm()}}) {
+        const double w = half_tan / len;
+        entries.emplace_back(interior[i], interior[i], w);
+        if (interior[other] >= 0) {
+          entries.emplace_back(interior[i], interior[other], -w);
+        } else {
+          rhs.row(interior[i]) += w * (*out)[other].transpose();
+        }
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> m(ni, ni);
+  m.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+  lu.compute(m);
+  if (lu.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd sol = lu.solve(rhs);
+  if (lu.info() != Eigen::Success || !sol.allFinite()) return false;
+  for (int v = 0; v < n; ++v) {
+    if (interior[v] >= 0) (*out)[v] = sol.row(interior[v]).transpose();
+  }
+  return true;
+}
+
+}  // namespace
+
+absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Triangle>& triangles,
+                                     const std::vector<int>& boundary,
+                                     const Points& target_boundary,
+                                     const MapToBoundaryOptions& options, const CancelToken* cancel,
+                                     MapToBoundaryReport* report) {
+  const int n = static_cast<int>(source.size());
+  if (boundary.size() != target_boundary.size() || boundary.size() < 3) {
+    return absl::InvalidArgumentError(absl::StrCat("map: ", boundary.size(),
+                                                   " boundary vertices but ",
+                                                   target_boundary.size(), " target positions"));
+  }
+  for (int b : boundary) {
+    if (b < 0 || b >= n) return absl::InvalidArgumentError("map: boundary index out of range");
+  }
+  for (const Point& p : target_boundary) {
+    if (!p.allFinite()) return absl::InvalidArgumentError("map: target is not finite");
+  }
+  if (CountInverted(triangles, source) > 0) {
+    return absl::InvalidArgumentError("map: the source mesh has inverted triangles");
+  }
+  MapToBoundaryReport local_report;
+  MapToBoundaryReport& rep = report ? *report : local_report;
+  rep = MapToBoundaryReport();
+  auto cancelled = [&] { return cancel != nullptr && cancel->IsCancelled(); };
+
+  Mapper mapper(source, triangles, boundary, target_boundary);
+  Constraints fixed;  // boundary pinned at the target
+  fixed.free_index.assign(n, 0);
+  fixed.fixed_at = source;
+  for (size_t k = 0; k < boundary.size(); ++k) {
+    fixed.free_index[boundary[k]] = -1;
+    fixed.fixed_at[boundary[k]] = target_boundary[k];
+  }
+  for (int v = 0; v < n; ++v) {
+    if (fixed.free_index[v] >= 0) fixed.free_index[v] = fixed.free_count++;
+  }
+
+  Points x;
+  bool placed = false;
+  if (options.tutte_when_convex && IsConvexPositive(target_boundary) &&
+      TutteEmbedding(source, triangles, boundary, target_boundary, &x) &&
+      CountInverted(triangles, x) == 0) {
+    rep.tutte = placed = true;
+  }
+
+  if (!placed) {
+    // Progressive boundary pull from the identity.
+    x = source;
+    Constraints pull;
+    pull.free_index.resize(n);
+    for (int v = 0; v < n; ++v) pull.free_index[v] = v;
+    pull.free_count = n;
+    Point lo = target_boundary[0], hi = lo;
+    for (const Point& p : target_boundary) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double scale = (hi - lo).norm();
+    const double tolerance = options.boundary_tolerance * scale;
+    pull.penalty = mapper.total_area() / (boundary.size() * scale * scale);
+    while (mapper.MaxBoundaryDistance(x) > tolerance && rep.iterations < options.max_iterations) {
+      ++rep.stages;
+      pull.penalty *= 10;
+      for (int it = 0; it < options.iterations_per_stage && rep.iterations < options.max_iterations;
+           ++it) {
+        if (cancelled()) return absl::CancelledError("map: cancelled");
+        ++rep.iterations;
+        const double progress = mapper.Iterate(&x, pull);
+        if (progress < 0) return absl::FailedPreconditionError("map: linear solve failed");
+        if (progress < 1e-7) break;
+      }
+      if (rep.stages > 40) break;
+    }
+    const double distance = mapper.MaxBoundaryDistance(x);
+    if (distance > tolerance) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("the boundary could not be pulled onto the target without folding triangles "
+                       "(a boundary vertex stays ",
+                       distance, " away after ", rep.iterations, " iterations)"));
+    }
+    // Exact placement: the proxy step with the boundary pinned; it must not fold anything.
+    Points proxy;
+    if (!mapper.ProxySolve(x, fixed, &proxy)) {
+      return absl::FailedPreconditionError("map: linear solve failed");
+    }
+    Points d(n);
+    for (int v = 0; v < n; ++v) d[v] = proxy[v] - x[v];
+    if (!(mapper.MaxStep(x, d) > 1.0)) {
+      // Move the boundary alone instead.
+      for (int v = 0; v < n; ++v) d[v] = fixed.free_index[v] < 0 ? proxy[v] - x[v] : Point(0, 0);
+      if (!(mapper.MaxStep(x, d) > 1.0)) {
+        return absl::FailedPreconditionError(
+            "placing the boundary exactly on the target would fold a triangle");
+      }
+    }
+    for (int v = 0; v < n; ++v) x[v] += d[v];
+  }
+  for (size_t k = 0; k < boundary.size(); ++k) x[boundary[k]] = target_boundary[k];
+  if (CountInverted(triangles, x) > 0) {
+    return absl::FailedPreconditionError("the exactly placed boundary folds a triangle");
+  }
+  for (int it = 0; it < options.polish_iterations; ++it) {
+    if (cancelled()) return absl::CancelledError("map: cancelled");
+    ++rep.iterations;
+    const double progress = mapper.Iterate(&x, fixed);
+    if (progress < 1e-6) break;
+  }
+  for (size_t k = 0; k < boundary.size(); ++k) x[boundary[k]] = target_boundary[k];
+  if (const int inverted = CountInverted(triangles, x); inverted > 0) {
+    return absl::FailedPreconditionError(absl::StrCat(inverted, " triangles fold"));
+  }
+  rep.energy = mapper.Distortion(x) / mapper.total_area();
+  return x;
+}
+
+}  // namespace inbetween::solver

@@ -1,0 +1,45 @@
+// Injective map of a triangle mesh into a new boundary: Tutte embedding for convex targets,
+// otherwise a LIM-style progressive boundary pull under a symmetric Dirichlet barrier.
+#pragma once
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "solver/core/cancel.h"
+#include "solver/core/types.h"
+
+namespace inbetween::solver {
+
+struct MapToBoundaryOptions {
+  // Total SLIM iterations (local-global proxy + flip-free line search) allowed.
+  int max_iterations = 2000;
+  // Iterations per penalty stage of the boundary pull.
+  int iterations_per_stage = 60;
+  // Interior-only iterations after the boundary is exactly on target (quality polish).
+  int polish_iterations = 20;
+  // Boundary vertices must be within this distance (relative to the target's bounding-box
+  // diagonal) of their target before the final exact placement.
+  double boundary_tolerance = 1e-6;
+  // Try the mean-value Tutte embedding first when the target boundary is convex.
+  bool tutte_when_convex = true;
+};
+
+struct MapToBoundaryReport {
+  bool tutte = false;   // the result started from a convex Tutte embedding
+  int iterations = 0;   // SLIM iterations
+  int stages = 0;       // penalty stages of the boundary pull
+  double energy = 0.0;  // area-weighted mean symmetric Dirichlet (4 = isometry)
+};
+
+// `source` is a valid mesh (all `triangles` positive), `boundary` lists its boundary vertices in
+// order and `target_boundary[k]` is where boundary[k] must go. Returns positions for every
+// vertex: boundary exactly on target, no triangle inverted or degenerate.
+// Errors: INVALID_ARGUMENT (sizes), FAILED_PRECONDITION (no injective map found), CANCELLED.
+absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Triangle>& triangles,
+                                     const std::vector<int>& boundary,
+                                     const Points& target_boundary,
+                                     const MapToBoundaryOptions& options = {},
+                                     const CancelToken* cancel = nullptr,
+                                     MapToBoundaryReport* report = nullptr);
+
+}  // namespace inbetween::solver

@@ -1,0 +1,51 @@
+// Splits every interior edge joining two boundary vertices at its midpoint (1 -> 2 triangles on
+// each side), so that no triangle is spanned by boundary vertices alone.
+#include "solver/mesh/split_boundary_chords.h"
+
+#include <algorithm>
+#include <map>
+#include <utility>
+
+namespace inbetween::solver {
+
+int SplitBoundaryChords(Points* vertices, std::vector<Triangle>* triangles,
+                        std::vector<bool>* is_boundary) {
+  using Edge = std::pair<int, int>;
+  auto key = [](int a, int b) { return Edge(std::min(a, b), std::max(a, b)); };
+  std::map<Edge, int> count;
+  for (const Triangle& t : *triangles) {
+    for (int k = 0; k < 3; ++k) ++count[key(t[k], t[(k + 1) % 3])];
+  }
+  // Chords in a deterministic (sorted) order, each with its new midpoint vertex.
+  std::map<Edge, int> midpoint;
+  for (const auto& [edge, c] : count) {
+    if (c == 2 && (*is_boundary)[edge.first] && (*is_boundary)[edge.second]) {
+      midpoint[edge] = static_cast<int>(vertices->size());
+      vertices->push_back(0.5 * ((*vertices)[edge.first] + (*vertices)[edge.second]));
+      is_boundary->push_back(false);
+    }
+  }
+  if (midpoint.empty()) return 0;
+  // Split triangles; a triangle may hold several chords, so repeat until none is left.
+  std::vector<Triangle> pending = std::move(*triangles);
+  triangles->clear();
+  while (!pending.empty()) {
+    std::vector<Triangle> next;
+    for (const Triangle& t : pending) {
+      bool split = false;
+      for (int k = 0; k < 3 && !split; ++k) {
+        const int a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
+        auto it = midpoint.find(key(a, b));
+        if (it == midpoint.end()) continue;
+        next.push_back({a, it->second, c});
+        next.push_back({it->second, b, c});
+        split = true;
+      }
+      if (!split) triangles->push_back(t);
+    }
+    pending = std::move(next);
+  }
+  return static_cast<int>(midpoint.size());
+}
+
+}  // namespace inbetween::solver

@@ -1,0 +1,229 @@
+// Property tests for ImportSvg: path commands, transforms, basic shapes, orientation, errors.
+#include "solver/io/svg_import.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "solver/geometry/polygon.h"
+#include "tests/unit/solver/io/read_example.h"
+
+namespace inbetween::solver {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string Svg(const std::string& body) {
+  return "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"200\" height=\"200\">" + body +
+         "</svg>";
+}
+
+Drawing ImportOk(const std::string& svg, double tolerance = 0.05) {
+  SvgImportOptions options;
+  options.tolerance = tolerance;
+  absl::StatusOr<Drawing> d = ImportSvg(svg, options);
+  EXPECT_TRUE(d.ok()) << d.status();
+  return d.ok() ? *d : Drawing{};
+}
+
+void ExpectBox(const Points& p, double x0, double y0, double x1, double y1, double eps = 1e-9) {
+  Point lo = p[0], hi = p[0];
+  for (const Point& q : p) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  EXPECT_NEAR(lo.x(), x0, eps);
+  EXPECT_NEAR(lo.y(), y0, eps);
+  EXPECT_NEAR(hi.x(), x1, eps);
+  EXPECT_NEAR(hi.y(), y1, eps);
+}
+
+TEST(SvgImportTest, AbsoluteLinesGiveOnePositiveOutlineWithoutClosingPoint) {
+  // Drawn with negative orientation, with a repeated closing point and a duplicate point.
+  Drawing d = ImportOk(Svg("<path d=\"M 0 0 L 0 50 L 0 50 L 40 50 L 40 0 L 0 0 Z\"/>"));
+  ASSERT_EQ(d.outlines.size(), 1u);
+  EXPECT_EQ(d.outlines[0].points.size(), 4u);
+  EXPECT_DOUBLE_EQ(PolygonSignedArea(d.outlines[0].points), 2000.0);
+}
+
+TEST(SvgImportTest, RelativeAndOrthogonalCommandsMatchAbsolute) {
+  Drawing a = ImportOk(Svg("<path d=\"M10 20 H 50 V 60 H 10 Z\"/>"));
+  Drawing r = ImportOk(Svg("<path d=\"m10 20 h40 v40 h-40 z\"/>"));
+  Drawing l = ImportOk(Svg("<path d=\"M10,20 l40,0 0,40 -40,0z\"/>"));
+  ASSERT_EQ(a.outlines.size(), 1u);
+  ASSERT_EQ(r.outlines.size(), 1u);
+  ASSERT_EQ(l.outlines.size(), 1u);
+  EXPECT_EQ(a.outlines[0].points, r.outlines[0].points);
+  EXPECT_EQ(a.outlines[0].points, l.outlines[0].points);
+}
+
+TEST(SvgImportTest, ArcsFlattenWithinTolerance) {
+  // Full circle of radius 40 around (100, 100) from two arcs (absolute and relative).
+  const double tol = 0.05;
+  Drawing d =
+      ImportOk(Svg("<path d=\"M 60 100 A 40 40 0 0 1 140 100 a 40 40 0 0 1 -80 0 Z\"/>"), tol);
+  ASSERT_EQ(d.outlines.size(), 1u);
+  const Points& p = d.outlines[0].points;
+  EXPECT_GT(p.size(), 20u);
+  for (const Point& q : p) EXPECT_NEAR((q - Point(100, 100)).norm(), 40.0, 2e-3 * 40 + tol);
+  // Chord midpoints stay within the tolerance of the circle (plus the cubic approximation).
+  for (size_t i = 0; i < p.size(); ++i) {
+    const Point mid = 0.5 * (p[i] + p[(i + 1) % p.size()]);
+    EXPECT_GT((mid - Point(100, 100)).norm(), 40.0 - tol - 0.02);
+  }
+  EXPECT_NEAR(std::abs(PolygonSignedArea(p)), M_PI * 1600, 0.01 * M_PI * 1600);
+}
+
+TEST(SvgImportTest, CubicAndQuadraticShorthands) {
+  // C/S and Q/T curves bulging out of the square's sides stay inside their control hulls.
+  Drawing d =
+      ImportOk(Svg("<path d=\"M 0 0 C 10 -10 30 -10 40 0 S 50 30 40 40 Q 20 50 0 40 T 0 0 Z\"/>"));
+  ASSERT_EQ(d.outlines.size(), 1u);
+  const Points& p = d.outlines[0].points;
+  EXPECT_GT(p.size(), 12u);
+  for (const Point& q : p) {
+    EXPECT_TRUE(q.allFinite());
+    EXPECT_GE(q.x(), -10.0);
+    EXPECT_LE(q.x(), 50.0);
+    EXPECT_GE(q.y(), -10.0);
+    EXPECT_LE(q.y(), 50.0);
+  }
+  EXPECT_GT(PolygonSignedArea(p), 1600.0);  // bulges outward on three sides
+  // The relative forms give the same outline.
+  Drawing r = ImportOk(
+      Svg("<path d=\"m 0 0 c 10 -10 30 -10 40 0 s 10 30 0 40 q -20 10 -40 0 t 0 -40 z\"/>"));
+  ASSERT_EQ(r.outlines.size(), 1u);
+  ASSERT_EQ(r.outlines[0].points.size(), p.size());
+  for (size_t i = 0; i < p.size(); ++i) EXPECT_LT((r.outlines[0].points[i] - p[i]).norm(), 1e-9);
+}
+
+TEST(SvgImportTest, TransformsComposeThroughGroups) {
+  Drawing d = ImportOk(Svg(
+      "<g transform=\"translate(100 50)\"><g transform=\"scale(2)\">"
+      "<rect x=\"0\" y=\"0\" width=\"10\" height=\"5\" transform=\"translate(1,1)\"/></g></g>"));
+  ASSERT_EQ(d.outlines.size(), 1u);
+  ExpectBox(d.outlines[0].points, 102, 52, 122, 62);
+  EXPECT_NEAR(PolygonSignedArea(d.outlines[0].points), 200.0, 1e-9);
+}
+
+TEST(SvgImportTest, RotationMatrixAndMirrorKeepPositiveOrientation) {
+  Drawing d = ImportOk(Svg(
+      "<polygon points=\"0,0 10,0 10,10 0,10\" transform=\"matrix(-1 0 0 1 50 0) rotate(30)\"/>"));
+  ASSERT_EQ(d.outlines.size(), 1u);
+  EXPECT_NEAR(PolygonSignedArea(d.outlines[0].points), 100.0, 1e-9);
+}
+
+TEST(SvgImportTest, BasicShapes) {
+  Drawing d =
+      ImportOk(Svg("<rect x=\"0\" y=\"0\" width=\"30\" height=\"20\"/>"
+                   "<circle cx=\"100\" cy=\"100\" r=\"10\"/>"
+                   "<ellipse cx=\"150\" cy=\"30\" rx=\"20\" ry=\"10\"/>"
+                   "<polygon points=\"0,100 30,100 15,130\"/>"
+                   "<polyline points=\"0,150 30,150 30,180\"/>"
+                   "<rect x=\"50\" y=\"150\" width=\"40\" height=\"30\" rx=\"5\"/>"));
+  ASSERT_EQ(d.outlines.size(), 6u);
+  const double expected[] = {600, M_PI * 100, M_PI * 200, 450, 450, 1200 - (4 - M_PI) * 25};
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_NEAR(PolygonSignedArea(d.outlines[i].points), expected[i], 0.01 * expected[i]) << i;
+  }
+}
+
+TEST(SvgImportTest, HolesAreNegativeByNestingDepth) {
+  // Outer square, a hole (drawn in the same direction), and an island inside the hole.
+  Drawing d =
+      ImportOk(Svg("<path d=\"M0 0 H100 V100 H0 Z M20 20 H80 V80 H20 Z\"/>"
+                   "<circle cx=\"50\" cy=\"50\" r=\"10\"/>"
+                   "<rect x=\"150\" y=\"0\" width=\"10\" height=\"10\"/>"));
+  ASSERT_EQ(d.outlines.size(), 4u);
+  EXPECT_GT(PolygonSignedArea(d.outlines[0].points), 0);
+  EXPECT_LT(PolygonSignedArea(d.outlines[1].points), 0);
+  EXPECT_GT(PolygonSignedArea(d.outlines[2].points), 0);
+  EXPECT_GT(PolygonSignedArea(d.outlines[3].points), 0);
+}
+
+TEST(SvgImportTest, UnfilledAndNonRenderingElementsAreIgnored) {
+  Drawing d = ImportOk(Svg(
+      "<title>t</title><desc>d</desc><metadata><x/></metadata>"
+      "<defs><path id=\"template\" d=\"M0 0 H5 V5 Z\"/></defs>"
+      "<path fill=\"none\" stroke=\"black\" d=\"M0 0 H50 V50 Z\"/>"
+      "<path style=\"fill:none;stroke:red\" d=\"M0 0 H60 V60 Z\"/>"
+      "<g fill=\"none\"><rect width=\"70\" height=\"70\"/></g>"
+      "<g fill=\"none\"><rect fill=\"red\" data-name=\"kept\" width=\"80\" height=\"20\"/></g>"));
+  ASSERT_EQ(d.outlines.size(), 1u);
+  EXPECT_NEAR(PolygonSignedArea(d.outlines[0].points), 1600.0, 1e-9);
+}
+
+TEST(SvgImportTest, MissingNamespaceIsAccepted) {
+  Drawing d = ImportOk("<svg><path d=\"M0 0 H10 V10 H0 Z\"/></svg>");
+  ASSERT_EQ(d.outlines.size(), 1u);
+}
+
+TEST(SvgImportTest, MalformedXmlNamesTheLine) {
+  absl::StatusOr<Drawing> d =
+      ImportSvg("<svg xmlns=\"http://www.w3.org/2000/svg\">\n<path d=\"M0 0\"\n</svg>");
+  ASSERT_FALSE(d.ok());
+  EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(d.status().message(), HasSubstr("line 3"));
+}
+
+TEST(SvgImportTest, BadPathDataNamesTheElement) {
+  absl::StatusOr<Drawing> d = ImportSvg(Svg("<path id=\"wing\" d=\"M 0 0 L 10 banana Z\"/>"));
+  ASSERT_FALSE(d.ok());
+  EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(d.status().message(), HasSubstr("<path id=\"wing\">"));
+  EXPECT_THAT(d.status().message(), HasSubstr("line 1"));
+}
+
+TEST(SvgImportTest, NonFiniteCoordinatesAreRejected) {
+  for (const char* data : {"M 0 0 L 1e999 0 L 0 10 Z", "M 0 0 L nan 0 L 0 10 Z"}) {
+    absl::StatusOr<Drawing> d = ImportSvg(Svg(std::string("<path id=\"p\" d=\"") + data + "\"/>"));
+    ASSERT_FALSE(d.ok()) << data;
+    EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(d.status().message(), HasSubstr("id=\"p\"")) << d.status();
+  }
+}
+
+TEST(SvgImportTest, NoFilledShapeIsAnError) {
+  absl::StatusOr<Drawing> d = ImportSvg(Svg("<path fill=\"none\" d=\"M0 0 H10 V10 Z\"/>"));
+  ASSERT_FALSE(d.ok());
+  EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(d.status().message(), HasSubstr("no filled shape"));
+}
+
+TEST(SvgImportTest, EntitiesAreNeverExpanded) {
+  const std::string internal =
+      "<?xml version=\"1.0\"?>\n<!DOCTYPE svg [ <!ENTITY sq \"M0 0 H10 V10 H0 Z\"> ]>\n"
+      "<svg xmlns=\"http://www.w3.org/2000/svg\"><path d=\"&sq;\"/></svg>";
+  absl::StatusOr<Drawing> d = ImportSvg(internal);
+  ASSERT_FALSE(d.ok());
+  EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(d.status().message(), HasSubstr("entity"));
+
+  const std::string external =
+      "<?xml version=\"1.0\"?>\n<!DOCTYPE svg [ <!ENTITY x SYSTEM \"file:///etc/passwd\"> ]>\n"
+      "<svg xmlns=\"http://www.w3.org/2000/svg\"><title>&x;</title>"
+      "<path d=\"M0 0 H10 V10 H0 Z\"/></svg>";
+  d = ImportSvg(external);
+  ASSERT_FALSE(d.ok());
+  EXPECT_THAT(d.status().message(), HasSubstr("entity"));
+
+  // A declared but unused entity is harmless.
+  const std::string unused =
+      "<?xml version=\"1.0\"?>\n<!DOCTYPE svg [ <!ENTITY sq \"M0 0 H10 V10 H0 Z\"> ]>\n"
+      "<svg xmlns=\"http://www.w3.org/2000/svg\"><path d=\"M0 0 H5 V5 H0 Z\"/></svg>";
+  Drawing ok = ImportOk(unused);
+  ASSERT_EQ(ok.outlines.size(), 1u);
+  EXPECT_NEAR(PolygonSignedArea(ok.outlines[0].points), 25.0, 1e-12);
+}
+
+TEST(SvgImportTest, ExampleFilesImport) {
+  for (const char* name : {"square_hexagon/square.svg", "square_hexagon/hexagon.svg",
+                           "bar_arch/bar.svg", "bar_arch/arch.svg"}) {
+    const std::string text = ReadExample(name);
+    Drawing d = ImportOk(text);
+    ASSERT_EQ(d.outlines.size(), 1u) << name;
+    EXPECT_GT(PolygonSignedArea(d.outlines[0].points), 0) << name;
+  }
+}
+
+}  // namespace
+}  // namespace inbetween::solver

@@ -1,0 +1,132 @@
+// End-to-end tests of the slice: SVG examples -> multimesh, and its error statuses.
+#include "solver/mesh/build_multimesh.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "solver/geometry/polygon.h"
+#include "solver/io/svg_import.h"
+#include "solver/mesh/validate.h"
+#include "tests/unit/solver/io/read_example.h"
+
+namespace inbetween::solver {
+namespace {
+
+using ::testing::HasSubstr;
+
+Drawing Example(const std::string& name) {
+  absl::StatusOr<Drawing> d = ImportSvg(ReadExample(name));
+  EXPECT_TRUE(d.ok()) << name << ": " << d.status();
+  return d.ok() ? *d : Drawing{};
+}
+
+double DistanceToOutline(const Points& outline, const Point& p) {
+  double best = INFINITY;
+  for (size_t i = 0; i < outline.size(); ++i) {
+    const Point a = outline[i], d = outline[(i + 1) % outline.size()] - a;
+    const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (a + t * d - p).norm());
+  }
+  return best;
+}
+
+void ExpectValid(const std::vector<Drawing>& drawings, const Multimesh& mesh) {
+  EXPECT_TRUE(ValidateMultimesh(mesh).ok()) << ValidateMultimesh(mesh);
+  ASSERT_EQ(mesh.num_shapes(), static_cast<int>(drawings.size()));
+  EXPECT_GT(mesh.triangles.size(), 50u);
+  for (int s = 0; s < mesh.num_shapes(); ++s) {
+    EXPECT_EQ(CountInverted(mesh.triangles, mesh.shapes[s]), 0);
+    Points boundary;
+    for (int b : mesh.boundary) {
+      boundary.push_back(mesh.shapes[s][b]);
+      EXPECT_LT(DistanceToOutline(drawings[s].outlines[0].points, mesh.shapes[s][b]), 1e-9);
+    }
+    EXPECT_GT(PolygonSignedArea(boundary), 0);
+    // The mesh covers the drawing: triangle areas add up to the boundary's area.
+    double area = 0;
+    for (const Triangle& t : mesh.triangles) area += 0.5 * SignedArea2(t, mesh.shapes[s]);
+    EXPECT_NEAR(area, PolygonSignedArea(boundary), 1e-6 * std::abs(area));
+  }
+}
+
+TEST(BuildMultimeshTest, SquareHexagonExample) {
+  const std::vector<Drawing> drawings = {Example("square_hexagon/square.svg"),
+                                         Example("square_hexagon/hexagon.svg")};
+  std::vector<double> fractions;
+  MultimeshReport report;
+  absl::StatusOr<Multimesh> mesh = BuildMultimesh(
+      drawings, {}, nullptr,
+      [&](const std::string&, double f, const std::string&) { fractions.push_back(f); }, &report);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ExpectValid(drawings, *mesh);
+  EXPECT_EQ(report.vertices, mesh->num_vertices());
+  EXPECT_EQ(report.triangles, static_cast<int>(mesh->triangles.size()));
+  ASSERT_GE(fractions.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+  EXPECT_EQ(fractions.back(), 1.0);
+
+  // Deterministic.
+  absl::StatusOr<Multimesh> again = BuildMultimesh(drawings, {});
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->triangles, mesh->triangles);
+  EXPECT_EQ(again->shapes, mesh->shapes);
+}
+
+TEST(BuildMultimeshTest, BarArchExampleNonConvexBothWays) {
+  const Drawing bar = Example("bar_arch/bar.svg");
+  const Drawing arch = Example("bar_arch/arch.svg");
+  for (const std::vector<Drawing>& drawings :
+       {std::vector<Drawing>{bar, arch}, std::vector<Drawing>{arch, bar, arch}}) {
+    absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, {});
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    ExpectValid(drawings, *mesh);
+  }
+}
+
+TEST(BuildMultimeshTest, FineSizeBoundTransfersBoundarySteinerPoints) {
+  const std::vector<Drawing> drawings = {Example("square_hexagon/square.svg"),
+                                         Example("square_hexagon/hexagon.svg")};
+  MultimeshOptions options;
+  options.boundary_vertices = 24;
+  options.max_edge_relative = 0.03;
+  absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, options);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_GT(mesh->boundary.size(), 24u);
+  ExpectValid(drawings, *mesh);
+}
+
+TEST(BuildMultimeshTest, ErrorsNameTheDrawing) {
+  const Drawing square = Example("square_hexagon/square.svg");
+  EXPECT_EQ(BuildMultimesh({square}, {}).status().code(), absl::StatusCode::kInvalidArgument);
+
+  Drawing two = square;
+  two.outlines.push_back({{{200, 0}, {210, 0}, {210, 10}}});
+  absl::Status s = BuildMultimesh({square, square, two}, {}).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kUnimplemented);
+  EXPECT_THAT(s.message(), HasSubstr("drawing 2 has 2 outlines"));
+
+  const Drawing bow_tie{{Outline{{{0, 0}, {10, 10}, {10, 0}, {0, 10}}}}};
+  s = BuildMultimesh({square, bow_tie}, {}).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("drawing 1: outline crosses itself at (5, 5)"));
+
+  Drawing nan = square;
+  nan.outlines[0].points[2].x() = std::numeric_limits<double>::quiet_NaN();
+  s = BuildMultimesh({square, nan}, {}).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("drawing 1, outline 0, point 2 is not finite"));
+}
+
+TEST(BuildMultimeshTest, Cancelled) {
+  CancelToken cancel;
+  cancel.Cancel();
+  const Drawing square = Example("square_hexagon/square.svg");
+  EXPECT_EQ(BuildMultimesh({square, square}, {}, &cancel).status().code(),
+            absl::StatusCode::kCancelled);
+}
+
+}  // namespace
+}  // namespace inbetween::solver
