@@ -1,0 +1,58 @@
+// Comesh optimization objective (DESIGN "Comesh optimization"; S-eq.1, S-eq.2, S §6):
+//   E(X_1..X_n) = (1 - w) sum_i D_hat(X_i) + w sum_i C_hat(X_i, X_{i+1 mod n}),
+//   D_hat(X_i) = D(X_i) / N_i,             N_i = OdtNormalization(rest X_i)   (odt_energy.h)
+//   C_hat(X_i, X_j) = C(X_i, X_j) / A_i,   A_i = total area of rest X_i       (mips_energy.h)
+// Both terms are dimensionless and resolution independent, so w means the same at any scale and
+// mesh size (w = 0.5 by default, S-Table 1). The normalizers are frozen at the rest (input)
+// geometry so that E is a plain sum of per-triangle terms; with a fixed boundary they equal the
+// current values anyway. The cyclic sum suffices by the transitivity of MIPS (S §6).
+//
+// Reported numbers (the paper's columns):
+//   mesh energy = (1/n) sum_i D_hat(X_i)   (1 = tiling by equal equilateral triangles)
+//   map energy  = (1/n) sum_i C_hat(X_i, X_{i+1})  = mean over the cycle of the area-weighted
+//                 mean sigma* (2 = every map conformal).
+#pragma once
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "solver/core/types.h"
+
+namespace inbetween::solver {
+
+struct ComeshEnergies {
+  double objective = 0.0;  // E
+  double mesh = 0.0;       // mean normalized ODT energy
+  double map = 0.0;        // mean area-weighted sigma* over the cycle
+};
+
+class ComeshObjective {
+ public:
+  // Fails (InvalidArgument) without shapes, on shapes of different sizes, on triangle indices out
+  // of range or repeated, on w outside [0, 1], or on a shape of zero area.
+  static absl::StatusOr<ComeshObjective> Create(const std::vector<Triangle>& triangles,
+                                                const std::vector<Points>& rest,
+                                                double map_weight = 0.5);
+
+  // E(shapes); +inf if any triangle is inverted or degenerate in any shape. If `gradient` is
+  // given it is overwritten with dE/dX (same layout as `shapes`; not meaningful when E = +inf).
+  double Evaluate(const std::vector<Points>& shapes, std::vector<Points>* gradient = nullptr,
+                  ComeshEnergies* energies = nullptr) const;
+
+  int num_shapes() const { return static_cast<int>(areas_.size()); }
+  int num_vertices() const { return num_vertices_; }
+  double map_weight() const { return map_weight_; }
+  double rest_area(int shape) const { return areas_[shape]; }
+  const std::vector<Triangle>& triangles() const { return triangles_; }
+
+ private:
+  ComeshObjective() = default;
+
+  std::vector<Triangle> triangles_;
+  int num_vertices_ = 0;
+  double map_weight_ = 0.5;
+  std::vector<double> areas_;           // A_i
+  std::vector<double> odt_normalizer_;  // N_i
+};
+
+}  // namespace inbetween::solver

@@ -1,0 +1,86 @@
+// Tests for the comesh objective: (1 - w) ODT + w cyclic MIPS, gradient and reported energies.
+#include "solver/comesh/comesh_objective.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/unit/solver/comesh/comesh_test_meshes.h"
+
+namespace inbetween::solver {
+namespace {
+
+double RelativeGradientError(const ComeshObjective& o, const std::vector<Points>& shapes) {
+  std::vector<Points> g;
+  o.Evaluate(shapes, &g);
+  double err2 = 0.0, norm2 = 0.0;
+  const double h = 1e-7;
+  for (size_t s = 0; s < shapes.size(); ++s) {
+    for (size_t v = 0; v < shapes[s].size(); ++v) {
+      for (int c = 0; c < 2; ++c) {
+        std::vector<Points> p = shapes, m = shapes;
+        p[s][v][c] += h;
+        m[s][v][c] -= h;
+        const double fd = (o.Evaluate(p) - o.Evaluate(m)) / (2 * h);
+        err2 += (fd - g[s][v][c]) * (fd - g[s][v][c]);
+        norm2 += g[s][v][c] * g[s][v][c];
+      }
+    }
+  }
+  return std::sqrt(err2 / norm2);
+}
+
+TEST(ComeshObjectiveTest, GradientMatchesFiniteDifferences) {
+  const Multimesh m = testing::SquareGrid(4);
+  const Points a = testing::SmoothlyDistorted(m.shapes[0], 0.07);
+  const Points b = testing::TutteHexagon(m);
+  const Points c =
+      testing::Similar(testing::SmoothlyDistorted(m.shapes[0], -0.05), 0.4, 2.0, Point(1, 1));
+  for (double w : {0.0, 0.3, 0.5, 1.0}) {
+    for (const std::vector<Points>& shapes :
+         {std::vector<Points>{a}, std::vector<Points>{a, b}, std::vector<Points>{a, b, c}}) {
+      auto o = ComeshObjective::Create(m.triangles, shapes, w);
+      ASSERT_TRUE(o.ok()) << o.status();
+      EXPECT_LT(RelativeGradientError(*o, shapes), 1e-5)
+          << "w = " << w << ", shapes = " << shapes.size();
+    }
+  }
+}
+
+TEST(ComeshObjectiveTest, ReportsConformalAndGridEnergies) {
+  const Multimesh m = testing::SquareGrid(6);
+  const std::vector<Points> shapes = {m.shapes[0],
+                                      testing::Similar(m.shapes[0], 0.9, 3.0, Point(5, 1))};
+  auto o = ComeshObjective::Create(m.triangles, shapes, 0.25);
+  ASSERT_TRUE(o.ok());
+  ComeshEnergies e;
+  const double f = o->Evaluate(shapes, nullptr, &e);
+  EXPECT_NEAR(e.map, 2.0, 1e-12);
+  EXPECT_NEAR(e.mesh, 2.0 / std::sqrt(3.0), 1e-12);
+  EXPECT_NEAR(f, 2 * (0.75 * e.mesh + 0.25 * e.map), 1e-12);
+  EXPECT_EQ(e.objective, f);
+}
+
+TEST(ComeshObjectiveTest, InvertedShapeGivesInfinity) {
+  const Multimesh m = testing::SquareGrid(3);
+  std::vector<Points> shapes = {m.shapes[0], m.shapes[0]};
+  auto o = ComeshObjective::Create(m.triangles, shapes);
+  ASSERT_TRUE(o.ok());
+  shapes[1][5] = Point(2.0, 2.0);  // interior vertex thrown outside: flips triangles
+  EXPECT_TRUE(std::isinf(o->Evaluate(shapes)));
+}
+
+TEST(ComeshObjectiveTest, RejectsBadInput) {
+  const Multimesh m = testing::SquareGrid(2);
+  EXPECT_FALSE(ComeshObjective::Create(m.triangles, {}).ok());
+  EXPECT_FALSE(ComeshObjective::Create(m.triangles, {m.shapes[0]}, 1.5).ok());
+  Points shorter = m.shapes[0];
+  shorter.pop_back();
+  EXPECT_FALSE(ComeshObjective::Create(m.triangles, {m.shapes[0], shorter}).ok());
+  std::vector<Triangle> bad = m.triangles;
+  bad[0][1] = 99;
+  EXPECT_FALSE(ComeshObjective::Create(bad, {m.shapes[0]}).ok());
+}
+
+}  // namespace
+}  // namespace inbetween::solver

@@ -1,0 +1,168 @@
+// Tests for the comesh inner loop: descent, no inversion at any iterate, conformal limit,
+// improvement on square -> hexagon, cancellation, determinism, input validation.
+#include "solver/comesh/comesh_optimizer.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "solver/comesh/comesh_objective.h"
+#include "tests/unit/solver/comesh/comesh_test_meshes.h"
+
+namespace inbetween::solver {
+namespace {
+
+double TotalArea(const std::vector<Triangle>& triangles, const Points& x) {
+  double area = 0.0;
+  for (const Triangle& t : triangles) {
+    const Point ab = x[t[1]] - x[t[0]], ac = x[t[2]] - x[t[0]];
+    area += 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
+  }
+  return area;
+}
+
+// k even: see SquareGrid (no corner triangle with three vertices on one hexagon side).
+Multimesh SquareToHexagon(int k) {
+  Multimesh m = testing::SquareGrid(k);
+  m.shapes.push_back(testing::TutteHexagon(m));
+  return m;
+}
+
+TEST(ComeshOptimizerTest, DecreasesObjectiveWithoutInvertingAnyIterate) {
+  const Multimesh m = SquareToHexagon(10);
+  auto objective = ComeshObjective::Create(m.triangles, m.shapes, 0.5);
+  ASSERT_TRUE(objective.ok());
+  double previous = objective->Evaluate(m.shapes);
+  int iterates = 0, inverted = 0, increases = 0;
+  ComeshOptions options;
+  options.on_iterate = [&](int, const std::vector<Points>& shapes) {
+    ++iterates;
+    for (const Points& x : shapes) inverted += testing::CountNonPositive(m.triangles, x);
+    const double f = objective->Evaluate(shapes);
+    if (!(f <= previous)) ++increases;
+    previous = f;
+  };
+  ComeshReport report;
+  auto out = OptimizeComesh(m, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_GT(iterates, 5);
+  EXPECT_EQ(iterates, report.inner);
+  EXPECT_EQ(inverted, 0);
+  EXPECT_EQ(increases, 0);
+  EXPECT_LT(report.objective_after, report.objective_before);
+  EXPECT_LT(report.map_energy, report.map_energy_before);
+  EXPECT_EQ(report.vertices_before, m.num_vertices());
+  EXPECT_EQ(report.vertices_after, m.num_vertices());
+  // Sliding keeps every shape's domain: same total area, square boundary stays on the square.
+  for (int s = 0; s < m.num_shapes(); ++s) {
+    EXPECT_NEAR(TotalArea(m.triangles, out->shapes[s]), TotalArea(m.triangles, m.shapes[s]), 1e-12);
+  }
+  int moved = 0;
+  for (int v : m.boundary) {
+    const Point p = out->shapes[0][v];
+    EXPECT_NEAR(std::min({p.x(), p.y(), 1.0 - p.x(), 1.0 - p.y()}), 0.0, 1e-12);
+    moved += p != m.shapes[0][v];
+  }
+  EXPECT_GT(moved, 0);
+  for (const Point& corner : {Point(0, 0), Point(1, 0), Point(1, 1), Point(0, 1)}) {
+    bool found = false;
+    for (int v : m.boundary) found |= out->shapes[0][v] == corner;
+    EXPECT_TRUE(found) << corner.transpose();
+  }
+}
+
+TEST(ComeshOptimizerTest, FixedBoundaryWhenSlidingIsOff) {
+  const Multimesh m = SquareToHexagon(8);
+  ComeshOptions options;
+  options.slide_boundary = false;
+  ComeshReport report;
+  auto out = OptimizeComesh(m, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_LT(report.objective_after, report.objective_before);
+  for (int s = 0; s < m.num_shapes(); ++s) {
+    for (int v : m.boundary) EXPECT_EQ(out->shapes[s][v], m.shapes[s][v]);
+  }
+}
+
+TEST(ComeshOptimizerTest, SimilarShapesReachConformalMapEnergy) {
+  Multimesh m = testing::SquareGrid(8);
+  const Points distorted = testing::SmoothlyDistorted(m.shapes[0], 0.09);
+  m.shapes = {m.shapes[0], testing::Similar(distorted, 0.5, 2.5, Point(4, -1))};
+  ComeshReport report;
+  auto out = OptimizeComesh(m, ComeshOptions{}, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_GT(report.map_energy_before, 2.02);
+  EXPECT_LT(report.map_energy, 2.001) << report.stop_reason;
+  EXPECT_GE(report.map_energy, 2.0 - 1e-12);
+}
+
+TEST(ComeshOptimizerTest, SquareToHexagonImprovesMapAndKeepsMeshSane) {
+  const Multimesh m = SquareToHexagon(12);
+  for (bool laplacian : {true, false}) {
+    ComeshOptions options;
+    options.laplacian_preconditioner = laplacian;
+    ComeshReport report;
+    auto out = OptimizeComesh(m, options, nullptr, nullptr, &report);
+    ASSERT_TRUE(out.ok()) << out.status();
+    EXPECT_LT(report.map_energy, report.map_energy_before - 0.01) << "laplacian " << laplacian;
+    EXPECT_LT(report.mesh_energy, 1.5);
+    for (const Points& x : out->shapes) EXPECT_EQ(testing::CountNonPositive(m.triangles, x), 0);
+  }
+}
+
+TEST(ComeshOptimizerTest, ThreeShapeCycle) {
+  Multimesh m = SquareToHexagon(8);
+  m.shapes.push_back(testing::SmoothlyDistorted(m.shapes[0], -0.08));
+  ComeshReport report;
+  auto out = OptimizeComesh(m, ComeshOptions{}, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_LT(report.objective_after, report.objective_before);
+  for (const Points& x : out->shapes) EXPECT_EQ(testing::CountNonPositive(m.triangles, x), 0);
+}
+
+TEST(ComeshOptimizerTest, Deterministic) {
+  const Multimesh m = SquareToHexagon(8);
+  ComeshOptions options;
+  options.max_iterations = 40;
+  auto a = OptimizeComesh(m, options, nullptr, nullptr, nullptr);
+  auto b = OptimizeComesh(m, options, nullptr, nullptr, nullptr);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->shapes, b->shapes);
+}
+
+TEST(ComeshOptimizerTest, CancelStopsWithCancelled) {
+  const Multimesh m = SquareToHexagon(10);
+  CancelToken cancel;
+  int calls = 0;
+  ProgressFn progress = [&](const std::string& stage, double fraction, const std::string&) {
+    EXPECT_EQ(stage, "comesh");
+    EXPECT_GE(fraction, 0.0);
+    EXPECT_LE(fraction, 1.0);
+    if (++calls == 3) cancel.Cancel();
+  };
+  auto out = OptimizeComesh(m, ComeshOptions{}, &cancel, progress, nullptr);
+  EXPECT_TRUE(absl::IsCancelled(out.status())) << out.status();
+  EXPECT_EQ(calls, 3);
+}
+
+TEST(ComeshOptimizerTest, RejectsInvertedInputNamingShape) {
+  Multimesh m = SquareToHexagon(4);
+  std::swap(m.shapes[1][6], m.shapes[1][7]);
+  auto out = OptimizeComesh(m, ComeshOptions{}, nullptr, nullptr, nullptr);
+  ASSERT_EQ(out.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(out.status().message().find("shape 1"), std::string::npos) << out.status();
+}
+
+TEST(ComeshOptimizerTest, NothingFreeReturnsInput) {
+  Multimesh m = testing::SquareGrid(1);
+  m.shapes.push_back(testing::Similar(m.shapes[0], 0.1, 2.0, Point(0, 0)));
+  ComeshReport report;
+  auto out = OptimizeComesh(m, ComeshOptions{}, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok());
+  EXPECT_EQ(out->shapes, m.shapes);
+  EXPECT_EQ(report.stop_reason, "no_free");
+}
+
+}  // namespace
+}  // namespace inbetween::solver
