@@ -9,8 +9,8 @@
 namespace inbetween::solver {
 
 struct FrameTiming {
-  double time = 0.0;        // normalized time in [0, 1]
-  ExampleWeights weights;   // one per example, sum 1
+  double time = 0.0;       // normalized time in [0, 1]
+  ExampleWeights weights;  // one per example, sum 1
 };
 
 struct Schedule {
