@@ -1,0 +1,45 @@
+// Sparse SPD solver backend: A = L D L^T (CHOLMOD, SuiteSparse) behind one small pimpl class, so
+// that nothing else includes cholmod.h. The fill-reducing ordering and symbolic factorization are
+// computed once (Analyze); the numeric factorization can be redone for new values on the same
+// pattern (Factorize), e.g. the per-frame matrix sum_i w_i K_i of the inbetweening global step.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+
+namespace inbetween::solver {
+
+class SparseCholesky {
+ public:
+  SparseCholesky();
+  SparseCholesky(SparseCholesky&&) noexcept;
+  SparseCholesky& operator=(SparseCholesky&&) noexcept;
+  ~SparseCholesky();
+
+  // Symbolic analysis of the pattern of `a` (square; only the upper triangle, diagonal included,
+  // is read, so a full symmetric matrix may be passed). Forgets any previous factorization.
+  absl::Status Analyze(const Eigen::SparseMatrix<double>& a);
+
+  // Numeric factorization of `a`, which must have exactly the analyzed pattern (same compressed
+  // structure). FailedPrecondition if `a` is not positive definite.
+  absl::Status Factorize(const Eigen::SparseMatrix<double>& a);
+
+  // Analyze + Factorize.
+  absl::Status Compute(const Eigen::SparseMatrix<double>& a);
+
+  // Solves A X = B for all columns of B. FailedPrecondition before a successful Factorize.
+  absl::StatusOr<Eigen::MatrixXd> Solve(const Eigen::MatrixXd& b) const;
+
+  int rows() const;
+  bool factorized() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace inbetween::solver
