@@ -75,7 +75,7 @@ absl::Status RunAnimate(const AnimateOptions& options, InbetweenClient& client) 
   bar.Finish();
   if (!frames.ok()) return Annotate(frames.status(), "inbetween");
 
-  SvgFrameOptions svg_options;
+  render::SvgFrameOptions svg_options;
   svg_options.mesh_overlay = options.mesh_overlay;
   absl::Status written = WriteFrames(options.out_dir, *frames, svg_options);
   if (!written.ok()) return written;

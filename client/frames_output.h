@@ -5,22 +5,16 @@
 
 #include "absl/status/status.h"
 #include "client/inbetween_client.h"
-#include "nlohmann/json.hpp"
+#include "client/render/frame_set.h"
+#include "client/render/svg_frames.h"
 
 namespace inbetween::client {
 
-// The frames.json document (format in docs/file-formats.md):
-// {"triangles": [[i,j,k],...], "keys": [...], "frames": [{"index","time","weights","vertices"}]}
-nlohmann::json FramesToJson(const FramesResult& frames);
+// The stream's frames as plain render data.
+render::FrameSet ToFrameSet(const FramesResult& frames);
 
-struct SvgFrameOptions {
-  const char* fill = "#3b7dd8";
-  bool mesh_overlay = false;  // draw triangle edges on top
-};
-
-// One SVG per frame, all with the same viewBox (the union of every frame's bounds) so that a
-// sequence plays without jumping.
+// Writes DIR/frames.json (docs/file-formats.md) and one SVG per frame.
 absl::Status WriteFrames(const std::filesystem::path& dir, const FramesResult& frames,
-                         const SvgFrameOptions& options = {});
+                         const render::SvgFrameOptions& options = {});
 
 }  // namespace inbetween::client

@@ -37,7 +37,7 @@ FramesResult TwoFrames() {
 }
 
 TEST(FramesOutputTest, JsonHasTheDocumentedShape) {
-  nlohmann::json j = FramesToJson(TwoFrames());
+  nlohmann::json j = render::FrameSetToJson(ToFrameSet(TwoFrames()));
   EXPECT_EQ(j["triangles"], nlohmann::json::parse("[[0,1,2]]"));
   EXPECT_EQ(j["keys"], nlohmann::json::parse("[0,1]"));
   ASSERT_EQ(j["frames"].size(), 2u);

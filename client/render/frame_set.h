@@ -1,0 +1,35 @@
+// Plain frame data for rendering and export: what frames.json holds, without gRPC types.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "nlohmann/json.hpp"
+
+namespace inbetween::render {
+
+using Vertex = std::array<double, 2>;
+
+struct FrameData {
+  int index = 0;
+  double time = 0.0;             // normalized [0, 1]
+  std::vector<double> weights;   // example weights
+  std::vector<Vertex> vertices;  // one per mesh vertex, user units (y down)
+};
+
+struct FrameSet {
+  std::vector<std::array<int, 3>> triangles;  // shared by every frame
+  std::vector<int> keys;                      // frame index of each key drawing
+  std::vector<FrameData> frames;
+};
+
+// Parses a frames.json document (docs/file-formats.md). Errors name the JSON path
+// ("frames[3].vertices[10]: expected [x, y]").
+absl::StatusOr<FrameSet> FrameSetFromJson(const nlohmann::json& doc);
+
+// The frames.json document for a frame set (inverse of FrameSetFromJson).
+nlohmann::json FrameSetToJson(const FrameSet& frames);
+
+}  // namespace inbetween::render
