@@ -1,0 +1,57 @@
+// The project file (JSON, versioned; schema in docs/project-file.md): the drawings, their cuts,
+// openings and correspondences, key times and timing, every solver parameter, output settings.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "inbetween/v1/inbetween.pb.h"
+#include "nlohmann/json.hpp"
+
+namespace inbetween::client {
+
+inline constexpr int kProjectFileVersion = 1;
+
+using XY = std::array<double, 2>;
+using XYs = std::vector<XY>;
+
+struct ProjectDrawing {
+  std::filesystem::path file;      // SVG, relative paths resolved against the project's folder
+  std::optional<double> key_time;  // normalized [0, 1]
+  std::vector<XYs> cuts;           // open polylines
+  std::vector<XYs> openings;       // open polylines
+};
+
+struct OutputSettings {
+  std::vector<std::string> formats = {"svg", "json"};
+  int width = 512;      // raster width in pixels
+  double fps = 24.0;    // animation rate for GIF/WebP/Lottie
+  std::string fill = "#3b7dd8";
+  bool mesh_overlay = false;
+};
+
+struct Project {
+  int version = kProjectFileVersion;
+  std::vector<ProjectDrawing> drawings;
+  std::vector<XYs> correspondences;  // each: one point per drawing
+  v1::Parameters parameters;         // meshing, comesh, inbetween (unset = server defaults)
+  OutputSettings output;
+};
+
+// Parses and checks a project document. Unknown fields and wrong types are errors naming the
+// JSON path ("$.inbetween.tau: expected a number, got string"); relative drawing paths are
+// resolved against `base_dir`.
+absl::StatusOr<Project> ParseProject(const nlohmann::json& doc,
+                                     const std::filesystem::path& base_dir);
+
+// Reads and parses a project file; errors start with the file name.
+absl::StatusOr<Project> LoadProject(const std::filesystem::path& path);
+
+// The document for a project; drawing paths are written relative to `base_dir` when possible.
+nlohmann::json ProjectToJson(const Project& project, const std::filesystem::path& base_dir);
+
+}  // namespace inbetween::client

@@ -1,0 +1,92 @@
+// Tests client/project_file.cpp: schema checks with JSON paths, defaults, round trip.
+#include "client/project_file.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace inbetween::client {
+namespace {
+
+using ::testing::HasSubstr;
+using nlohmann::json;
+
+json Minimal() { return json::parse(R"({"version": 1, "drawings": ["a.svg", "b.svg"]})"); }
+
+TEST(ProjectFileTest, MinimalProjectResolvesPathsAgainstTheBaseDir) {
+  auto p = ParseProject(Minimal(), "/projects/walk");
+  ASSERT_TRUE(p.ok()) << p.status();
+  ASSERT_EQ(p->drawings.size(), 2u);
+  EXPECT_EQ(p->drawings[1].file, std::filesystem::path("/projects/walk/b.svg"));
+  EXPECT_FALSE(p->drawings[0].key_time.has_value());
+  EXPECT_FALSE(p->parameters.inbetween().has_tau());
+}
+
+TEST(ProjectFileTest, FullProjectRoundTrips) {
+  json doc = json::parse(R"({
+    "version": 1,
+    "drawings": [{"file": "a.svg", "key_time": 0, "cuts": [[[0,0],[1,1]]]},
+                 {"file": "b.svg", "key_time": 1, "openings": [[[2,2],[3,3],[4,2]]]}],
+    "correspondences": [[[0,0],[5,5]]],
+    "meshing": {"boundary_vertices": 96, "shape_bound": 0.1},
+    "comesh": {"map_weight": 0.3, "max_outer_iterations": 7},
+    "inbetween": {"method": "alexa", "frames": 30, "timing": "ease_in_out", "ease": [0.5],
+                  "stiffness": [{"polygon": [[0,0],[1,0],[1,1]], "kappa": 10}],
+                  "lambda": 2, "tau": 0.2, "alpha": 0.25, "epsilon": 0.5, "rho": 3,
+                  "timestep": 0.05, "max_iterations": 40},
+    "output": {"formats": ["svg", "gif"], "width": 256, "fps": 12, "fill": "#ff0000",
+               "mesh_overlay": true}})");
+  auto p = ParseProject(doc, "/base");
+  ASSERT_TRUE(p.ok()) << p.status();
+  EXPECT_EQ(p->parameters.inbetween().method(), v1::METHOD_ALEXA);
+  EXPECT_DOUBLE_EQ(p->parameters.inbetween().tau(), 0.2);
+  EXPECT_DOUBLE_EQ(p->parameters.comesh().map_weight(), 0.3);
+  EXPECT_EQ(p->drawings[0].cuts.size(), 1u);
+  EXPECT_EQ(p->drawings[1].openings[0].size(), 3u);
+  EXPECT_EQ(p->output.width, 256);
+  json again = ProjectToJson(*p, "/base");
+  EXPECT_EQ(again, doc) << again.dump(2);
+}
+
+struct BadCase {
+  const char* json_text;
+  const char* message;
+};
+
+class ProjectFileErrorTest : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(ProjectFileErrorTest, NamesTheJsonPath) {
+  auto p = ParseProject(json::parse(GetParam().json_text), "/base");
+  ASSERT_FALSE(p.ok());
+  EXPECT_EQ(p.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(p.status().message(), HasSubstr(GetParam().message));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Catalogue, ProjectFileErrorTest,
+    ::testing::Values(
+        BadCase{R"([1,2])", "$: expected an object"},
+        BadCase{R"({"drawings": ["a.svg", "b.svg"]})", "missing field 'version'"},
+        BadCase{R"({"version": 2, "drawings": ["a.svg", "b.svg"]})", "unsupported version 2"},
+        BadCase{R"({"version": 1, "drawings": ["a.svg"]})", "$.drawings: needs 2 to 16"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "colour": 1})",
+                "$.colour: unknown field"},
+        BadCase{R"({"version": 1, "drawings": ["a", {"file": 3}]})",
+                "$.drawings[1].file: expected a string, got number"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "inbetween": {"tau": "big"}})",
+                "$.inbetween.tau: expected a number, got string"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "inbetween": {"alpha": 2}})",
+                "$.inbetween.alpha: value 2 out of range [0, 1]"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "inbetween": {"method": "x"}})",
+                "$.inbetween.method: unknown method 'x'"},
+        BadCase{R"({"version": 1, "drawings": ["a", {"file": "b", "cuts": [[[0,0]]]}]})",
+                "$.drawings[1].cuts[0]: needs at least 2 points"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "correspondences": [[[0,0]]]})",
+                "$.correspondences[0]: needs at least 2 points"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"],
+                    "inbetween": {"stiffness": [{"polygon": [[0,0],[1,0],[1,"x"]], "kappa": 1}]}})",
+                "$.inbetween.stiffness[0].polygon[2][1]: expected a number"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "output": {"width": 1.5}})",
+                "$.output.width: expected an integer"}));
+
+}  // namespace
+}  // namespace inbetween::client
