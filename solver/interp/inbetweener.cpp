@@ -1,32 +1,51 @@
-// Inbetweening of a multimesh at given example weights w (the sum_i w_i W_D(X_i, x) part of the
-// per-frame objective in DESIGN.md; cohesion S-eq.4-16, non-overlap S-eq.8/9 and dynamics
-// S-eq.28/29 come with later issues).
+// Inbetweening of a multimesh at given example weights w: the per-frame objective of DESIGN.md,
+//   sum_i w_i [W_D(X_i, x) + W_C(C_i, x)] + W_O(x)  (+ the dynamics term of S-eq.28/29).
 //  - kLinear: x = sum_i w_i X_i.
 //  - kAlexa (Alexa, Cohen-Or, Levin 2000): per triangle A_i = R(theta_i) S_i from example 0 to i
 //    (example_rotations.h); target J*_t = R(sum_i w_i theta_it) sum_i w_i S_it; one least-squares
-//    solve min sum_t kappa_t A_0t ||J_t(x) - J*_t||^2 whose matrix (the Laplacian K_0 of example
-//    0) is factored once in Create.
-//  - kZhu17: local-global minimization of sum_i w_i W_D(X_i, x) (S-eq.3, arap_energy.h), started
-//    from the kAlexa solution. The global matrix sum_i w_i K_i changes with w but its pattern
-//    does not: CHOLMOD analyzes it once in Create and refactors numerically once per distinct
-//    weight vector (every iteration of a frame reuses it).
-// Translation gauge (all methods): W_D is invariant to translating each connected component, so
-// the lowest-index vertex of each component is pinned during the solve (making the reduced
-// matrices positive definite) and the component is then shifted so that its mass-weighted
-// centroid c(x) = sum_v m_v x_v / sum_v m_v equals sum_i w_i c(X_i). The vertex masses m_v (a
-// third of the adjacent triangles' areas, averaged over the examples) are the same for all shapes,
-// so c is linear and the key shapes keep their own centroids.
+//    solve min sum_t kappa_t A_0t ||J_t(x) - J*_t||^2 with example 0's Laplacian, factored once.
+//  - kZhu17: local-global minimization of
+//      E(x) = Wbar(w, x) + W_C(w, x)                       (blended_arap.h, cohesive_energy.h)
+//    Wbar is S-eq.3 per example measured in one fixed reference per triangle, so the global
+//    matrix Kbar + Hbar (cohesive) does not depend on w: CHOLMOD factors it ONCE in Create, and
+//    every iteration of every frame is a local step plus one back-substitution with 2 right-hand
+//    sides. W_C's weight-dependent, capped and anisotropic parts enter only the right-hand side
+//    (majorize-minimize, cohesive_energy.h). Each iteration lowers E (Anderson steps that would
+//    not are replaced by the plain step). The start is the lower-energy of (a) the Alexa targets
+//    solved with the same matrix and (b) the previous frame moved into this frame's gauge.
+//    Non-overlap W_O (S-eq.8/9) is checked on every frame (overlap.h) and, when violated, enforced
+//    by pushing the offending boundary vertices out to the boundary with a stiff spring term
+//    (a second matrix with the spring on every boundary vertex, factored on first use).
+//  - Dynamics (S-eq.28/29, DESIGN.md's reading), kZhu17 with epsilon > 0: Phi = the frame above;
+//    x = argmin beta ||x - x_pred||_M^2 + Wbar(Phi, x) + W_C, x_pred = 2 x(s-1) - x(s-2) moved
+//    into Phi's gauge, beta = xi rho / (2 h^2) = epsilon kappa / (2 (delta + 1)),
+//    delta = Wbar(Phi, x(s-1)) (S-eq.29), kappa the area-weighted mean stiffness. The matrix holds
+//    beta_max M, beta_max = epsilon kappa / 2 >= beta (factored once; the difference is
+//    majorized like W_C). Key frames stay exact.
+// Gauge (rigid motions leave E unchanged): per gauge group (vertices connected by triangles or
+// cohesive pairs) the mass-weighted centroid is sum_i w_i c_i (example centroids), and for kZhu17
+// the area-weighted mean rotation angle relative to example 0 is that of the Alexa angles
+// sum_i w_i theta_it (blended_arap.h AngleOffset). The translation is fixed by pinning one vertex
+// per group in the solve and shifting afterwards; the vertex masses m_v (a third of the adjacent
+// triangles' areas, averaged over the examples) are the same for all shapes, so keys keep their
+// own centroids.
 #include "solver/interp/inbetweener.h"
 
+#include <Eigen/Cholesky>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <numeric>
+#include <optional>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "solver/core/sparse_cholesky.h"
 #include "solver/interp/arap_energy.h"
+#include "solver/interp/blended_arap.h"
+#include "solver/interp/cohesive_energy.h"
 #include "solver/interp/example_rotations.h"
+#include "solver/interp/overlap.h"
 #include "solver/interp/polar.h"
 
 namespace inbetween::solver {
@@ -62,71 +81,165 @@ absl::Status CheckMesh(const Multimesh& mesh) {
   return absl::OkStatus();
 }
 
+// Anderson acceleration (type II, Walker & Ni 2011) of x -> G(x) with a sliding window; the Gram
+// matrix of the residual differences is updated incrementally.
+class Anderson {
+ public:
+  explicit Anderson(int history) : m_(history) {}
+
+  void Reset() {
+    dg_.clear();
+    df_.clear();
+    gram_.clear();
+    has_previous_ = false;
+  }
+
+  // g = G(x_k), f = G(x_k) - x_k; returns x_{k+1}.
+  Eigen::VectorXd Step(const Eigen::VectorXd& g, const Eigen::VectorXd& f) {
+    if (has_previous_) {
+      dg_.push_back(g - g_previous_);
+      df_.push_back(f - f_previous_);
+      std::vector<double> row(df_.size());
+      for (size_t j = 0; j < df_.size(); ++j) row[j] = df_.back().dot(df_[j]);
+      gram_.push_back(row);
+      if (static_cast<int>(df_.size()) > m_) {
+        dg_.pop_front();
+        df_.pop_front();
+        gram_.pop_front();
+        for (auto& r : gram_) r.erase(r.begin());
+      }
+    }
+    g_previous_ = g;
+    f_previous_ = f;
+    has_previous_ = true;
+    const int k = static_cast<int>(df_.size());
+    if (k == 0) return g;
+    Eigen::MatrixXd a(k, k);
+    Eigen::VectorXd rhs(k);
+    for (int i = 0; i < k; ++i) {
+      for (int j = 0; j <= i; ++j) a(i, j) = a(j, i) = gram_[i][j];
+      rhs(i) = df_[i].dot(f);
+    }
+    a.diagonal().array() += 1e-10 * a.trace() / k + 1e-300;
+    const Eigen::VectorXd gamma = a.ldlt().solve(rhs);
+    Eigen::VectorXd x = g;
+    for (int j = 0; j < k; ++j) x -= gamma(j) * dg_[j];
+    return x;
+  }
+
+ private:
+  int m_;
+  std::deque<Eigen::VectorXd> dg_, df_;
+  std::deque<std::vector<double>> gram_;  // gram_[i][j] = df_i . df_j, j <= i
+  Eigen::VectorXd g_previous_, f_previous_;
+  bool has_previous_ = false;
+};
+
 }  // namespace
 
 struct Inbetweener::Impl {
   InbetweenOptions options;
   std::vector<Triangle> triangles;
   std::vector<Coords> shapes;
-  std::vector<ArapEnergy> energies;  // W_D(X_i, .) per example
-  ExampleRotations rotations;        // Alexa split, unwrapped
+  std::optional<BlendedArap> arap;         // kZhu17 energy (also reported for all methods)
+  std::optional<CohesiveEnergy> cohesive;  // may have no edges
+  std::optional<OverlapChecker> overlap;
+  std::optional<ArapEnergy> alexa_energy;  // example 0, kAlexa
+  ExampleRotations rotations;              // kAlexa split, unwrapped
 
   // Gauge.
-  std::vector<int> component;  // per vertex
-  int num_components = 0;
+  std::vector<int> group;  // per vertex
+  int num_groups = 0;
   std::vector<double> mass;                             // m_v
-  std::vector<double> component_mass;                   // sum of m_v per component
-  std::vector<std::vector<Eigen::Vector2d>> centroids;  // [example][component]
-  std::vector<int> free_index;                          // reduced index, -1 for pinned vertices
+  std::vector<double> group_mass;                       // sum of m_v per group
+  std::vector<std::vector<Eigen::Vector2d>> centroids;  // [example][group]
+  std::vector<std::vector<int>> group_triangles;
+  std::vector<int> free_index;  // reduced index, -1 for pinned vertices
   int num_free = 0;
+  double size = 1.0;        // sqrt of the total reference area
+  double mean_kappa = 1.0;  // area-weighted
 
-  // Reduced (pinned rows/columns removed) Laplacians: one pattern, values per example.
-  Eigen::SparseMatrix<double> reduced;
-  std::vector<Eigen::VectorXd> reduced_values;
-  SparseCholesky alexa_solver;  // K_0, factored in Create
-  SparseCholesky zhu_solver;    // sum_i w_i K_i, analyzed in Create
-  ExampleWeights zhu_factored_weights;
+  SparseCholesky solver;          // kAlexa: K_0; kZhu17: Kbar + Hbar (pinned)
+  SparseCholesky dynamic_solver;  // Kbar + Hbar + beta_max M (not pinned), epsilon > 0
+  SparseCholesky contact_solver;  // Kbar + Hbar + gamma on boundary vertices (pinned), lazily
+  bool contact_factored = false;
+  double contact_stiffness = 0.0;
+  Eigen::SparseMatrix<double> zhu_matrix;  // Kbar + Hbar, full
+
+  // The two frames Solve returned last (dynamics through the two-argument Solve).
+  Points last_frame, frame_before_last;
+
+  // What one frame's objective is made of (see the header comment).
+  struct Problem {
+    const ExampleWeights* w = nullptr;
+    std::vector<double> thresholds;  // cohesive tau_e l_e
+    // Dynamics: rest = Jbar(Phi) per triangle, inertia beta ||x - pred||_M^2, matrix beta_max M.
+    bool dynamic = false;
+    std::vector<Eigen::Matrix2d> rest;
+    Coords pred;
+    double beta = 0.0, beta_max = 0.0;
+    std::vector<Eigen::Vector2d> group_centroids;  // gauge target per group
+    // Contacts: spring gamma ||x_v - target_v||^2 on boundary vertices (others: proximal).
+    bool contact = false;
+    std::vector<OverlapContact> contacts;
+  };
 
   int num_vertices() const { return static_cast<int>(free_index.size()); }
-
   absl::Status Setup(const Multimesh& mesh);
-  void ApplyGauge(const ExampleWeights& w, Coords* x) const;
-  absl::StatusOr<Coords> SolveReduced(const SparseCholesky& solver, const Coords& b,
-                                      const ExampleWeights& w) const;
-  double BlendedEnergy(const ExampleWeights& w, const Coords& x) const;
+  absl::StatusOr<Eigen::SparseMatrix<double>> Reduce(const Eigen::SparseMatrix<double>& k) const;
+  std::vector<Eigen::Vector2d> BlendedCentroids(const ExampleWeights& w) const;
+  Eigen::Vector2d Centroid(const Coords& x, int g) const;
+  void Translate(const std::vector<Eigen::Vector2d>& target, Coords* x) const;
+  void Rotate(const ExampleWeights& w, Coords* x) const;
+  absl::StatusOr<Coords> GlobalSolve(const SparseCholesky& s, bool pinned, const Coords& b,
+                                     const std::vector<Eigen::Vector2d>& centroid_target) const;
+  double Evaluate(const Coords& x, const Problem& p, Coords* rhs, int* separated) const;
+  absl::StatusOr<Coords> Iterate(const Problem& p, Coords x, double energy, Coords rhs,
+                                 const CancelToken* cancel, FrameReport* report) const;
   absl::StatusOr<Coords> Alexa(const ExampleWeights& w) const;
   absl::StatusOr<Coords> Zhu17(const ExampleWeights& w, const Frame& previous,
-                               const CancelToken* cancel, FrameReport* report);
+                               const Frame& before_previous, const CancelToken* cancel,
+                               FrameReport* report);
+  absl::Status EnforceNonOverlap(Problem* p, Coords* x, const CancelToken* cancel,
+                                 FrameReport* report);
+  absl::StatusOr<Frame> Solve(const ExampleWeights& weights, const Frame& previous,
+                              const Frame& before_previous, const CancelToken* cancel,
+                              FrameReport* report);
 };
 
 absl::Status Inbetweener::Impl::Setup(const Multimesh& mesh) {
   triangles = mesh.triangles;
   const int n = mesh.num_vertices();
   const int num_shapes = mesh.num_shapes();
-  for (int i = 0; i < num_shapes; ++i) {
-    absl::StatusOr<ArapEnergy> e = ArapEnergy::Create(triangles, mesh.shapes[i], options.stiffness);
-    if (!e.ok()) {
-      return absl::InvalidArgumentError(absl::StrCat("shape ", i, ": ", e.status().message()));
-    }
-    energies.push_back(*std::move(e));
-    shapes.push_back(ToCoords(mesh.shapes[i]));
-  }
-  rotations = ComputeExampleRotations(triangles, mesh.shapes);
+  for (int i = 0; i < num_shapes; ++i) shapes.push_back(ToCoords(mesh.shapes[i]));
+  absl::StatusOr<BlendedArap> blended =
+      BlendedArap::Create(triangles, mesh.shapes, options.stiffness);
+  if (!blended.ok()) return blended.status();
+  arap = *std::move(blended);
+  absl::StatusOr<CohesiveEnergy> coh =
+      CohesiveEnergy::Create(mesh.cohesive_edges, mesh.shapes,
+                             {options.lambda, options.tau, options.alpha, options.hysteresis});
+  if (!coh.ok()) return coh.status();
+  cohesive = *std::move(coh);
+  overlap.emplace(triangles, mesh.cohesive_edges, n);
 
-  // Connected components by shared vertices (union-find, roots = lowest index).
+  // Gauge groups: connected by shared triangle vertices or cohesive pairs (union-find, roots =
+  // lowest index).
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&](int v) {
     while (parent[v] != v) v = parent[v] = parent[parent[v]];
     return v;
   };
+  auto unite = [&](int p, int q) {
+    const int a = find(p), b = find(q);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
   std::vector<char> used(n, 0);
   for (const Triangle& t : triangles) {
     for (int k = 0; k < 3; ++k) {
       used[t[k]] = 1;
-      const int a = find(t[k]);
-      const int b = find(t[(k + 1) % 3]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      unite(t[k], t[(k + 1) % 3]);
     }
   }
   for (int v = 0; v < n; ++v) {
@@ -134,104 +247,249 @@ absl::Status Inbetweener::Impl::Setup(const Multimesh& mesh) {
       return absl::InvalidArgumentError(absl::StrCat("vertex ", v, " is in no triangle"));
     }
   }
-  component.assign(n, -1);
+  if (options.lambda > 0.0) {
+    for (const auto& e : mesh.cohesive_edges) {
+      unite(e[0], e[2]);
+      unite(e[1], e[3]);
+    }
+  }
+  group.assign(n, -1);
   free_index.assign(n, -1);
-  std::vector<int> root_component(n, -1);
+  std::vector<int> root_group(n, -1);
   for (int v = 0; v < n; ++v) {
     const int r = find(v);
-    if (root_component[r] < 0) {
-      root_component[r] = num_components++;  // v == r: the pinned vertex
+    if (root_group[r] < 0) {
+      root_group[r] = num_groups++;  // v == r: the pinned vertex
     } else {
       free_index[v] = num_free++;
     }
-    component[v] = root_component[r];
+    group[v] = root_group[r];
+  }
+  group_triangles.assign(num_groups, {});
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
+    group_triangles[group[triangles[t][0]]].push_back(t);
   }
 
   mass.assign(n, 0.0);
+  double total_area = 0.0, kappa_area = 0.0;
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
     double area = 0.0;
-    for (const ArapEnergy& e : energies) area += e.rest_area(t);
+    for (int i = 0; i < num_shapes; ++i) {
+      const Triangle& tri = triangles[t];
+      const Eigen::Vector2d e1 = mesh.shapes[i][tri[1]] - mesh.shapes[i][tri[0]];
+      const Eigen::Vector2d e2 = mesh.shapes[i][tri[2]] - mesh.shapes[i][tri[0]];
+      area += 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+    }
     area /= static_cast<double>(num_shapes);
     for (int k = 0; k < 3; ++k) mass[triangles[t][k]] += area / 3.0;
+    total_area += arap->reference_area(t);
+    kappa_area += arap->stiffness(t) * arap->reference_area(t);
   }
-  component_mass.assign(num_components, 0.0);
-  for (int v = 0; v < n; ++v) component_mass[component[v]] += mass[v];
-  centroids.assign(num_shapes,
-                   std::vector<Eigen::Vector2d>(num_components, Eigen::Vector2d::Zero()));
+  size = std::sqrt(total_area);
+  mean_kappa = kappa_area / total_area;
+  group_mass.assign(num_groups, 0.0);
+  for (int v = 0; v < n; ++v) group_mass[group[v]] += mass[v];
+  centroids.assign(num_shapes, std::vector<Eigen::Vector2d>(num_groups, Eigen::Vector2d::Zero()));
   for (int i = 0; i < num_shapes; ++i) {
-    for (int v = 0; v < n; ++v) {
-      centroids[i][component[v]] += mass[v] * shapes[i].row(v).transpose();
-    }
-    for (int c = 0; c < num_components; ++c) centroids[i][c] /= component_mass[c];
+    for (int v = 0; v < n; ++v) centroids[i][group[v]] += mass[v] * shapes[i].row(v).transpose();
+    for (int g = 0; g < num_groups; ++g) centroids[i][g] /= group_mass[g];
   }
 
-  // Reduced Laplacians. Every K_i has the same pattern (triangle list only), and the reduction
-  // keeps it, so one analysis serves every weighted sum.
-  for (int i = 0; i < num_shapes; ++i) {
-    const Eigen::SparseMatrix<double>& k = energies[i].Laplacian();
+  if (options.method == InterpMethod::kAlexa) {
+    absl::StatusOr<ArapEnergy> e = ArapEnergy::Create(triangles, mesh.shapes[0], options.stiffness);
+    if (!e.ok()) return e.status();
+    alexa_energy = *std::move(e);
+    rotations = ComputeExampleRotations(triangles, mesh.shapes);
+    absl::StatusOr<Eigen::SparseMatrix<double>> k = Reduce(alexa_energy->Laplacian());
+    if (!k.ok()) return k.status();
+    if (absl::Status s = solver.Compute(*k); !s.ok()) {
+      return absl::InternalError(absl::StrCat("factoring example 0's ARAP matrix: ", s.message()));
+    }
+  } else if (options.method == InterpMethod::kZhu17) {
     std::vector<Eigen::Triplet<double>> triplets;
-    triplets.reserve(static_cast<size_t>(k.nonZeros()));
-    for (int col = 0; col < k.outerSize(); ++col) {
-      if (free_index[col] < 0) continue;
-      for (Eigen::SparseMatrix<double>::InnerIterator it(k, col); it; ++it) {
-        if (free_index[it.row()] < 0) continue;
-        triplets.emplace_back(free_index[it.row()], free_index[col], it.value());
+    cohesive->AddMatrix(&triplets);
+    Eigen::SparseMatrix<double> h(n, n);
+    h.setFromTriplets(triplets.begin(), triplets.end());
+    zhu_matrix = arap->Laplacian() + h;
+    zhu_matrix.makeCompressed();
+    absl::StatusOr<Eigen::SparseMatrix<double>> k = Reduce(zhu_matrix);
+    if (!k.ok()) return k.status();
+    if (absl::Status s = solver.Compute(*k); !s.ok()) {
+      return absl::InternalError(absl::StrCat("factoring the inbetweening matrix: ", s.message()));
+    }
+    if (options.epsilon > 0.0) {
+      Eigen::SparseMatrix<double> m = zhu_matrix;
+      const double beta_max = 0.5 * options.epsilon * mean_kappa;
+      for (int v = 0; v < n; ++v) m.coeffRef(v, v) += beta_max * mass[v];
+      m.makeCompressed();
+      if (absl::Status s = dynamic_solver.Compute(m); !s.ok()) {
+        return absl::InternalError(absl::StrCat("factoring the dynamics matrix: ", s.message()));
       }
     }
-    Eigen::SparseMatrix<double> r(num_free, num_free);
-    r.setFromTriplets(triplets.begin(), triplets.end());
-    r.makeCompressed();
-    if (i == 0) {
-      reduced = r;
-    } else if (r.nonZeros() != reduced.nonZeros() ||
-               !std::equal(r.innerIndexPtr(), r.innerIndexPtr() + r.nonZeros(),
-                           reduced.innerIndexPtr())) {
-      return absl::InternalError("example Laplacians do not share one sparsity pattern");
-    }
-    reduced_values.push_back(Eigen::Map<const Eigen::VectorXd>(r.valuePtr(), r.nonZeros()));
   }
-  if (absl::Status s = alexa_solver.Compute(reduced); !s.ok()) {
-    return absl::InternalError(absl::StrCat("factoring example 0's ARAP matrix: ", s.message()));
-  }
-  if (absl::Status s = zhu_solver.Analyze(reduced); !s.ok()) return s;
   return absl::OkStatus();
 }
 
-void Inbetweener::Impl::ApplyGauge(const ExampleWeights& w, Coords* x) const {
-  std::vector<Eigen::Vector2d> shift(num_components, Eigen::Vector2d::Zero());
-  for (int v = 0; v < num_vertices(); ++v) {
-    shift[component[v]] -= mass[v] * x->row(v).transpose();
+absl::StatusOr<Eigen::SparseMatrix<double>> Inbetweener::Impl::Reduce(
+    const Eigen::SparseMatrix<double>& k) const {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<size_t>(k.nonZeros()));
+  for (int col = 0; col < k.outerSize(); ++col) {
+    if (free_index[col] < 0) continue;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(k, col); it; ++it) {
+      if (free_index[it.row()] < 0) continue;
+      triplets.emplace_back(free_index[it.row()], free_index[col], it.value());
+    }
   }
-  for (int c = 0; c < num_components; ++c) {
-    shift[c] /= component_mass[c];
-    for (size_t i = 0; i < w.size(); ++i) shift[c] += w[i] * centroids[i][c];
-  }
-  for (int v = 0; v < num_vertices(); ++v) x->row(v) += shift[component[v]].transpose();
+  Eigen::SparseMatrix<double> r(num_free, num_free);
+  r.setFromTriplets(triplets.begin(), triplets.end());
+  r.makeCompressed();
+  return r;
 }
 
-absl::StatusOr<Coords> Inbetweener::Impl::SolveReduced(const SparseCholesky& solver,
-                                                       const Coords& b,
-                                                       const ExampleWeights& w) const {
-  Eigen::MatrixXd rhs(num_free, 2);
-  for (int v = 0; v < num_vertices(); ++v) {
-    if (free_index[v] >= 0) rhs.row(free_index[v]) = b.row(v);
+std::vector<Eigen::Vector2d> Inbetweener::Impl::BlendedCentroids(const ExampleWeights& w) const {
+  std::vector<Eigen::Vector2d> c(num_groups, Eigen::Vector2d::Zero());
+  for (int g = 0; g < num_groups; ++g) {
+    for (size_t i = 0; i < w.size(); ++i) c[g] += w[i] * centroids[i][g];
   }
-  absl::StatusOr<Eigen::MatrixXd> sol = solver.Solve(rhs);
-  if (!sol.ok()) return sol.status();
+  return c;
+}
+
+Eigen::Vector2d Inbetweener::Impl::Centroid(const Coords& x, int g) const {
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  for (int v = 0; v < num_vertices(); ++v) {
+    if (group[v] == g) c += mass[v] * x.row(v).transpose();
+  }
+  return c / group_mass[g];
+}
+
+void Inbetweener::Impl::Translate(const std::vector<Eigen::Vector2d>& target, Coords* x) const {
+  std::vector<Eigen::Vector2d> shift(num_groups, Eigen::Vector2d::Zero());
+  for (int v = 0; v < num_vertices(); ++v) shift[group[v]] -= mass[v] * x->row(v).transpose();
+  for (int g = 0; g < num_groups; ++g) shift[g] = shift[g] / group_mass[g] + target[g];
+  for (int v = 0; v < num_vertices(); ++v) x->row(v) += shift[group[v]].transpose();
+}
+
+void Inbetweener::Impl::Rotate(const ExampleWeights& w, Coords* x) const {
+  for (int g = 0; g < num_groups; ++g) {
+    const double offset = arap->AngleOffset(*x, w, group_triangles[g]);
+    if (offset == 0.0) continue;
+    const Eigen::Vector2d c = Centroid(*x, g);
+    const Eigen::Matrix2d r = RotationMatrix(-offset);
+    for (int v = 0; v < num_vertices(); ++v) {
+      if (group[v] == g) x->row(v) = (c + r * (x->row(v).transpose() - c)).transpose();
+    }
+  }
+}
+
+absl::StatusOr<Coords> Inbetweener::Impl::GlobalSolve(
+    const SparseCholesky& s, bool pinned, const Coords& b,
+    const std::vector<Eigen::Vector2d>& centroid_target) const {
   Coords x = Coords::Zero(num_vertices(), 2);  // pinned vertices at 0, moved by the gauge
-  for (int v = 0; v < num_vertices(); ++v) {
-    if (free_index[v] >= 0) x.row(v) = sol->row(free_index[v]);
+  if (pinned) {
+    Eigen::MatrixXd rhs(num_free, 2);
+    for (int v = 0; v < num_vertices(); ++v) {
+      if (free_index[v] >= 0) rhs.row(free_index[v]) = b.row(v);
+    }
+    absl::StatusOr<Eigen::MatrixXd> sol = s.Solve(rhs);
+    if (!sol.ok()) return sol.status();
+    for (int v = 0; v < num_vertices(); ++v) {
+      if (free_index[v] >= 0) x.row(v) = sol->row(free_index[v]);
+    }
+  } else {
+    absl::StatusOr<Eigen::MatrixXd> sol = s.Solve(b);
+    if (!sol.ok()) return sol.status();
+    x = *sol;
   }
-  ApplyGauge(w, &x);
+  Translate(centroid_target, &x);
   return x;
 }
 
-double Inbetweener::Impl::BlendedEnergy(const ExampleWeights& w, const Coords& x) const {
-  double e = 0.0;
-  for (size_t i = 0; i < w.size(); ++i) {
-    if (w[i] != 0.0) e += w[i] * energies[i].Value(x);
+double Inbetweener::Impl::Evaluate(const Coords& x, const Problem& p, Coords* rhs,
+                                   int* separated) const {
+  static thread_local std::vector<Eigen::Matrix2d> targets;
+  rhs->setZero(num_vertices(), 2);
+  double energy =
+      p.dynamic ? arap->LocalStepToRest(x, p.rest, &targets) : arap->LocalStep(x, *p.w, &targets);
+  arap->AddRhs(targets, rhs);
+  if (cohesive->num_edges() > 0) {
+    std::vector<char> open;
+    energy += cohesive->LocalStep(x, *p.w, p.thresholds, rhs, &open);
+    if (separated != nullptr)
+      *separated = static_cast<int>(std::count(open.begin(), open.end(), 1));
   }
-  return e;
+  if (p.dynamic) {
+    // beta ||x - pred||_M^2 majorized by beta_max ||x - pred||^2 - (beta_max - beta) (linearized
+    // at x): right-hand side M (beta pred + (beta_max - beta) x).
+    for (int v = 0; v < num_vertices(); ++v) {
+      const Eigen::RowVector2d d = x.row(v) - p.pred.row(v);
+      energy += p.beta * mass[v] * d.squaredNorm();
+      rhs->row(v) += mass[v] * (p.beta * p.pred.row(v) + (p.beta_max - p.beta) * x.row(v));
+    }
+  }
+  if (p.contact) {
+    // gamma ||x_v - target||^2 for contacts; gamma ||x_v - x_v^k||^2 (proximal, zero at x) for
+    // the other boundary vertices. Only the contact springs count as energy.
+    for (int v : overlap->boundary_vertices()) rhs->row(v) += contact_stiffness * x.row(v);
+    for (const OverlapContact& c : p.contacts) {
+      const Eigen::RowVector2d d = x.row(c.vertex) - c.target.transpose();
+      energy += contact_stiffness * d.squaredNorm();
+      rhs->row(c.vertex) += contact_stiffness * (c.target.transpose() - x.row(c.vertex));
+    }
+  }
+  return energy;
+}
+
+absl::StatusOr<Coords> Inbetweener::Impl::Iterate(const Problem& p, Coords x, double energy,
+                                                  Coords rhs, const CancelToken* cancel,
+                                                  FrameReport* report) const {
+  const SparseCholesky& s = p.contact ? contact_solver : p.dynamic ? dynamic_solver : solver;
+  const bool pinned = !p.dynamic;
+  Anderson anderson(std::max(1, options.anderson_history));
+  const double displacement_limit = options.displacement_tolerance * size;
+  int iterations = 0;
+  int separated = 0;
+  Coords next_rhs(num_vertices(), 2);
+  while (iterations < options.max_iterations && energy > 0.0) {
+    if (cancel != nullptr && cancel->IsCancelled()) {
+      return absl::CancelledError("inbetweening cancelled");
+    }
+    absl::StatusOr<Coords> g = GlobalSolve(s, pinned, rhs, p.group_centroids);
+    if (!g.ok()) return g.status();
+    ++iterations;
+    const double step = (*g - x).cwiseAbs().maxCoeff();
+    const double previous_energy = energy;
+    bool accepted = false;
+    if (options.anderson) {
+      const Eigen::Map<const Eigen::VectorXd> gv(g->data(), g->size());
+      const Eigen::VectorXd f = gv - Eigen::Map<const Eigen::VectorXd>(x.data(), x.size());
+      const Eigen::VectorXd accelerated = anderson.Step(gv, f);
+      Coords candidate = Eigen::Map<const Coords>(accelerated.data(), num_vertices(), 2);
+      const double candidate_energy = Evaluate(candidate, p, &next_rhs, &separated);
+      if (candidate_energy <= energy) {
+        x = std::move(candidate);
+        energy = candidate_energy;
+        std::swap(rhs, next_rhs);
+        accepted = true;
+      } else {
+        anderson.Reset();
+      }
+    }
+    if (!accepted) {
+      x = *std::move(g);
+      energy = Evaluate(x, p, &rhs, &separated);
+    }
+    if (step <= displacement_limit ||
+        previous_energy - energy <= options.convergence_tolerance * previous_energy) {
+      break;
+    }
+  }
+  if (report != nullptr) {
+    report->iterations += iterations;
+    report->energy = energy;
+    report->separated_edges = separated;
+  }
+  return x;
 }
 
 absl::StatusOr<Coords> Inbetweener::Impl::Alexa(const ExampleWeights& w) const {
@@ -247,75 +505,182 @@ absl::StatusOr<Coords> Inbetweener::Impl::Alexa(const ExampleWeights& w) const {
     targets[t] = RotationMatrix(angle) * stretch;
   }
   Coords b = Coords::Zero(num_vertices(), 2);
-  energies[0].AddRhs(targets, 1.0, &b);
-  return SolveReduced(alexa_solver, b, w);
+  alexa_energy->AddRhs(targets, 1.0, &b);
+  return GlobalSolve(solver, true, b, BlendedCentroids(w));
+}
+
+absl::Status Inbetweener::Impl::EnforceNonOverlap(Problem* p, Coords* x, const CancelToken* cancel,
+                                                  FrameReport* report) {
+  std::vector<OverlapContact> contacts = overlap->Contacts(*x);
+  if (contacts.empty()) return absl::OkStatus();
+  if (!contact_factored) {
+    // Springs an order of magnitude stiffer than the material around a boundary vertex.
+    double max_diagonal = 0.0;
+    for (int v : overlap->boundary_vertices()) {
+      max_diagonal = std::max(max_diagonal, zhu_matrix.coeff(v, v));
+    }
+    contact_stiffness = 10.0 * max_diagonal;
+    Eigen::SparseMatrix<double> m = zhu_matrix;
+    for (int v : overlap->boundary_vertices()) m.coeffRef(v, v) += contact_stiffness;
+    m.makeCompressed();
+    absl::StatusOr<Eigen::SparseMatrix<double>> k = Reduce(m);
+    if (!k.ok()) return k.status();
+    if (absl::Status s = contact_solver.Compute(*k); !s.ok()) return s;
+    contact_factored = true;
+  }
+  p->contact = true;
+  for (int round = 0; round < 10 && !contacts.empty(); ++round) {
+    p->contacts = std::move(contacts);
+    Coords rhs;
+    const double energy = Evaluate(*x, *p, &rhs, nullptr);
+    absl::StatusOr<Coords> next = Iterate(*p, *x, energy, std::move(rhs), cancel, report);
+    if (!next.ok()) return next.status();
+    *x = *std::move(next);
+    contacts = overlap->Contacts(*x);
+  }
+  p->contact = false;
+  p->contacts.clear();
+  return absl::OkStatus();
 }
 
 absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const Frame& previous,
+                                                const Frame& before_previous,
                                                 const CancelToken* cancel, FrameReport* report) {
-  Coords x;
-  if (options.warm_start && !previous.vertices.empty()) {
-    x = ToCoords(previous.vertices);
-    ApplyGauge(w, &x);
-  } else {
-    absl::StatusOr<Coords> start = Alexa(w);
-    if (!start.ok()) return start.status();
-    x = *std::move(start);
-  }
-  if (w != zhu_factored_weights) {
-    Eigen::SparseMatrix<double> k = reduced;
-    Eigen::Map<Eigen::VectorXd> values(k.valuePtr(), k.nonZeros());
-    values.setZero();
-    for (size_t i = 0; i < w.size(); ++i) {
-      if (w[i] != 0.0) values += w[i] * reduced_values[i];
+  Problem p;
+  p.w = &w;
+  p.group_centroids = BlendedCentroids(w);
+  std::optional<Coords> prev;
+  if (!previous.vertices.empty()) prev = ToCoords(previous.vertices);
+  p.thresholds = cohesive->Thresholds(prev ? &*prev : nullptr);
+
+  // Start (a): the Alexa targets solved with the kZhu17 matrix (cohesive jumps pulled to 0).
+  std::vector<Eigen::Matrix2d> targets;
+  arap->AlexaTargets(w, &targets);
+  Coords b = Coords::Zero(num_vertices(), 2);
+  arap->AddRhs(targets, &b);
+  absl::StatusOr<Coords> cold = GlobalSolve(solver, true, b, p.group_centroids);
+  if (!cold.ok()) return cold.status();
+  Coords x = *std::move(cold);
+  Coords rhs;
+  double energy = Evaluate(x, p, &rhs, nullptr);
+  // Start (b): the previous frame in this frame's gauge.
+  if (options.warm_start && prev) {
+    Coords warm = *prev;
+    Rotate(w, &warm);
+    Translate(p.group_centroids, &warm);
+    Coords warm_rhs;
+    const double warm_energy = Evaluate(warm, p, &warm_rhs, nullptr);
+    if (warm_energy <= energy) {
+      x = std::move(warm);
+      rhs = std::move(warm_rhs);
+      energy = warm_energy;
+      report->warm_started = true;
     }
-    zhu_factored_weights.clear();
-    if (absl::Status s = zhu_solver.Factorize(k); !s.ok()) return s;
-    zhu_factored_weights = w;
+  }
+  absl::StatusOr<Coords> solved = Iterate(p, std::move(x), energy, std::move(rhs), cancel, report);
+  if (!solved.ok()) return solved.status();
+  x = *std::move(solved);
+  Rotate(w, &x);
+  Translate(p.group_centroids, &x);
+  if (options.prevent_overlap) {
+    if (absl::Status s = EnforceNonOverlap(&p, &x, cancel, report); !s.ok()) return s;
+  }
+  if (options.epsilon <= 0.0 || !prev) return x;
+
+  // Dynamics (S-eq.28/29): x is Phi.
+  const Coords& x1 = *prev;
+  const Coords x2 = before_previous.vertices.empty() ? x1 : ToCoords(before_previous.vertices);
+  p.dynamic = true;
+  p.rest.resize(triangles.size());
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
+    p.rest[t] = arap->DeformationGradient(x, t);
+  }
+  std::vector<Eigen::Matrix2d> scratch;
+  const double delta = arap->LocalStepToRest(x1, p.rest, &scratch);
+  p.beta_max = 0.5 * options.epsilon * mean_kappa;
+  p.beta = p.beta_max / (delta + 1.0);
+  report->xi = options.epsilon * options.h * options.h * mean_kappa / (options.rho * (delta + 1.0));
+  p.pred = 2.0 * x1 - x2;
+  Rotate(w, &p.pred);
+  Translate(p.group_centroids, &p.pred);
+  const Coords phi = x;
+  energy = Evaluate(x, p, &rhs, nullptr);
+  solved = Iterate(p, std::move(x), energy, std::move(rhs), cancel, report);
+  if (!solved.ok()) return solved.status();
+  x = *std::move(solved);
+  p.dynamic = false;
+  if (options.prevent_overlap && overlap->Count(x) > 0) return phi;  // keep the valid Phi
+  return x;
+}
+
+absl::StatusOr<Frame> Inbetweener::Impl::Solve(const ExampleWeights& weights, const Frame& previous,
+                                               const Frame& before_previous,
+                                               const CancelToken* cancel, FrameReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  const int num_shapes = static_cast<int>(shapes.size());
+  if (static_cast<int>(weights.size()) != num_shapes) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "weights has ", weights.size(), " values, the multimesh has ", num_shapes, " shapes"));
+  }
+  double sum = 0.0;
+  int unit = -1;  // the example hit exactly, if weights == e_unit
+  for (int i = 0; i < num_shapes; ++i) {
+    if (!std::isfinite(weights[i])) {
+      return absl::InvalidArgumentError(absl::StrCat("weights[", i, "] is not finite"));
+    }
+    if (options.method == InterpMethod::kZhu17 && weights[i] < 0.0) {
+      return absl::InvalidArgumentError(absl::StrCat("weights[", i, "] = ", weights[i],
+                                                     " is negative; kZhu17 needs weights >= 0"));
+    }
+    sum += weights[i];
+    if (weights[i] == 1.0) unit = i;
+  }
+  if (std::abs(sum - 1.0) > 1e-9) {
+    return absl::InvalidArgumentError(absl::StrCat("weights sum to ", sum, ", not 1"));
+  }
+  if (unit >= 0) {
+    for (int i = 0; i < num_shapes; ++i) {
+      if (i != unit && weights[i] != 0.0) unit = -1;
+    }
+  }
+  for (const Frame* f : {&previous, &before_previous}) {
+    if (!f->vertices.empty() && static_cast<int>(f->vertices.size()) != num_vertices()) {
+      return absl::InvalidArgumentError(absl::StrCat("previous frame has ", f->vertices.size(),
+                                                     " vertices, the multimesh has ",
+                                                     num_vertices()));
+    }
+  }
+  if (cancel != nullptr && cancel->IsCancelled()) {
+    return absl::CancelledError("inbetweening cancelled");
   }
 
-  // Energy of J = 0 everywhere: a scale for "the energy is zero up to rounding".
-  double scale = 0.0;
-  for (size_t i = 0; i < w.size(); ++i) {
-    for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
-      scale += w[i] * 2.0 * energies[i].rest_area(t) *
-               (options.stiffness.empty() ? 1.0 : options.stiffness[t]);
-    }
+  FrameReport local;
+  Coords x;
+  if (unit >= 0 && options.exact_keys) {
+    x = shapes[unit];
+  } else if (options.method == InterpMethod::kLinear) {
+    x = Coords::Zero(num_vertices(), 2);
+    for (int i = 0; i < num_shapes; ++i) x += weights[i] * shapes[i];
+  } else if (options.method == InterpMethod::kAlexa) {
+    absl::StatusOr<Coords> r = Alexa(weights);
+    if (!r.ok()) return r.status();
+    x = *std::move(r);
+  } else {
+    absl::StatusOr<Coords> r = Zhu17(weights, previous, before_previous, cancel, &local);
+    if (!r.ok()) return r.status();
+    x = *std::move(r);
   }
-  std::vector<std::vector<Eigen::Matrix2d>> fitted(w.size());
-  double energy = 0.0;
-  for (size_t i = 0; i < w.size(); ++i) {
-    if (w[i] == 0.0) continue;
-    fitted[i] = energies[i].FitRotations(x);
-    energy += w[i] * energies[i].Value(x, fitted[i]);
+  if (options.method != InterpMethod::kZhu17 || (unit >= 0 && options.exact_keys)) {
+    local.energy = arap->Value(x, weights);
   }
-  int iterations = 0;
-  while (iterations < options.max_iterations && energy > 1e-24 * scale) {
-    if (cancel != nullptr && cancel->IsCancelled()) {
-      return absl::CancelledError("inbetweening cancelled");
-    }
-    Coords b = Coords::Zero(num_vertices(), 2);
-    for (size_t i = 0; i < w.size(); ++i) {
-      if (w[i] != 0.0) energies[i].AddRhs(fitted[i], w[i], &b);
-    }
-    absl::StatusOr<Coords> next = SolveReduced(zhu_solver, b, w);
-    if (!next.ok()) return next.status();
-    x = *std::move(next);
-    ++iterations;
-    const double previous_energy = energy;
-    energy = 0.0;
-    for (size_t i = 0; i < w.size(); ++i) {
-      if (w[i] == 0.0) continue;
-      fitted[i] = energies[i].FitRotations(x);
-      energy += w[i] * energies[i].Value(x, fitted[i]);
-    }
-    if (previous_energy - energy <= options.convergence_tolerance * previous_energy) break;
-  }
-  if (report != nullptr) {
-    report->iterations = iterations;
-    report->energy = energy;
-  }
-  return x;
+  local.inverted = CountInverted(triangles, x);
+  local.overlaps = overlap->Count(x);
+  local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (report != nullptr) *report = local;
+  Frame frame{ToPoints(x)};
+  frame_before_last = std::move(last_frame);
+  last_frame = frame.vertices;
+  return frame;
 }
 
 Inbetweener::Inbetweener(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -333,6 +698,17 @@ absl::StatusOr<Inbetweener> Inbetweener::Create(const Multimesh& mesh, Inbetween
     return absl::InvalidArgumentError(
         absl::StrCat("convergence_tolerance must be >= 0, got ", options.convergence_tolerance));
   }
+  if (!(options.displacement_tolerance >= 0.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("displacement_tolerance must be >= 0, got ", options.displacement_tolerance));
+  }
+  if (!(options.epsilon >= 0.0) || !std::isfinite(options.epsilon)) {
+    return absl::InvalidArgumentError(absl::StrCat("epsilon must be >= 0, got ", options.epsilon));
+  }
+  if (!(options.rho > 0.0) || !(options.h > 0.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("rho and h must be > 0, got rho = ", options.rho, ", h = ", options.h));
+  }
   auto impl = std::make_unique<Impl>();
   impl->options = std::move(options);
   if (absl::Status s = impl->Setup(mesh); !s.ok()) return s;
@@ -341,68 +717,28 @@ absl::StatusOr<Inbetweener> Inbetweener::Create(const Multimesh& mesh, Inbetween
 
 absl::StatusOr<Frame> Inbetweener::Solve(const ExampleWeights& weights, const Frame& previous,
                                          const CancelToken* cancel, FrameReport* report) {
-  const auto start = std::chrono::steady_clock::now();
   Impl& m = *impl_;
-  const int num_shapes = static_cast<int>(m.shapes.size());
-  if (static_cast<int>(weights.size()) != num_shapes) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "weights has ", weights.size(), " values, the multimesh has ", num_shapes, " shapes"));
+  Frame before;
+  if (m.options.epsilon > 0.0 && !previous.vertices.empty() && previous.vertices == m.last_frame) {
+    before.vertices = m.frame_before_last;
   }
-  double sum = 0.0;
-  int unit = -1;  // the example hit exactly, if weights == e_unit
-  for (int i = 0; i < num_shapes; ++i) {
-    if (!std::isfinite(weights[i])) {
-      return absl::InvalidArgumentError(absl::StrCat("weights[", i, "] is not finite"));
-    }
-    if (m.options.method == InterpMethod::kZhu17 && weights[i] < 0.0) {
-      return absl::InvalidArgumentError(absl::StrCat("weights[", i, "] = ", weights[i],
-                                                     " is negative; kZhu17 needs weights >= 0"));
-    }
-    sum += weights[i];
-    if (weights[i] == 1.0) unit = i;
-  }
-  if (std::abs(sum - 1.0) > 1e-9) {
-    return absl::InvalidArgumentError(absl::StrCat("weights sum to ", sum, ", not 1"));
-  }
-  if (unit >= 0) {
-    for (int i = 0; i < num_shapes; ++i) {
-      if (i != unit && weights[i] != 0.0) unit = -1;
-    }
-  }
-  if (!previous.vertices.empty() &&
-      static_cast<int>(previous.vertices.size()) != m.num_vertices()) {
-    return absl::InvalidArgumentError(absl::StrCat("previous frame has ", previous.vertices.size(),
-                                                   " vertices, the multimesh has ",
-                                                   m.num_vertices()));
-  }
-  if (cancel != nullptr && cancel->IsCancelled()) {
-    return absl::CancelledError("inbetweening cancelled");
-  }
+  return m.Solve(weights, previous, before, cancel, report);
+}
 
-  FrameReport local_report;
-  Coords x;
-  if (unit >= 0 && m.options.exact_keys) {
-    x = m.shapes[unit];
-  } else if (m.options.method == InterpMethod::kLinear) {
-    x = Coords::Zero(m.num_vertices(), 2);
-    for (int i = 0; i < num_shapes; ++i) x += weights[i] * m.shapes[i];
-  } else if (m.options.method == InterpMethod::kAlexa) {
-    absl::StatusOr<Coords> r = m.Alexa(weights);
-    if (!r.ok()) return r.status();
-    x = *std::move(r);
-  } else {
-    absl::StatusOr<Coords> r = m.Zhu17(weights, previous, cancel, &local_report);
-    if (!r.ok()) return r.status();
-    x = *std::move(r);
-  }
-  if (m.options.method != InterpMethod::kZhu17 || (unit >= 0 && m.options.exact_keys)) {
-    local_report.energy = m.BlendedEnergy(weights, x);
-  }
-  local_report.inverted = CountInverted(m.triangles, x);
-  local_report.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (report != nullptr) *report = local_report;
-  return Frame{ToPoints(x)};
+absl::StatusOr<Frame> Inbetweener::Solve(const ExampleWeights& weights, const Frame& previous,
+                                         const Frame& before_previous, const CancelToken* cancel,
+                                         FrameReport* report) {
+  return impl_->Solve(weights, previous, before_previous, cancel, report);
+}
+
+absl::StatusOr<Frame> FrameSequence::Next(const ExampleWeights& weights, const CancelToken* cancel,
+                                          FrameReport* report) {
+  absl::StatusOr<Frame> f =
+      inbetweener_->Solve(weights, previous_, before_previous_, cancel, report);
+  if (!f.ok()) return f.status();
+  before_previous_ = std::move(previous_);
+  previous_ = *f;
+  return f;
 }
 
 }  // namespace inbetween::solver

