@@ -12,9 +12,51 @@ absl::Status PathError(const std::string& path, const std::string& what) {
   return absl::InvalidArgumentError(absl::StrCat("frames.json: ", path, ": ", what));
 }
 
+absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc);
+
 }  // namespace
 
 absl::StatusOr<FrameSet> FrameSetFromJson(const nlohmann::json& doc) {
+  // Every access below is type-checked first; the catch keeps a missed case from throwing
+  // across the library boundary.
+  try {
+    return FrameSetFromJsonUnchecked(doc);
+  } catch (const nlohmann::json::exception& e) {
+    return PathError("$", e.what());
+  }
+}
+
+absl::Status CheckFrameSet(const FrameSet& frames) {
+  if (frames.frames.empty()) return PathError("frames", "no frames");
+  const size_t num_vertices = frames.frames[0].vertices.size();
+  for (size_t f = 0; f < frames.frames.size(); ++f) {
+    const auto& verts = frames.frames[f].vertices;
+    if (verts.size() != num_vertices) {
+      return PathError(
+          absl::StrCat("frames[", f, "]"),
+          absl::StrCat("has ", verts.size(), " vertices, frames[0] has ", num_vertices));
+    }
+    for (size_t v = 0; v < verts.size(); ++v) {
+      if (!std::isfinite(verts[v][0]) || !std::isfinite(verts[v][1])) {
+        return PathError(absl::StrCat("frames[", f, "].vertices[", v, "]"),
+                         "expected [x, y] finite numbers");
+      }
+    }
+  }
+  for (size_t t = 0; t < frames.triangles.size(); ++t) {
+    for (int i : frames.triangles[t]) {
+      if (i < 0 || static_cast<size_t>(i) >= num_vertices) {
+        return PathError(absl::StrCat("triangles[", t, "]"),
+                         absl::StrCat("vertex index ", i, " out of range [0, ", num_vertices, ")"));
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+namespace {
+
+absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc) {
   if (!doc.is_object()) return PathError("$", "expected an object");
   FrameSet out;
   for (const char* key : {"triangles", "keys", "frames"}) {
@@ -46,10 +88,25 @@ absl::StatusOr<FrameSet> FrameSetFromJson(const nlohmann::json& doc) {
       return PathError(fp, "expected an object with a vertices array");
     }
     FrameData data;
-    data.index = fr.value("index", static_cast<int>(f));
-    data.time = fr.value("time", 0.0);
-    if (fr.contains("weights") && fr["weights"].is_array()) {
-      for (const auto& w : fr["weights"]) data.weights.push_back(w.get<double>());
+    data.index = static_cast<int>(f);
+    if (fr.contains("index")) {
+      if (!fr["index"].is_number_integer()) {
+        return PathError(fp + ".index", "expected an integer frame index");
+      }
+      data.index = fr["index"].get<int>();
+    }
+    if (fr.contains("time")) {
+      if (!fr["time"].is_number()) return PathError(fp + ".time", "expected a number");
+      data.time = fr["time"].get<double>();
+    }
+    if (fr.contains("weights")) {
+      if (!fr["weights"].is_array()) return PathError(fp + ".weights", "expected an array");
+      for (size_t w = 0; w < fr["weights"].size(); ++w) {
+        if (!fr["weights"][w].is_number()) {
+          return PathError(absl::StrCat(fp, ".weights[", w, "]"), "expected a number");
+        }
+        data.weights.push_back(fr["weights"][w].get<double>());
+      }
     }
     const auto& verts = fr["vertices"];
     for (size_t v = 0; v < verts.size(); ++v) {
@@ -78,13 +135,13 @@ absl::StatusOr<FrameSet> FrameSetFromJson(const nlohmann::json& doc) {
   return out;
 }
 
+}  // namespace
+
 nlohmann::json FrameSetToJson(const FrameSet& frames) {
   nlohmann::json out_frames = nlohmann::json::array();
   for (const auto& f : frames.frames) {
-    out_frames.push_back({{"index", f.index},
-                          {"time", f.time},
-                          {"weights", f.weights},
-                          {"vertices", f.vertices}});
+    out_frames.push_back(
+        {{"index", f.index}, {"time", f.time}, {"weights", f.weights}, {"vertices", f.vertices}});
   }
   return {{"triangles", frames.triangles}, {"keys", frames.keys}, {"frames", out_frames}};
 }

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "nlohmann/json.hpp"
 
@@ -28,6 +29,10 @@ struct FrameSet {
 // Parses a frames.json document (docs/file-formats.md). Errors name the JSON path
 // ("frames[3].vertices[10]: expected [x, y]").
 absl::StatusOr<FrameSet> FrameSetFromJson(const nlohmann::json& doc);
+
+// Checks what every renderer relies on: at least one frame, the same vertex count in every frame,
+// finite coordinates and triangle indices in range. Errors use frames.json paths.
+absl::Status CheckFrameSet(const FrameSet& frames);
 
 // The frames.json document for a frame set (inverse of FrameSetFromJson).
 nlohmann::json FrameSetToJson(const FrameSet& frames);

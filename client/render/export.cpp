@@ -1,0 +1,284 @@
+// Export of every output format (see export.h).
+#include "client/render/export.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <optional>
+#include <system_error>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
+#include "client/render/atomic_write.h"
+#include "client/render/color.h"
+#include "client/render/contact_sheet.h"
+#include "client/render/gif_encoder.h"
+#include "client/render/lottie_export.h"
+#include "client/render/png_io.h"
+#include "client/render/raster.h"
+#include "client/render/svg_frames.h"
+#include "client/render/webp_encoder.h"
+
+namespace inbetween::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ValidFormats() {
+  std::string list;
+  for (std::string_view f : kExportFormats) {
+    absl::StrAppend(&list, list.empty() ? "" : ", ", std::string(f));
+  }
+  return list;
+}
+
+absl::Status UnknownFormat(const std::string& name) {
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown output format \"", name, "\"; valid formats: ", ValidFormats()));
+}
+
+absl::StatusOr<std::vector<std::string>> CheckFormats(const std::vector<std::string>& formats) {
+  std::vector<std::string> out;
+  for (const std::string& f : formats) {
+    if (std::find(kExportFormats.begin(), kExportFormats.end(), f) == kExportFormats.end()) {
+      return UnknownFormat(f);
+    }
+    if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(f);
+  }
+  if (out.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("no output format given; valid formats: ", ValidFormats()));
+  }
+  return out;
+}
+
+// Contact sheet cells are half the frame width, within reason, 4 to a row.
+ContactSheetOptions SheetOptions(const ExportOptions& options) {
+  return {.cell_width = std::clamp(options.width / 2, 64, 512),
+          .columns = 4,
+          .inbetweens = 6,
+          .fill = options.fill,
+          .mesh_overlay = options.mesh_overlay};
+}
+
+// A hidden folder inside DIR that is removed again unless released.
+class StagingDir {
+ public:
+  static absl::StatusOr<StagingDir> Create(const fs::path& dir) {
+    static std::atomic<int> counter{0};
+    StagingDir s;
+    std::error_code ec;
+    s.created_dir_ = !fs::exists(dir, ec);
+    fs::create_directories(dir, ec);
+    if (ec || !fs::is_directory(dir)) {
+      return absl::UnavailableError(absl::StrCat("cannot create output directory ", dir.string(),
+                                                 ec ? absl::StrCat(": ", ec.message()) : ""));
+    }
+    s.dir_ = dir;
+    s.path_ = dir / absl::StrCat(".inbetween-export-", ::getpid(), "-", counter++);
+    fs::create_directory(s.path_, ec);
+    if (ec) {
+      s.Discard();
+      return absl::UnavailableError(
+          absl::StrCat("cannot write in ", dir.string(), ": ", ec.message()));
+    }
+    return s;
+  }
+  StagingDir(StagingDir&& other) noexcept { *this = std::move(other); }
+  StagingDir& operator=(StagingDir&& other) noexcept {
+    std::swap(dir_, other.dir_);
+    std::swap(path_, other.path_);
+    std::swap(created_dir_, other.created_dir_);
+    return *this;
+  }
+  ~StagingDir() { Discard(); }
+
+  const fs::path& path() const { return path_; }
+
+  // Moves every staged file into DIR.
+  absl::Status Commit(ExportReport* report) {
+    std::error_code ec;
+    std::vector<fs::path> staged;
+    for (const auto& entry : fs::directory_iterator(path_, ec)) staged.push_back(entry.path());
+    if (ec) return absl::UnavailableError(absl::StrCat("cannot list ", path_.string()));
+    std::sort(staged.begin(), staged.end());
+    for (const fs::path& from : staged) {
+      const fs::path to = dir_ / from.filename();
+      const uint64_t size = fs::file_size(from, ec);
+      fs::rename(from, to, ec);
+      if (ec) {
+        return absl::UnavailableError(
+            absl::StrCat("cannot move ", from.string(), " to ", to.string(), ": ", ec.message()));
+      }
+      if (report != nullptr) {
+        report->files.push_back(to);
+        report->bytes += size;
+      }
+    }
+    created_dir_ = false;  // DIR now holds output: keep it
+    Discard();
+    return absl::OkStatus();
+  }
+
+ private:
+  StagingDir() = default;
+  void Discard() {
+    std::error_code ignored;
+    if (!path_.empty()) fs::remove_all(path_, ignored);
+    if (created_dir_ && !dir_.empty()) fs::remove(dir_, ignored);  // only if still empty
+    path_.clear();
+    created_dir_ = false;
+  }
+
+  fs::path dir_;
+  fs::path path_;
+  bool created_dir_ = false;
+};
+
+}  // namespace
+
+absl::StatusOr<std::vector<std::string>> ParseFormats(const std::string& list) {
+  std::vector<std::string> formats;
+  for (absl::string_view part : absl::StrSplit(list, ',', absl::SkipWhitespace())) {
+    formats.push_back(absl::AsciiStrToLower(absl::StripAsciiWhitespace(part)));
+  }
+  return CheckFormats(formats);
+}
+
+absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
+                          ExportReport* report) {
+  // 1. Validate everything and set up the encoders before touching the file system.
+  absl::StatusOr<std::vector<std::string>> formats = CheckFormats(options.formats);
+  if (!formats.ok()) return formats.status();
+  const auto wants = [&](std::string_view f) {
+    return std::find(formats->begin(), formats->end(), f) != formats->end();
+  };
+  if (options.dir.empty()) return absl::InvalidArgumentError("no output directory given");
+  if (!(options.fps > 0) || !std::isfinite(options.fps)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("frame rate ", options.fps, " must be positive"));
+  }
+  // The fill also goes verbatim into the SVG, so it is checked for every format.
+  absl::StatusOr<Rgba8> fill = ParseColor(options.fill);
+  if (!fill.ok()) return fill.status();
+  if (absl::Status s = CheckFrameSet(frames); !s.ok()) return s;
+
+  const bool raster_frames = wants("png") || wants("gif") || wants("webp");
+  std::optional<FrameRasterizer> raster;
+  std::optional<GifEncoder> gif;
+  std::optional<WebpEncoder> webp;
+  if (raster_frames) {
+    absl::StatusOr<FrameRasterizer> r =
+        FrameRasterizer::Create(frames, {.width = options.width,
+                                         .fill = options.fill,
+                                         .mesh_overlay = options.mesh_overlay,
+                                         .transparent = options.transparent});
+    if (!r.ok()) return r.status();
+    raster.emplace(*std::move(r));
+  }
+  if (wants("gif")) {
+    GifOptions gif_options = {.fps = options.fps,
+                              .loop_count = 0,
+                              .transparent = options.transparent,
+                              .palette_colors = {}};
+    if (!options.transparent) gif_options.palette_colors.push_back(raster->background());
+    gif_options.palette_colors.push_back(*fill);
+    if (options.mesh_overlay) gif_options.palette_colors.push_back(kMeshOverlayColor);
+    absl::StatusOr<GifEncoder> e =
+        GifEncoder::Create(raster->width(), raster->height(), std::move(gif_options));
+    if (!e.ok()) return e.status();
+    gif.emplace(*std::move(e));
+  }
+  if (wants("webp")) {
+    absl::StatusOr<WebpEncoder> e = WebpEncoder::Create(
+        raster->width(), raster->height(),
+        {.fps = options.fps, .lossless = options.webp_lossless, .quality = options.webp_quality});
+    if (!e.ok()) return e.status();
+    webp.emplace(*std::move(e));
+  }
+  std::string lottie;
+  if (wants("lottie")) {
+    absl::StatusOr<nlohmann::json> doc =
+        LottieAnimation(frames, {.width = options.width, .fps = options.fps, .fill = options.fill});
+    if (!doc.ok()) return doc.status();
+    lottie = doc->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  }
+  std::optional<RgbaImage> sheet;
+  if (wants("contact")) {
+    absl::StatusOr<RgbaImage> s = RenderContactSheet(frames, SheetOptions(options));
+    if (!s.ok()) return s.status();
+    sheet.emplace(*std::move(s));
+  }
+  const auto progress = [&](std::string_view stage, int done, int total) {
+    if (options.progress) options.progress(stage, done, total);
+  };
+
+  // 2. Produce every file in the staging folder.
+  absl::StatusOr<StagingDir> staging = StagingDir::Create(options.dir);
+  if (!staging.ok()) return staging.status();
+  const fs::path& out = staging->path();
+  if (wants("json")) {
+    if (absl::Status s =
+            WriteFileAtomically(out / "frames.json", FrameSetToJson(frames).dump() + "\n");
+        !s.ok()) {
+      return s;
+    }
+    progress("json", 1, 1);
+  }
+  if (wants("svg")) {
+    if (absl::Status s = WriteSvgFrames(
+            out, frames, {.fill = options.fill, .mesh_overlay = options.mesh_overlay});
+        !s.ok()) {
+      return s;
+    }
+    progress("svg", 1, 1);
+  }
+  if (raster_frames) {
+    const int n = static_cast<int>(frames.frames.size());
+    for (int f = 0; f < n; ++f) {
+      const RgbaImage image = raster->Render(f);
+      if (wants("png")) {
+        const fs::path path = out / absl::StrFormat("frame_%04d.png", frames.frames[f].index);
+        if (absl::Status s = WritePng(path, image); !s.ok()) return s;
+      }
+      if (gif) {
+        if (absl::Status s = gif->AddFrame(image); !s.ok()) return s;
+      }
+      if (webp) {
+        if (absl::Status s = webp->AddFrame(image); !s.ok()) return s;
+      }
+      progress("frames", f + 1, n);
+    }
+  }
+  if (gif) {
+    absl::StatusOr<std::string> bytes = gif->Finish();
+    if (!bytes.ok()) return bytes.status();
+    if (absl::Status s = WriteFileAtomically(out / "animation.gif", *bytes); !s.ok()) return s;
+    progress("gif", 1, 1);
+  }
+  if (webp) {
+    absl::StatusOr<std::string> bytes = webp->Finish();
+    if (!bytes.ok()) return bytes.status();
+    if (absl::Status s = WriteFileAtomically(out / "animation.webp", *bytes); !s.ok()) return s;
+    progress("webp", 1, 1);
+  }
+  if (wants("lottie")) {
+    if (absl::Status s = WriteFileAtomically(out / "animation.lottie.json", lottie); !s.ok()) {
+      return s;
+    }
+    progress("lottie", 1, 1);
+  }
+  if (sheet) {
+    if (absl::Status s = WritePng(out / "contact_sheet.png", *sheet); !s.ok()) return s;
+    progress("contact", 1, 1);
+  }
+
+  // 3. Move the files into place.
+  return staging->Commit(report);
+}
+
+}  // namespace inbetween::render
