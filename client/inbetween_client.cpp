@@ -1,6 +1,8 @@
 // Thin gRPC client for inbetween.v1.Inbetween (see inbetween_client.h).
 #include "client/inbetween_client.h"
 
+#include <optional>
+
 #include "absl/strings/str_cat.h"
 
 namespace inbetween::client {
@@ -10,14 +12,29 @@ absl::Status FromGrpcStatus(const grpc::Status& status) {
   return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
 }
 
-InbetweenClient::InbetweenClient(std::shared_ptr<grpc::Channel> channel)
-    : stub_(v1::Inbetween::NewStub(std::move(channel))) {}
+class InbetweenClient::Call {
+ public:
+  Call(InbetweenClient* client, const std::string& session_id) : client_(client) {
+    if (!client->options_.token.empty()) {
+      context.AddMetadata("authorization", absl::StrCat("Bearer ", client->options_.token));
+    }
+    if (!session_id.empty()) context.AddMetadata("x-session-id", session_id);
+    std::lock_guard<std::mutex> lock(client_->mu_);
+    client_->in_flight_ = &context;
+    if (client_->cancelled_) context.TryCancel();
+  }
+  ~Call() {
+    std::lock_guard<std::mutex> lock(client_->mu_);
+    client_->in_flight_ = nullptr;
+  }
+  grpc::ClientContext context;
 
-void InbetweenClient::SetInFlight(grpc::ClientContext* context) {
-  std::lock_guard<std::mutex> lock(mu_);
-  in_flight_ = context;
-  if (context != nullptr && cancelled_) context->TryCancel();
-}
+ private:
+  InbetweenClient* client_;
+};
+
+InbetweenClient::InbetweenClient(std::shared_ptr<grpc::Channel> channel, ClientOptions options)
+    : stub_(v1::Inbetween::NewStub(std::move(channel))), options_(std::move(options)) {}
 
 void InbetweenClient::CancelInFlight() {
   std::lock_guard<std::mutex> lock(mu_);
@@ -25,71 +42,111 @@ void InbetweenClient::CancelInFlight() {
   if (in_flight_ != nullptr) in_flight_->TryCancel();
 }
 
-absl::StatusOr<v1::Session> InbetweenClient::CreateSession(const std::string& display_name) {
-  grpc::ClientContext context;
-  SetInFlight(&context);
+absl::StatusOr<v1::Session> InbetweenClient::CreateSession(const std::string& display_name,
+                                                           const v1::Parameters& parameters) {
+  Call call(this, "");
   v1::CreateSessionRequest request;
   request.set_display_name(display_name);
+  *request.mutable_parameters() = parameters;
   v1::CreateSessionResponse response;
-  grpc::Status status = stub_->CreateSession(&context, request, &response);
-  SetInFlight(nullptr);
+  grpc::Status status = stub_->CreateSession(&call.context, request, &response);
   if (!status.ok()) return FromGrpcStatus(status);
   return response.session();
 }
 
-absl::StatusOr<v1::PutDrawingResponse> InbetweenClient::PutSvgDrawing(
-    const v1::Session& session, const std::string& name, const std::string& svg_text) {
-  grpc::ClientContext context;
-  context.AddMetadata("x-session-id", session.id());
-  SetInFlight(&context);
-  v1::PutDrawingRequest request;
-  request.set_session_id(session.id());
-  request.set_expected_version(session.version());
-  request.mutable_drawing()->set_name(name);
-  request.mutable_drawing()->set_svg(svg_text);
-  v1::PutDrawingResponse response;
-  grpc::Status status = stub_->PutDrawing(&context, request, &response);
-  SetInFlight(nullptr);
+absl::StatusOr<v1::GetSessionResponse> InbetweenClient::GetSession(const std::string& session_id,
+                                                                   bool full) {
+  Call call(this, session_id);
+  v1::GetSessionRequest request;
+  request.set_session_id(session_id);
+  request.set_full(full);
+  v1::GetSessionResponse response;
+  grpc::Status status = stub_->GetSession(&call.context, request, &response);
   if (!status.ok()) return FromGrpcStatus(status);
   return response;
 }
 
+absl::StatusOr<std::vector<v1::Session>> InbetweenClient::ListSessions() {
+  std::vector<v1::Session> sessions;
+  v1::ListSessionsRequest request;
+  request.set_page_size(1000);
+  do {
+    Call call(this, "");
+    v1::ListSessionsResponse response;
+    grpc::Status status = stub_->ListSessions(&call.context, request, &response);
+    if (!status.ok()) return FromGrpcStatus(status);
+    for (auto& s : *response.mutable_sessions()) sessions.push_back(std::move(s));
+    request.set_page_token(response.next_page_token());
+  } while (!request.page_token().empty());
+  return sessions;
+}
+
+absl::StatusOr<v1::PutDrawingResponse> InbetweenClient::PutDrawing(
+    const v1::PutDrawingRequest& request) {
+  Call call(this, request.session_id());
+  v1::PutDrawingResponse response;
+  grpc::Status status = stub_->PutDrawing(&call.context, request, &response);
+  if (!status.ok()) return FromGrpcStatus(status);
+  return response;
+}
+
+absl::StatusOr<v1::Session> InbetweenClient::SetCorrespondences(
+    const v1::SetCorrespondencesRequest& request) {
+  Call call(this, request.session_id());
+  v1::SetCorrespondencesResponse response;
+  grpc::Status status = stub_->SetCorrespondences(&call.context, request, &response);
+  if (!status.ok()) return FromGrpcStatus(status);
+  return response.session();
+}
+
 absl::StatusOr<v1::BuildMultimeshResult> InbetweenClient::BuildMultimesh(
     const v1::Session& session, const ProgressCallback& progress) {
-  grpc::ClientContext context;
-  context.AddMetadata("x-session-id", session.id());
-  SetInFlight(&context);
+  Call call(this, session.id());
   v1::BuildMultimeshRequest request;
   request.set_session_id(session.id());
   request.set_expected_version(session.version());
-  auto reader = stub_->BuildMultimesh(&context, request);
+  auto reader = stub_->BuildMultimesh(&call.context, request);
   v1::BuildMultimeshResponse response;
-  v1::BuildMultimeshResult result;
-  bool have_result = false;
+  std::optional<v1::BuildMultimeshResult> result;
   while (reader->Read(&response)) {
     if (response.has_progress() && progress) progress(response.progress());
-    if (response.has_result()) {
-      result = response.result();
-      have_result = true;
-    }
+    if (response.has_result()) result = std::move(*response.mutable_result());
   }
   grpc::Status status = reader->Finish();
-  SetInFlight(nullptr);
   if (!status.ok()) return FromGrpcStatus(status);
-  if (!have_result) return absl::InternalError("BuildMultimesh stream ended without a result");
-  return result;
+  if (!result) return absl::InternalError("BuildMultimesh stream ended without a result");
+  return *std::move(result);
+}
+
+absl::StatusOr<v1::OptimizeComeshResult> InbetweenClient::OptimizeComesh(
+    const v1::Session& session, const std::function<void(const v1::ComeshIteration&)>& on_iter,
+    const ProgressCallback& progress) {
+  Call call(this, session.id());
+  v1::OptimizeComeshRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  auto reader = stub_->OptimizeComesh(&call.context, request);
+  v1::OptimizeComeshResponse response;
+  std::optional<v1::OptimizeComeshResult> result;
+  while (reader->Read(&response)) {
+    if (response.has_iteration() && on_iter) on_iter(response.iteration());
+    if (response.has_progress() && progress) progress(response.progress());
+    if (response.has_result()) result = std::move(*response.mutable_result());
+  }
+  grpc::Status status = reader->Finish();
+  if (!status.ok()) return FromGrpcStatus(status);
+  if (!result) return absl::InternalError("OptimizeComesh stream ended without a result");
+  return *std::move(result);
 }
 
 absl::StatusOr<FramesResult> InbetweenClient::Inbetween(
     const std::string& session_id, const v1::InbetweenParameters& parameters,
     const std::function<void(const v1::InbetweenFrame&, uint32_t total)>& on_frame) {
-  grpc::ClientContext context;
-  context.AddMetadata("x-session-id", session_id);
-  SetInFlight(&context);
+  Call call(this, session_id);
   v1::InbetweenRequest request;
   request.set_session_id(session_id);
   *request.mutable_parameters() = parameters;
-  auto reader = stub_->Inbetween(&context, request);
+  auto reader = stub_->Inbetween(&call.context, request);
   FramesResult result;
   bool have_header = false;
   v1::InbetweenResponse response;
@@ -103,7 +160,6 @@ absl::StatusOr<FramesResult> InbetweenClient::Inbetween(
     }
   }
   grpc::Status status = reader->Finish();
-  SetInFlight(nullptr);
   if (!status.ok()) return FromGrpcStatus(status);
   if (!have_header) return absl::InternalError("Inbetween stream ended without a header");
   if (result.frames.size() != result.header.frames()) {

@@ -26,30 +26,41 @@ struct FramesResult {
 
 using ProgressCallback = std::function<void(const v1::Progress&)>;
 
+struct ClientOptions {
+  std::string token;  // bearer token sent as "authorization: Bearer <token>"; empty = none
+};
+
 class InbetweenClient {
  public:
-  explicit InbetweenClient(std::shared_ptr<grpc::Channel> channel);
+  explicit InbetweenClient(std::shared_ptr<grpc::Channel> channel, ClientOptions options = {});
 
-  absl::StatusOr<v1::Session> CreateSession(const std::string& display_name);
-  // Adds an SVG drawing (the file's text) named `name`; returns the updated session.
-  absl::StatusOr<v1::PutDrawingResponse> PutSvgDrawing(const v1::Session& session,
-                                                       const std::string& name,
-                                                       const std::string& svg_text);
+  absl::StatusOr<v1::Session> CreateSession(const std::string& display_name,
+                                            const v1::Parameters& parameters = {});
+  absl::StatusOr<v1::GetSessionResponse> GetSession(const std::string& session_id, bool full);
+  // Every session of the caller (all pages).
+  absl::StatusOr<std::vector<v1::Session>> ListSessions();
+  absl::StatusOr<v1::PutDrawingResponse> PutDrawing(const v1::PutDrawingRequest& request);
+  absl::StatusOr<v1::Session> SetCorrespondences(const v1::SetCorrespondencesRequest& request);
   absl::StatusOr<v1::BuildMultimeshResult> BuildMultimesh(const v1::Session& session,
                                                           const ProgressCallback& progress);
+  absl::StatusOr<v1::OptimizeComeshResult> OptimizeComesh(
+      const v1::Session& session, const std::function<void(const v1::ComeshIteration&)>& on_iter,
+      const ProgressCallback& progress);
   // Streams all frames; `on_frame` (optional) sees each frame as it arrives.
   absl::StatusOr<FramesResult> Inbetween(
       const std::string& session_id, const v1::InbetweenParameters& parameters,
       const std::function<void(const v1::InbetweenFrame&, uint32_t total)>& on_frame);
 
-  // Cancels the RPC in flight (if any) from another thread, e.g. a SIGINT handler thread.
+  // Cancels the RPC in flight (if any) and every later one, from another thread (Ctrl-C).
   void CancelInFlight();
 
  private:
-  // Registers `context` as the in-flight call for CancelInFlight().
-  void SetInFlight(grpc::ClientContext* context);
+  // A context carrying the token and the session id (for proxies' session affinity), registered
+  // as the in-flight call for CancelInFlight() until it is destroyed.
+  class Call;
 
   std::unique_ptr<v1::Inbetween::Stub> stub_;
+  ClientOptions options_;
   std::mutex mu_;
   grpc::ClientContext* in_flight_ = nullptr;
   bool cancelled_ = false;

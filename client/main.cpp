@@ -5,15 +5,22 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
-#include "client/animate_command.h"
+#include "client/commands.h"
 #include "client/inbetween_client.h"
 #include "server/inbetween_server.h"
 
 namespace {
 
+using inbetween::client::ExitCodeFor;
+
 constexpr int kUsageError = 2;
+constexpr const char* kExitCodes =
+    "Exit codes: 0 ok, 2 usage, 3 bad input, 4 server unreachable or refused, 5 server failure, "
+    "130 interrupted.";
 
 // Ctrl-C / SIGTERM cancel the RPC in flight; the command then exits with code 130.
 void StartSignalThread(inbetween::client::InbetweenClient* client) {
@@ -30,6 +37,24 @@ void StartSignalThread(inbetween::client::InbetweenClient* client) {
   }).detach();
 }
 
+std::shared_ptr<grpc::ChannelCredentials> Credentials(const std::string& tls_ca) {
+  if (tls_ca.empty()) return grpc::InsecureChannelCredentials();
+  std::ifstream in(tls_ca);
+  std::stringstream pem;
+  pem << in.rdbuf();
+  grpc::SslCredentialsOptions options;
+  options.pem_root_certs = pem.str();
+  return grpc::SslCredentials(options);
+}
+
+// Adds the drawings/--project inputs shared by several subcommands.
+void AddInputs(CLI::App* cmd, inbetween::client::Inputs* inputs) {
+  cmd->add_option("drawings", inputs->drawings, "SVG drawings in key order (2 to 16)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--project", inputs->project, "Project file (docs/project-file.md)")
+      ->check(CLI::ExistingFile);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -42,33 +67,123 @@ int main(int argc, char** argv) {
 
   CLI::App app{"inbetween: 2D inbetween animation from a few key drawings"};
   app.require_subcommand(1);
-  std::string server;
+  app.footer(kExitCodes);
+  std::string server, token, tls_ca, progress = "auto";
+  bool quiet = false;
   app.add_option("--server", server,
                  "HOST:PORT of an inbetween-server; without it the service runs embedded");
+  app.add_option("--token", token, "Bearer token for the server");
+  app.add_option("--tls-ca", tls_ca, "PEM file of the CA that signed the server's certificate")
+      ->check(CLI::ExistingFile);
+  app.add_option("--progress", progress, "auto (bar on a terminal) | json (one line per event)")
+      ->check(CLI::IsMember({"auto", "json"}));
+  app.add_flag("-q,--quiet", quiet, "No progress output");
 
+  // animate
   inbetween::client::AnimateOptions animate;
-  CLI::App* cmd = app.add_subcommand("animate", "Inbetween frames from 2-16 SVG drawings");
-  cmd->fallthrough();  // global options (--server) may also follow the subcommand
-  cmd->footer(
+  std::string method;
+  uint32_t frames = 0;
+  std::string formats;
+  int width = 0;
+  double fps = 0;
+  bool overlay = false;
+  CLI::App* animate_cmd = app.add_subcommand("animate", "Inbetween frames from 2-16 drawings");
+  AddInputs(animate_cmd, &animate.inputs);
+  animate_cmd->add_option("--out", animate.out_dir, "Output directory")->required();
+  animate_cmd->add_option("--frames", frames, "Frames including the keys (default 24)")
+      ->check(CLI::Range(2, 100000));
+  animate_cmd->add_option("--method", method, "zhu17 (default) | alexa | linear")
+      ->check(CLI::IsMember({"linear", "alexa", "zhu17"}));
+  animate_cmd->add_option("--format", formats,
+                          "Comma list of svg,json,png,gif,webp,lottie,contact (default "
+                          "svg,json,gif)");
+  animate_cmd->add_option("--size", width, "Raster width in pixels (default 512)")
+      ->check(CLI::Range(8, 16384));
+  animate_cmd->add_option("--fps", fps, "Frames per second of GIF/WebP/Lottie (default 24)")
+      ->check(CLI::Range(0.1, 240.0));
+  animate_cmd->add_flag("--mesh", overlay, "Draw the triangle mesh over every frame");
+  animate_cmd->add_flag("--transparent", animate.transparent, "Transparent background");
+  animate_cmd->add_flag("--optimize", animate.optimize, "Optimize the comesh before inbetweening");
+  animate_cmd->footer(
       "Examples:\n"
       "  inbetween animate square.svg hexagon.svg --frames 24 --out out/\n"
+      "  inbetween animate --project walk.json --out out/ --format gif,webp,lottie --size 640\n"
       "  inbetween --server 127.0.0.1:50051 animate a.svg b.svg c.svg --out out/ --method alexa\n"
-      "Writes OUT/frames.json and OUT/frame_0000.svg ...; prints the path of frames.json.\n"
-      "Exit codes: 0 ok, 2 usage, 3 bad input, 4 server unreachable, 5 server failure, "
-      "130 interrupted.");
-  cmd->add_option("drawings", animate.drawings, "SVG drawings in key order (2 to 16)")
+      "Writes OUT/frames.json, OUT/frame_NNNN.svg, OUT/animation.gif ...; prints the path of "
+      "frames.json (and the session id when --server is used).");
+
+  // mesh / optimize
+  inbetween::client::MeshOptions mesh;
+  CLI::App* mesh_cmd = app.add_subcommand("mesh", "Build the multimesh of 2-16 drawings");
+  AddInputs(mesh_cmd, &mesh.inputs);
+  mesh_cmd->add_option("--out", mesh.out_dir, "Output directory")->required();
+  mesh_cmd->footer(
+      "Examples:\n  inbetween mesh mouth_closed.svg mouth_open.svg --out mesh/\n"
+      "Writes OUT/multimesh.json and OUT/shape_N.svg (each shape with its mesh).");
+  inbetween::client::MeshOptions optimize;
+  optimize.optimize = true;
+  CLI::App* optimize_cmd =
+      app.add_subcommand("optimize", "Build and optimize the multimesh (comesh optimization)");
+  AddInputs(optimize_cmd, &optimize.inputs);
+  optimize_cmd->add_option("--out", optimize.out_dir, "Output directory")->required();
+  optimize_cmd->footer(
+      "Examples:\n  inbetween optimize square.svg hexagon.svg --out mesh/\n"
+      "Writes OUT/multimesh.json, OUT/shape_N.svg and OUT/report.json.");
+
+  // render
+  inbetween::client::RenderOptions render;
+  CLI::App* render_cmd = app.add_subcommand("render", "Render a frames.json to images");
+  render_cmd->add_option("frames", render.frames_json, "frames.json")
       ->required()
-      ->check(CLI::ExistingFile)
-      ->expected(2, 16);
-  cmd->add_option("--frames", animate.frames, "Frames including the keys")
-      ->default_val(24)
-      ->check(CLI::Range(2, 100000));
-  cmd->add_option("--out", animate.out_dir, "Output directory")->required();
-  cmd->add_option("--method", animate.method, "linear | alexa | zhu17")
-      ->default_val("zhu17")
+      ->check(CLI::ExistingFile);
+  render_cmd->add_option("--out", render.out_dir, "Output directory")->required();
+  render_cmd->add_option("--format", render.formats, "Comma list (see animate)")
+      ->default_val("svg,json,gif");
+  render_cmd->add_option("--size", render.width, "Raster width in pixels")
+      ->default_val(512)
+      ->check(CLI::Range(8, 16384));
+  render_cmd->add_option("--fps", render.fps, "Frames per second")->default_val(24);
+  render_cmd->add_option("--fill", render.fill, "Fill colour (#rrggbb)")->default_val("#3b7dd8");
+  render_cmd->add_flag("--mesh", render.mesh_overlay, "Draw the triangle mesh");
+  render_cmd->add_flag("--transparent", render.transparent, "Transparent background");
+  render_cmd->footer("Examples:\n  inbetween render out/frames.json --out out/ --format png,gif");
+
+  // inspect
+  std::string inspect_id;
+  CLI::App* inspect_cmd =
+      app.add_subcommand("inspect", "Show a session's state, or list your sessions");
+  inspect_cmd->add_option("session", inspect_id, "Session id (omit to list every session)");
+  inspect_cmd->footer(
+      "Examples:\n  inbetween --server 127.0.0.1:50051 inspect\n"
+      "  inbetween --server 127.0.0.1:50051 inspect 4f2a9c...");
+
+  // validate
+  inbetween::client::Inputs validate;
+  CLI::App* validate_cmd =
+      app.add_subcommand("validate", "Check drawings and a project file; report every problem");
+  AddInputs(validate_cmd, &validate);
+  validate_cmd->footer("Examples:\n  inbetween validate --project walk.json\n"
+                       "  inbetween validate a.svg b.svg");
+
+  // init
+  inbetween::client::Inputs init;
+  std::string init_out;
+  bool force = false;
+  CLI::App* init_cmd = app.add_subcommand("init", "Write a project file for some drawings");
+  init_cmd->add_option("drawings", init.drawings, "SVG drawings in key order")
+      ->required()
+      ->check(CLI::ExistingFile);
+  init_cmd->add_option("--out,-o", init_out, "Project file to write")->required();
+  init_cmd->add_option("--frames", frames, "Frames including the keys");
+  init_cmd->add_option("--method", method, "zhu17 | alexa | linear")
       ->check(CLI::IsMember({"linear", "alexa", "zhu17"}));
-  cmd->add_flag("--mesh", animate.mesh_overlay, "Draw the mesh over each SVG frame");
-  cmd->add_flag("-q,--quiet", animate.quiet, "No progress output");
+  init_cmd->add_flag("--force", force, "Overwrite an existing file");
+  init_cmd->footer("Examples:\n  inbetween init pose*.svg -o walk.json --frames 48");
+
+  for (CLI::App* cmd : {animate_cmd, mesh_cmd, optimize_cmd, render_cmd, inspect_cmd,
+                        validate_cmd, init_cmd}) {
+    cmd->fallthrough();  // global options may also follow the subcommand
+  }
 
   try {
     app.parse(argc, argv);
@@ -76,6 +191,21 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kUsageError;
   }
+
+  inbetween::client::InbetweenOverrides overrides;
+  if (frames != 0) overrides.frames = frames;
+  if (!method.empty()) overrides.method = method;
+  const auto mode = quiet                ? inbetween::client::ProgressMode::kQuiet
+                    : progress == "json" ? inbetween::client::ProgressMode::kJson
+                                         : inbetween::client::ProgressMode::kAuto;
+  inbetween::client::ProgressBar bar(mode);
+
+  auto report = [](const absl::Status& status) {
+    if (!status.ok()) std::fprintf(stderr, "error: %s\n", std::string(status.message()).c_str());
+    return ExitCodeFor(status);
+  };
+  if (*render_cmd) return report(inbetween::client::RunRender(render, bar));
+  if (*init_cmd) return report(inbetween::client::RunInit(init, init_out, overrides, force));
 
   std::unique_ptr<inbetween::server::InbetweenServer> embedded;
   std::shared_ptr<grpc::Channel> channel;
@@ -90,15 +220,37 @@ int main(int argc, char** argv) {
     embedded = std::move(*started);
     channel = embedded->InProcessChannel();
   } else {
-    channel = grpc::CreateChannel(server, grpc::InsecureChannelCredentials());
+    channel = grpc::CreateChannel(server, Credentials(tls_ca));
   }
 
-  inbetween::client::InbetweenClient client(channel);
+  inbetween::client::InbetweenClient client(channel, {.token = token});
   StartSignalThread(&client);
-  absl::Status status = inbetween::client::RunAnimate(animate, client);
-  if (embedded) embedded->Shutdown();
-  if (!status.ok()) {
-    std::fprintf(stderr, "error: %s\n", std::string(status.message()).c_str());
+  const inbetween::client::RunContext ctx{
+      .client = &client, .progress = &bar, .remote = !server.empty()};
+  absl::Status status;
+  if (*animate_cmd) {
+    if (!animate.inputs.project.empty() || !animate.inputs.drawings.empty()) {
+      animate.overrides = overrides;
+      if (!formats.empty()) animate.formats = formats;
+      if (width != 0) animate.width = width;
+      if (fps != 0) animate.fps = fps;
+      if (overlay) animate.mesh_overlay = true;
+    }
+    status = inbetween::client::RunAnimate(animate, ctx);
+  } else if (*mesh_cmd) {
+    status = inbetween::client::RunMesh(mesh, ctx);
+  } else if (*optimize_cmd) {
+    status = inbetween::client::RunMesh(optimize, ctx);
+  } else if (*inspect_cmd) {
+    if (inspect_id.empty() && server.empty()) {
+      status = absl::InvalidArgumentError(
+          "inspect without a session id lists a server's sessions: give --server HOST:PORT");
+    } else {
+      status = inbetween::client::RunInspect(inspect_id, ctx);
+    }
+  } else if (*validate_cmd) {
+    status = inbetween::client::RunValidate(validate, ctx);
   }
-  return inbetween::client::ExitCodeFor(status);
+  if (embedded) embedded->Shutdown();
+  return report(status);
 }

@@ -1,4 +1,4 @@
-// Terminal progress bar (see progress_bar.h).
+// Terminal / JSON progress output (see progress_bar.h).
 #include "client/progress_bar.h"
 
 #include <unistd.h>
@@ -6,14 +6,29 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "nlohmann/json.hpp"
+
 namespace inbetween::client {
 
-ProgressBar::ProgressBar() : tty_(isatty(STDERR_FILENO) == 1) {}
+ProgressBar::ProgressBar(ProgressMode mode) : mode_(mode), tty_(isatty(STDERR_FILENO) == 1) {}
 
-void ProgressBar::Update(const std::string& label, double fraction) {
-  const int percent = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0 + 0.5);
-  if (label == last_label_ && percent == last_percent_) return;
-  if (!tty_) {
+void ProgressBar::Update(const std::string& label, double fraction, const std::string& detail) {
+  if (mode_ == ProgressMode::kQuiet) return;
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  const int percent = static_cast<int>(fraction * 100.0 + 0.5);
+  const auto now = std::chrono::steady_clock::now();
+  if (label != last_label_) {
+    if (tty_ && !last_label_.empty() && mode_ == ProgressMode::kAuto) std::fprintf(stderr, "\n");
+    stage_start_ = now;
+  } else if (percent == last_percent_) {
+    return;
+  }
+  const double elapsed = std::chrono::duration<double>(now - stage_start_).count();
+  if (mode_ == ProgressMode::kJson) {
+    nlohmann::json event = {{"stage", label}, {"fraction", fraction}, {"elapsed_s", elapsed}};
+    if (!detail.empty()) event["detail"] = detail;
+    std::fprintf(stderr, "%s\n", event.dump().c_str());
+  } else if (!tty_) {
     // Logs: one line when a stage starts and one when it completes.
     if (label != last_label_ || (percent == 100 && last_percent_ != 100)) {
       std::fprintf(stderr, "%s %d%%\n", label.c_str(), percent);
@@ -21,8 +36,12 @@ void ProgressBar::Update(const std::string& label, double fraction) {
   } else {
     constexpr int kWidth = 30;
     const int filled = percent * kWidth / 100;
-    std::fprintf(stderr, "\r%-24.24s [%.*s%*s] %3d%%", label.c_str(), filled,
-                 "##############################", kWidth - filled, "", percent);
+    char eta[32] = "";
+    if (fraction > 0.02 && fraction < 1.0) {
+      std::snprintf(eta, sizeof(eta), " ETA %.1fs", elapsed * (1.0 - fraction) / fraction);
+    }
+    std::fprintf(stderr, "\r%-16.16s [%.*s%*s] %3d%%%-14s", label.c_str(), filled,
+                 "##############################", kWidth - filled, "", percent, eta);
     std::fflush(stderr);
   }
   last_label_ = label;
@@ -30,7 +49,7 @@ void ProgressBar::Update(const std::string& label, double fraction) {
 }
 
 void ProgressBar::Finish() {
-  if (tty_ && !last_label_.empty()) std::fprintf(stderr, "\n");
+  if (mode_ == ProgressMode::kAuto && tty_ && !last_label_.empty()) std::fprintf(stderr, "\n");
   last_label_.clear();
   last_percent_ = -1;
 }

@@ -1,0 +1,465 @@
+// The `inbetween` subcommands (see commands.h).
+#include "client/commands.h"
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "client/frames_output.h"
+#include "client/render/export.h"
+#include "client/render/svg_frames.h"
+
+namespace inbetween::client {
+namespace {
+
+using nlohmann::json;
+
+absl::StatusOr<std::string> ReadFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat("cannot open ", path.string()));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+absl::Status WriteText(const std::filesystem::path& path, const std::string& text) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out.flush()) return absl::UnavailableError(absl::StrCat("cannot write ", tmp.string()));
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) return absl::UnavailableError(absl::StrCat("cannot write ", path.string()));
+  return absl::OkStatus();
+}
+
+absl::Status Annotate(const absl::Status& status, const std::string& context) {
+  if (status.ok()) return status;
+  return absl::Status(status.code(), absl::StrCat(context, ": ", status.message()));
+}
+
+absl::StatusOr<v1::Method> ParseMethod(const std::string& name) {
+  if (name == "linear") return v1::METHOD_LINEAR;
+  if (name == "alexa") return v1::METHOD_ALEXA;
+  if (name == "zhu17") return v1::METHOD_ZHU17;
+  return absl::InvalidArgumentError(
+      absl::StrCat("--method: unknown method '", name, "' (expected linear, alexa or zhu17)"));
+}
+
+v1::Polyline ToPolyline(const XYs& points) {
+  v1::Polyline line;
+  for (const XY& p : points) {
+    v1::Point* q = line.add_points();
+    q->set_x(p[0]);
+    q->set_y(p[1]);
+  }
+  return line;
+}
+
+void ShowProgress(const RunContext& ctx, const v1::Progress& p) {
+  if (ctx.progress) ctx.progress->Update(p.stage(), p.fraction(), p.detail());
+}
+
+void FinishProgress(const RunContext& ctx) {
+  if (ctx.progress) ctx.progress->Finish();
+}
+
+// Creates a session and uploads the project's drawings (with their cuts and openings) and
+// correspondences. Errors name the drawing.
+absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::string& name,
+                                          const RunContext& ctx) {
+  auto session = ctx.client->CreateSession(name, project.parameters);
+  if (!session.ok()) return Annotate(session.status(), "create session");
+  for (size_t i = 0; i < project.drawings.size(); ++i) {
+    const ProjectDrawing& d = project.drawings[i];
+    const std::string where = absl::StrCat("drawing ", i + 1, " (", d.file.string(), ")");
+    auto svg = ReadFile(d.file);
+    if (!svg.ok()) return Annotate(svg.status(), where);
+    v1::PutDrawingRequest request;
+    request.set_session_id(session->id());
+    request.set_expected_version(session->version());
+    request.mutable_drawing()->set_name(d.file.filename().string());
+    request.mutable_drawing()->set_svg(*std::move(svg));
+    if (d.key_time) request.mutable_drawing()->set_key_time(*d.key_time);
+    for (const auto& [lines, kind] : {std::pair{&d.cuts, v1::ELEMENT_KIND_CUT},
+                                      std::pair{&d.openings, v1::ELEMENT_KIND_OPENING}}) {
+      for (const XYs& line : *lines) {
+        v1::TopologyElement* e = request.add_topology();
+        e->set_kind(kind);
+        *e->mutable_polyline() = ToPolyline(line);
+      }
+    }
+    auto put = ctx.client->PutDrawing(request);
+    if (!put.ok()) return Annotate(put.status(), where);
+    *session = put->session();
+  }
+  if (!project.correspondences.empty()) {
+    v1::SetCorrespondencesRequest request;
+    request.set_session_id(session->id());
+    request.set_expected_version(session->version());
+    for (const XYs& mark : project.correspondences) {
+      *request.add_correspondences()->mutable_points() = ToPolyline(mark).points();
+    }
+    auto updated = ctx.client->SetCorrespondences(request);
+    if (!updated.ok()) return Annotate(updated.status(), "correspondences");
+    *session = *updated;
+  }
+  if (ctx.remote) std::printf("session %s\n", session->id().c_str());
+  return session;
+}
+
+absl::StatusOr<v1::BuildMultimeshResult> Build(const v1::Session& session, const RunContext& ctx) {
+  auto built = ctx.client->BuildMultimesh(
+      session, [&](const v1::Progress& p) { ShowProgress(ctx, p); });
+  FinishProgress(ctx);
+  if (!built.ok()) return Annotate(built.status(), "build multimesh");
+  return built;
+}
+
+absl::StatusOr<v1::OptimizeComeshResult> Optimize(const v1::Session& session,
+                                                  const RunContext& ctx) {
+  auto optimized = ctx.client->OptimizeComesh(
+      session,
+      [&](const v1::ComeshIteration& it) {
+        if (ctx.progress) {
+          ctx.progress->Update("optimize", 0.0,
+                               absl::StrFormat("outer %u inner %u map %.4f mesh %.4f", it.outer(),
+                                               it.inner(), it.map_energy(), it.mesh_energy()));
+        }
+      },
+      [&](const v1::Progress& p) { ShowProgress(ctx, p); });
+  FinishProgress(ctx);
+  if (!optimized.ok()) return Annotate(optimized.status(), "optimize comesh");
+  return optimized;
+}
+
+json MultimeshToJson(const v1::Multimesh& mesh) {
+  json triangles = json::array();
+  for (const auto& t : mesh.triangles()) triangles.push_back({t.a(), t.b(), t.c()});
+  json shapes = json::array();
+  for (const auto& s : mesh.shapes()) {
+    json vertices = json::array();
+    for (const auto& p : s.vertices()) vertices.push_back({p.x(), p.y()});
+    shapes.push_back({{"vertices", std::move(vertices)}});
+  }
+  json cohesive = json::array();
+  for (const auto& c : mesh.cohesive_edges()) cohesive.push_back({c.a(), c.b(), c.c(), c.d()});
+  return {{"triangles", std::move(triangles)},
+          {"shapes", std::move(shapes)},
+          {"cohesive_edges", std::move(cohesive)},
+          {"boundary", std::vector<uint32_t>(mesh.boundary().begin(), mesh.boundary().end())}};
+}
+
+// The multimesh's shapes as a frame set, so the SVG exporter can draw each shape's mesh.
+render::FrameSet ShapesAsFrames(const v1::Multimesh& mesh) {
+  render::FrameSet set;
+  for (const auto& t : mesh.triangles()) {
+    set.triangles.push_back(
+        {static_cast<int>(t.a()), static_cast<int>(t.b()), static_cast<int>(t.c())});
+  }
+  for (int i = 0; i < mesh.shapes_size(); ++i) {
+    render::FrameData f;
+    f.index = i + 1;
+    for (const auto& p : mesh.shapes(i).vertices()) f.vertices.push_back({p.x(), p.y()});
+    set.frames.push_back(std::move(f));
+    set.keys.push_back(i);
+  }
+  return set;
+}
+
+}  // namespace
+
+absl::StatusOr<Project> ResolveProject(const Inputs& inputs) {
+  Project project;
+  if (!inputs.project.empty()) {
+    auto loaded = LoadProject(inputs.project);
+    if (!loaded.ok()) return loaded.status();
+    project = *std::move(loaded);
+  }
+  if (!inputs.drawings.empty()) {
+    project.drawings.clear();
+    for (const auto& path : inputs.drawings) {
+      ProjectDrawing d;
+      d.file = path;
+      project.drawings.push_back(std::move(d));
+    }
+  }
+  if (project.drawings.size() < 2 || project.drawings.size() > 16) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "need 2 to 16 drawings (on the command line or in --project), got ",
+        project.drawings.size()));
+  }
+  return project;
+}
+
+absl::Status RunAnimate(const AnimateOptions& options, const RunContext& ctx) {
+  auto project = ResolveProject(options.inputs);
+  if (!project.ok()) return project.status();
+  v1::InbetweenParameters* params = project->parameters.mutable_inbetween();
+  if (options.overrides.frames) params->set_frames(*options.overrides.frames);
+  if (options.overrides.method) {
+    auto method = ParseMethod(*options.overrides.method);
+    if (!method.ok()) return method.status();
+    params->set_method(*method);
+  }
+  render::ExportOptions out;
+  out.dir = options.out_dir;
+  auto formats = render::ParseFormats(options.formats.value_or(
+      absl::StrJoin(project->output.formats, ",")));
+  if (!formats.ok()) return Annotate(formats.status(), "--format");
+  out.formats = *formats;
+  out.width = options.width.value_or(project->output.width);
+  out.fps = options.fps.value_or(project->output.fps);
+  out.fill = project->output.fill;
+  out.mesh_overlay = options.mesh_overlay.value_or(project->output.mesh_overlay);
+  out.transparent = options.transparent;
+
+  auto session = UploadProject(*project, "inbetween animate", ctx);
+  if (!session.ok()) return session.status();
+  auto built = Build(*session, ctx);
+  if (!built.ok()) return built.status();
+  if (options.optimize) {
+    auto optimized = Optimize(built->session(), ctx);
+    if (!optimized.ok()) return optimized.status();
+  }
+  auto frames = ctx.client->Inbetween(
+      session->id(), *params, [&](const v1::InbetweenFrame& f, uint32_t total) {
+        if (ctx.progress) ctx.progress->Update("frames", total ? (f.index() + 1.0) / total : 1.0);
+      });
+  FinishProgress(ctx);
+  if (!frames.ok()) return Annotate(frames.status(), "inbetween");
+
+  out.progress = [&](std::string_view stage, int done, int total) {
+    if (ctx.progress) {
+      ctx.progress->Update(absl::StrCat("write ", std::string(stage)), total ? double(done) / total : 1.0);
+    }
+  };
+  absl::Status written = render::ExportFrames(ToFrameSet(*frames), out);
+  FinishProgress(ctx);
+  if (!written.ok()) return written;
+
+  uint32_t inverted = 0;
+  for (const auto& f : frames->frames) inverted += f.stats().inverted_triangles();
+  std::fprintf(stderr, "%zu frames, %d triangles, %d vertices, %u inverted triangles -> %s\n",
+               frames->frames.size(), frames->header.triangles_size(),
+               frames->frames.empty() ? 0 : frames->frames[0].vertices_size(), inverted,
+               options.out_dir.string().c_str());
+  std::printf("%s\n", (options.out_dir / "frames.json").string().c_str());
+  return absl::OkStatus();
+}
+
+absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
+  auto project = ResolveProject(options.inputs);
+  if (!project.ok()) return project.status();
+  auto session = UploadProject(*project, options.optimize ? "inbetween optimize" : "inbetween mesh",
+                               ctx);
+  if (!session.ok()) return session.status();
+  auto built = Build(*session, ctx);
+  if (!built.ok()) return built.status();
+  v1::Multimesh mesh = built->multimesh();
+  json report;
+  if (options.optimize) {
+    auto optimized = Optimize(built->session(), ctx);
+    if (!optimized.ok()) return optimized.status();
+    mesh = optimized->multimesh();
+    report = {{"vertices_before", built->stats().vertices()},
+              {"vertices_after", optimized->stats().vertices()},
+              {"inner", optimized->inner_iterations()},
+              {"outer", optimized->outer_iterations()},
+              {"seconds", optimized->seconds()},
+              {"map_energy", optimized->stats().map_energy()},
+              {"mesh_energy", optimized->stats().mesh_energy()}};
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(options.out_dir, ec);
+  if (ec) return absl::UnavailableError(absl::StrCat("cannot create ", options.out_dir.string()));
+  absl::Status s = WriteText(options.out_dir / "multimesh.json", MultimeshToJson(mesh).dump() + "\n");
+  if (!s.ok()) return s;
+  const render::FrameSet shapes = ShapesAsFrames(mesh);
+  render::SvgFrameOptions svg;
+  svg.mesh_overlay = true;
+  for (size_t i = 0; i < shapes.frames.size(); ++i) {
+    s = WriteText(options.out_dir / absl::StrCat("shape_", i + 1, ".svg"),
+                  render::FrameSvg(shapes, i, svg));
+    if (!s.ok()) return s;
+  }
+  if (options.optimize) {
+    s = WriteText(options.out_dir / "report.json", report.dump(2) + "\n");
+    if (!s.ok()) return s;
+  }
+  const auto& stats = built->stats();
+  std::fprintf(stderr, "%u shapes, %d vertices, %d triangles, %zu cohesive edges -> %s\n",
+               stats.shapes(), mesh.shapes_size() ? mesh.shapes(0).vertices_size() : 0,
+               mesh.triangles_size(), static_cast<size_t>(mesh.cohesive_edges_size()),
+               options.out_dir.string().c_str());
+  std::printf("%s\n", (options.out_dir / "multimesh.json").string().c_str());
+  return absl::OkStatus();
+}
+
+absl::Status RunRender(const RenderOptions& options, ProgressBar& progress) {
+  auto text = ReadFile(options.frames_json);
+  if (!text.ok()) return text.status();
+  json doc = json::parse(*text, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded()) {
+    return absl::InvalidArgumentError(absl::StrCat(options.frames_json.string(), ": not JSON"));
+  }
+  auto frames = render::FrameSetFromJson(doc);
+  if (!frames.ok()) return Annotate(frames.status(), options.frames_json.string());
+  render::ExportOptions out;
+  out.dir = options.out_dir;
+  auto formats = render::ParseFormats(options.formats);
+  if (!formats.ok()) return Annotate(formats.status(), "--format");
+  out.formats = *formats;
+  out.width = options.width;
+  out.fps = options.fps;
+  out.fill = options.fill;
+  out.mesh_overlay = options.mesh_overlay;
+  out.transparent = options.transparent;
+  out.progress = [&](std::string_view stage, int done, int total) {
+    progress.Update(absl::StrCat("write ", std::string(stage)), total ? double(done) / total : 1.0);
+  };
+  render::ExportReport report;
+  absl::Status s = render::ExportFrames(*frames, out, &report);
+  progress.Finish();
+  if (!s.ok()) return s;
+  for (const auto& f : report.files) std::printf("%s\n", (options.out_dir / f).string().c_str());
+  return absl::OkStatus();
+}
+
+absl::Status RunInspect(const std::string& session_id, const RunContext& ctx) {
+  if (session_id.empty()) {
+    auto sessions = ctx.client->ListSessions();
+    if (!sessions.ok()) return sessions.status();
+    for (const auto& s : *sessions) {
+      std::printf("%s\tversion %llu\t%d drawings\t%s\t%s\n", s.id().c_str(),
+                  static_cast<unsigned long long>(s.version()), s.drawings_size(),
+                  v1::Stage_Name(s.stage()).c_str(), s.display_name().c_str());
+    }
+    return absl::OkStatus();
+  }
+  auto got = ctx.client->GetSession(session_id, /*full=*/true);
+  if (!got.ok()) return got.status();
+  const v1::Session& s = got->session();
+  std::printf("session %s\nversion %llu\nstage %s\n", s.id().c_str(),
+              static_cast<unsigned long long>(s.version()), v1::Stage_Name(s.stage()).c_str());
+  for (int i = 0; i < s.drawings_size(); ++i) {
+    const v1::Drawing& d = s.drawings(i);
+    int outlines = 0, cuts = 0, openings = 0;
+    for (const auto& e : d.elements()) {
+      outlines += e.kind() == v1::ELEMENT_KIND_OUTLINE;
+      cuts += e.kind() == v1::ELEMENT_KIND_CUT;
+      openings += e.kind() == v1::ELEMENT_KIND_OPENING;
+    }
+    std::printf("drawing %d (id %u, %s): %d outlines, %d cuts, %d openings\n", i + 1, d.id(),
+                d.name().c_str(), outlines, cuts, openings);
+  }
+  if (s.stage() >= v1::STAGE_MULTIMESH) {
+    const auto& m = s.multimesh_stats();
+    std::printf("multimesh: %u shapes, %u vertices, %u triangles, map energy %.4f, "
+                "mesh energy %.4f, %u inverted\n",
+                m.shapes(), m.vertices(), m.triangles(), m.map_energy(), m.mesh_energy(),
+                m.inverted_triangles());
+  }
+  return absl::OkStatus();
+}
+
+absl::Status RunValidate(const Inputs& inputs, const RunContext& ctx) {
+  std::vector<std::string> problems;
+  absl::StatusOr<Project> project = ResolveProject(inputs);
+  if (!project.ok()) {
+    problems.push_back(std::string(project.status().message()));
+  } else {
+    auto session = ctx.client->CreateSession("inbetween validate");
+    if (!session.ok()) return session.status();
+    // Every drawing on its own, so one bad drawing does not hide the next.
+    int imported = 0;
+    for (size_t i = 0; i < project->drawings.size(); ++i) {
+      const ProjectDrawing& d = project->drawings[i];
+      const std::string where = absl::StrCat("drawing ", i + 1, " (", d.file.string(), ")");
+      auto svg = ReadFile(d.file);
+      if (!svg.ok()) {
+        problems.push_back(absl::StrCat(where, ": ", svg.status().message()));
+        continue;
+      }
+      v1::PutDrawingRequest request;
+      request.set_session_id(session->id());
+      request.set_expected_version(session->version());
+      request.mutable_drawing()->set_name(d.file.filename().string());
+      request.mutable_drawing()->set_svg(*svg);
+      auto put = ctx.client->PutDrawing(request);
+      if (!put.ok()) {
+        problems.push_back(absl::StrCat(where, ": ", put.status().message()));
+        continue;
+      }
+      *session = put->session();
+      ++imported;
+    }
+    // Whether the drawings fit together (same topology, mappable) only the build can tell.
+    if (problems.empty() && imported >= 2) {
+      auto built = ctx.client->BuildMultimesh(*session, nullptr);
+      if (!built.ok()) problems.push_back(absl::StrCat("build: ", built.status().message()));
+    }
+  }
+  for (const auto& p : problems) std::printf("%s\n", p.c_str());
+  if (problems.empty()) {
+    std::printf("ok\n");
+    return absl::OkStatus();
+  }
+  return absl::InvalidArgumentError(absl::StrCat(problems.size(), " problem(s) found"));
+}
+
+absl::Status RunInit(const Inputs& inputs, const std::filesystem::path& project_out,
+                     const InbetweenOverrides& overrides, bool force) {
+  if (!force && std::filesystem::exists(project_out)) {
+    return absl::AlreadyExistsError(
+        absl::StrCat(project_out.string(), " exists (use --force to overwrite)"));
+  }
+  auto project = ResolveProject(inputs);
+  if (!project.ok()) return project.status();
+  for (const auto& d : project->drawings) {
+    if (!std::filesystem::exists(d.file)) {
+      return absl::NotFoundError(absl::StrCat("cannot open ", d.file.string()));
+    }
+  }
+  if (overrides.frames) project->parameters.mutable_inbetween()->set_frames(*overrides.frames);
+  if (overrides.method) {
+    auto method = ParseMethod(*overrides.method);
+    if (!method.ok()) return method.status();
+    project->parameters.mutable_inbetween()->set_method(*method);
+  }
+  const auto base = std::filesystem::absolute(project_out).parent_path();
+  for (auto& d : project->drawings) d.file = std::filesystem::absolute(d.file);
+  absl::Status s = WriteText(project_out, ProjectToJson(*project, base).dump(2) + "\n");
+  if (!s.ok()) return s;
+  std::printf("%s\n", project_out.string().c_str());
+  return absl::OkStatus();
+}
+
+int ExitCodeFor(const absl::Status& status) {
+  switch (status.code()) {
+    case absl::StatusCode::kOk:
+      return 0;
+    case absl::StatusCode::kInvalidArgument:
+    case absl::StatusCode::kFailedPrecondition:
+    case absl::StatusCode::kNotFound:
+    case absl::StatusCode::kAlreadyExists:
+    case absl::StatusCode::kOutOfRange:
+      return 3;  // the input (drawings, files, parameters) is the problem
+    case absl::StatusCode::kUnavailable:
+    case absl::StatusCode::kDeadlineExceeded:
+    case absl::StatusCode::kUnauthenticated:
+    case absl::StatusCode::kPermissionDenied:
+      return 4;  // the server could not be reached or refused us
+    case absl::StatusCode::kCancelled:
+      return 130;  // interrupted (Ctrl-C)
+    default:
+      return 5;  // anything else: a server-side failure (including UNIMPLEMENTED)
+  }
+}
+
+}  // namespace inbetween::client

@@ -1,0 +1,85 @@
+// The `inbetween` subcommands as plain functions over an InbetweenClient (embedded or remote),
+// so they can be tested without a process. main.cpp only parses flags and calls these.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "client/inbetween_client.h"
+#include "client/progress_bar.h"
+#include "client/project_file.h"
+
+namespace inbetween::client {
+
+// Where drawings and parameters come from: `--project FILE` and/or drawings on the command line
+// (drawings given on the command line replace the project's).
+struct Inputs {
+  std::vector<std::filesystem::path> drawings;
+  std::filesystem::path project;  // empty = none
+};
+
+absl::StatusOr<Project> ResolveProject(const Inputs& inputs);
+
+// Overrides from the command line (unset = the project's value, then the server default).
+struct InbetweenOverrides {
+  std::optional<uint32_t> frames;
+  std::optional<std::string> method;  // linear | alexa | zhu17
+};
+
+struct RunContext {
+  InbetweenClient* client = nullptr;
+  ProgressBar* progress = nullptr;
+  bool remote = false;  // print the session id so a studio can come back to it
+};
+
+struct AnimateOptions {
+  Inputs inputs;
+  std::filesystem::path out_dir;
+  InbetweenOverrides overrides;
+  std::optional<std::string> formats;  // "svg,json,gif"; unset = project's output.formats
+  std::optional<int> width;
+  std::optional<double> fps;
+  std::optional<bool> mesh_overlay;
+  bool transparent = false;
+  bool optimize = false;  // run comesh optimization before inbetweening
+};
+absl::Status RunAnimate(const AnimateOptions& options, const RunContext& ctx);
+
+struct MeshOptions {
+  Inputs inputs;
+  std::filesystem::path out_dir;
+  bool optimize = false;  // `inbetween optimize`: also run comesh optimization, write report.json
+};
+// Writes DIR/multimesh.json and DIR/shape_N.svg (mesh drawn), plus report.json when optimizing.
+absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx);
+
+struct RenderOptions {
+  std::filesystem::path frames_json;
+  std::filesystem::path out_dir;
+  std::string formats = "svg,json,gif";
+  int width = 512;
+  double fps = 24;
+  std::string fill = "#3b7dd8";
+  bool mesh_overlay = false;
+  bool transparent = false;
+};
+absl::Status RunRender(const RenderOptions& options, ProgressBar& progress);
+
+// With an id: that session's state. Without: every session of the caller, one per line.
+absl::Status RunInspect(const std::string& session_id, const RunContext& ctx);
+
+// Checks the project file and every drawing and reports every problem at once (stdout, one per
+// line); fails with INVALID_ARGUMENT carrying the count when there is any.
+absl::Status RunValidate(const Inputs& inputs, const RunContext& ctx);
+
+// Writes a project file for the drawings (paths relative to the file).
+absl::Status RunInit(const Inputs& inputs, const std::filesystem::path& project_out,
+                     const InbetweenOverrides& overrides, bool force);
+
+// Process exit code for a final status (documented in docs/cli.md).
+int ExitCodeFor(const absl::Status& status);
+
+}  // namespace inbetween::client
