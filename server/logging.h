@@ -1,0 +1,21 @@
+// spdlog set-up for the server (level and text/JSON line format) and the per-RPC log line.
+#pragma once
+
+#include <grpcpp/support/status.h>
+
+#include "absl/status/status.h"
+#include "absl/strings/string_view.h"
+
+namespace inbetween::server {
+
+// level: trace|debug|info|warn|error|off. format: text|json. Logs go to stderr. In JSON mode
+// each line is one object {"time","level","thread","msg"}; the message is JSON-escaped (quote,
+// backslash and control characters), nothing else is transformed. Bad values are
+// INVALID_ARGUMENT naming the flag (--log-level / --log-format).
+absl::Status ConfigureLogging(absl::string_view level, absl::string_view format);
+
+// One line per finished RPC: debug when OK, warn otherwise; names the session when known.
+void LogRpc(absl::string_view rpc, absl::string_view session_id, const grpc::Status& status,
+            double seconds);
+
+}  // namespace inbetween::server

@@ -1,0 +1,206 @@
+// Parameter ranges and defaults exactly as documented in proto/inbetween/v1/inbetween.proto.
+#include "server/parameters.h"
+
+#include <cmath>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+
+namespace inbetween::server {
+namespace {
+
+// `value` must lie in [lo, hi] (or (lo, hi] when lo_open); non-finite values never do.
+absl::Status CheckRange(double value, double lo, double hi, bool lo_open, absl::string_view field,
+                        absl::string_view name) {
+  const bool ok = std::isfinite(value) && (lo_open ? value > lo : value >= lo) && value <= hi;
+  if (ok) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrCat(field, ".", name, " = ", value, " is not in ",
+                                                 lo_open ? "(" : "[", lo, ", ", hi, "]"));
+}
+
+absl::Status ValidateComesh(const inbetween::v1::ComeshParameters& comesh,
+                            absl::string_view field) {
+  if (comesh.has_map_weight()) {
+    if (auto s = CheckRange(comesh.map_weight(), 0, 1, false, field, "map_weight"); !s.ok()) {
+      return s;
+    }
+  }
+  if (comesh.max_outer_iterations() > 1000) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ".max_outer_iterations = ", comesh.max_outer_iterations(), " is not in [1, 1000]"));
+  }
+  if (comesh.max_inner_iterations() > 100000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".max_inner_iterations = ", comesh.max_inner_iterations(),
+                     " is not in [1, 100000]"));
+  }
+  if (comesh.tolerance() != 0) {
+    if (!(std::isfinite(comesh.tolerance()) && comesh.tolerance() > 0 && comesh.tolerance() < 1)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".tolerance = ", comesh.tolerance(), " is not in (0, 1)"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status ValidateMeshing(const inbetween::v1::MeshingParameters& meshing,
+                             absl::string_view field) {
+  const uint32_t n = meshing.boundary_vertices();
+  if (n != 0 && (n < 8 || n > 100000)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".boundary_vertices = ", n, " is not in [8, 100000]"));
+  }
+  if (meshing.max_edge_relative() != 0) {
+    if (auto s = CheckRange(meshing.max_edge_relative(), 0, 1, true, field, "max_edge_relative");
+        !s.ok()) {
+      return s;
+    }
+  }
+  if (meshing.shape_bound() != 0) {
+    if (auto s = CheckRange(meshing.shape_bound(), 0, 0.125, true, field, "shape_bound"); !s.ok()) {
+      return s;
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ValidateInbetween(const inbetween::v1::InbetweenParameters& p,
+                               absl::string_view field) {
+  if (!inbetween::v1::Method_IsValid(p.method())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".method = ", p.method(), " is not a known Method"));
+  }
+  if (p.frames() > static_cast<uint32_t>(kMaxFrames)) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat(field, ".frames = ", p.frames(), " exceeds the limit of ", kMaxFrames));
+  }
+  if (p.frames() == 1) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".frames = 1 is not in [2, ", kMaxFrames, "]"));
+  }
+  if (!inbetween::v1::TimingCurve_IsValid(p.timing())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".timing = ", p.timing(), " is not a known TimingCurve"));
+  }
+  for (int i = 0; i < p.ease_size(); ++i) {
+    if (auto s = CheckRange(p.ease(i), 0, 1, false, field, absl::StrCat("ease[", i, "]"));
+        !s.ok()) {
+      return s;
+    }
+  }
+  for (int i = 0; i < p.stiffness_size(); ++i) {
+    const inbetween::v1::StiffnessRegion& region = p.stiffness(i);
+    const std::string name = absl::StrCat("stiffness[", i, "]");
+    if (region.polygon().points_size() < 3) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".", name, ".polygon needs at least 3 points"));
+    }
+    for (const inbetween::v1::Point& q : region.polygon().points()) {
+      if (!std::isfinite(q.x()) || !std::isfinite(q.y())) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(field, ".", name, ".polygon has a non-finite point"));
+      }
+    }
+    if (auto s = CheckRange(region.kappa(), 0, 1e6, true, field, name + ".kappa"); !s.ok()) {
+      return s;
+    }
+  }
+  if (p.has_lambda()) {
+    if (auto s = CheckRange(p.lambda(), 0, 1e9, false, field, "lambda"); !s.ok()) return s;
+  }
+  if (p.has_tau()) {
+    if (auto s = CheckRange(p.tau(), 0, 1e9, false, field, "tau"); !s.ok()) return s;
+  }
+  if (p.has_alpha()) {
+    if (auto s = CheckRange(p.alpha(), 0, 1, false, field, "alpha"); !s.ok()) return s;
+  }
+  if (auto s = CheckRange(p.epsilon(), 0, 1e6, false, field, "epsilon"); !s.ok()) return s;
+  if (p.has_rho()) {
+    if (auto s = CheckRange(p.rho(), 0, 1e9, true, field, "rho"); !s.ok()) return s;
+  }
+  if (p.has_timestep()) {
+    if (auto s = CheckRange(p.timestep(), 0, 10, true, field, "timestep"); !s.ok()) return s;
+  }
+  if (p.max_iterations() > 10000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".max_iterations = ", p.max_iterations(), " is not in [1, 10000]"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ValidateParameters(const inbetween::v1::Parameters& parameters,
+                                absl::string_view field) {
+  if (auto s = ValidateMeshing(parameters.meshing(), absl::StrCat(field, ".meshing")); !s.ok()) {
+    return s;
+  }
+  if (auto s = ValidateComesh(parameters.comesh(), absl::StrCat(field, ".comesh")); !s.ok()) {
+    return s;
+  }
+  return ValidateInbetween(parameters.inbetween(), absl::StrCat(field, ".inbetween"));
+}
+
+solver::MultimeshOptions ToMultimeshOptions(const inbetween::v1::MeshingParameters& meshing) {
+  solver::MultimeshOptions options;
+  options.boundary_vertices = static_cast<int>(meshing.boundary_vertices());
+  options.max_edge_relative = meshing.max_edge_relative();
+  if (meshing.shape_bound() != 0) options.shape_bound = meshing.shape_bound();
+  return options;
+}
+
+inbetween::v1::InbetweenParameters MergeInbetween(
+    const inbetween::v1::InbetweenParameters& session,
+    const inbetween::v1::InbetweenParameters& request) {
+  inbetween::v1::InbetweenParameters out = session;
+  if (request.method() != 0) out.set_method(request.method());
+  if (request.frames() != 0) out.set_frames(request.frames());
+  if (request.timing() != 0) out.set_timing(request.timing());
+  if (request.ease_size() > 0) *out.mutable_ease() = request.ease();
+  if (request.stiffness_size() > 0) *out.mutable_stiffness() = request.stiffness();
+  if (request.has_lambda()) out.set_lambda(request.lambda());
+  if (request.has_tau()) out.set_tau(request.tau());
+  if (request.has_alpha()) out.set_alpha(request.alpha());
+  if (request.epsilon() != 0) out.set_epsilon(request.epsilon());
+  if (request.has_rho()) out.set_rho(request.rho());
+  if (request.has_timestep()) out.set_timestep(request.timestep());
+  if (request.max_iterations() != 0) out.set_max_iterations(request.max_iterations());
+  return out;
+}
+
+absl::StatusOr<InbetweenPlan> ToInbetweenPlan(const inbetween::v1::InbetweenParameters& p,
+                                              absl::string_view field) {
+  if (auto s = ValidateInbetween(p, field); !s.ok()) return s;
+  if (p.timing() != inbetween::v1::TIMING_CURVE_UNSPECIFIED &&
+      p.timing() != inbetween::v1::TIMING_CURVE_LINEAR) {
+    return absl::UnimplementedError(
+        absl::StrCat(field, ".timing = ", inbetween::v1::TimingCurve_Name(p.timing()),
+                     " is not implemented yet in this server version (use TIMING_CURVE_LINEAR)"));
+  }
+  InbetweenPlan plan;
+  if (p.frames() != 0) plan.frames = static_cast<int>(p.frames());
+  solver::InbetweenOptions& o = plan.options;
+  switch (p.method()) {
+    case inbetween::v1::METHOD_LINEAR:
+      o.method = solver::InterpMethod::kLinear;
+      break;
+    case inbetween::v1::METHOD_ALEXA:
+      o.method = solver::InterpMethod::kAlexa;
+      break;
+    default:  // METHOD_UNSPECIFIED = METHOD_ZHU17; unknown values were rejected above.
+      o.method = solver::InterpMethod::kZhu17;
+      break;
+  }
+  // Proto defaults are written out here (not taken from the solver struct) because the proto is
+  // the contract: a solver default change must not silently change the API.
+  o.lambda = p.has_lambda() ? p.lambda() : 1.0;
+  o.tau = p.has_tau() ? p.tau() : 0.1;
+  o.alpha = p.has_alpha() ? p.alpha() : 0.5;
+  o.epsilon = p.epsilon();
+  o.rho = p.has_rho() ? p.rho() : 1.0;
+  o.h = p.has_timestep() ? p.timestep() : 1.0 / 24;
+  o.max_iterations = p.max_iterations() != 0 ? static_cast<int>(p.max_iterations()) : 20;
+  return plan;
+}
+
+}  // namespace inbetween::server

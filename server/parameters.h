@@ -1,0 +1,45 @@
+// The API's Parameters: range checks, merging request over session values, and translation to
+// the solver's option structs with the documented defaults.
+#pragma once
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "inbetween/v1/inbetween.pb.h"
+#include "solver/interp/inbetweener.h"
+#include "solver/mesh/build_multimesh.h"
+
+namespace inbetween::server {
+
+inline constexpr int kDefaultFrames = 24;
+inline constexpr int kMaxFrames = 100000;
+
+// Range checks of every field (the ranges in inbetween.proto). Errors are INVALID_ARGUMENT
+// naming `field`.subfield, or RESOURCE_EXHAUSTED for frames above kMaxFrames.
+absl::Status ValidateParameters(const inbetween::v1::Parameters& parameters,
+                                absl::string_view field);
+absl::Status ValidateMeshing(const inbetween::v1::MeshingParameters& meshing,
+                             absl::string_view field);
+absl::Status ValidateInbetween(const inbetween::v1::InbetweenParameters& inbetween,
+                               absl::string_view field);
+
+// Validated meshing parameters -> solver options (zero fields take the solver's defaults).
+solver::MultimeshOptions ToMultimeshOptions(const inbetween::v1::MeshingParameters& meshing);
+
+// Request fields that are set (non-zero, present or non-empty) override the session's.
+inbetween::v1::InbetweenParameters MergeInbetween(
+    const inbetween::v1::InbetweenParameters& session,
+    const inbetween::v1::InbetweenParameters& request);
+
+struct InbetweenPlan {
+  int frames = kDefaultFrames;
+  solver::InbetweenOptions options;
+};
+
+// Validated, merged parameters -> what the server runs. Features the solver does not have yet
+// (non-linear timing curves) are UNIMPLEMENTED rather than ignored. Stiffness regions need the
+// mesh: the caller fills options.stiffness with StiffnessPerTriangle.
+absl::StatusOr<InbetweenPlan> ToInbetweenPlan(const inbetween::v1::InbetweenParameters& params,
+                                              absl::string_view field);
+
+}  // namespace inbetween::server

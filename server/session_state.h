@@ -1,0 +1,27 @@
+// What the server keeps per session: the API-visible Session plus the solver-side data derived
+// from it (parsed drawings, the multimesh), so heavy stages need no re-parsing.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "inbetween/v1/inbetween.pb.h"
+#include "solver/core/types.h"
+#include "solver/mesh/multimesh.h"
+
+namespace inbetween::server {
+
+struct SessionState {
+  // The session as the API shows it, drawings with their source (SVG text) and elements.
+  inbetween::v1::Session session;
+  // parsed[i] = the solver drawing of session.drawings(i) (its outlines), same order.
+  std::vector<solver::Drawing> parsed;
+  // The stored multimesh when session.stage() >= STAGE_MULTIMESH, else null. Shared and
+  // immutable so that copying a state out of the store is cheap.
+  std::shared_ptr<const solver::Multimesh> multimesh;
+  // Next drawing id to hand out; ids are never reused within a session.
+  uint32_t next_drawing_id = 1;
+};
+
+}  // namespace inbetween::server

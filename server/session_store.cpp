@@ -1,0 +1,132 @@
+// MemorySessionStore: sessions in a map under one mutex; List pages by insertion sequence.
+#include "server/session_store.h"
+
+#include <charconv>
+#include <chrono>
+#include <iterator>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace inbetween::server {
+
+absl::Status StaleVersionError(absl::string_view id, uint64_t current, uint64_t expected) {
+  return absl::AbortedError(
+      absl::StrCat("session ", id, " is at version ", current, ", request expected ", expected));
+}
+
+int64_t NowUnixMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+namespace {
+
+absl::Status NotFound(absl::string_view id) {
+  return absl::NotFoundError(absl::StrCat("session ", id, " not found"));
+}
+
+}  // namespace
+
+MemorySessionStore::MemorySessionStore(size_t max_sessions)
+    : max_sessions_(max_sessions), rng_(std::random_device{}()) {}
+
+std::string MemorySessionStore::NewIdLocked() {
+  static constexpr char kHex[] = "0123456789abcdef";
+  while (true) {
+    uint64_t bits = rng_();
+    std::string id(16, '0');
+    for (char& c : id) {
+      c = kHex[bits & 0xf];
+      bits >>= 4;
+    }
+    if (!by_id_.contains(id)) return id;
+  }
+}
+
+absl::StatusOr<SessionState> MemorySessionStore::Get(absl::string_view id) const {
+  std::lock_guard lock(mutex_);
+  auto it = by_id_.find(id);
+  if (it == by_id_.end()) return NotFound(id);
+  return it->second.state;
+}
+
+absl::StatusOr<SessionState> MemorySessionStore::Create(SessionState state) {
+  std::lock_guard lock(mutex_);
+  if (by_id_.size() >= max_sessions_) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the server holds the maximum of ", max_sessions_, " sessions"));
+  }
+  std::string id = state.session.id();
+  if (id.empty()) {
+    id = NewIdLocked();
+  } else if (by_id_.contains(id)) {
+    return absl::AlreadyExistsError(absl::StrCat("session ", id, " already exists"));
+  }
+  const int64_t now = NowUnixMs();
+  state.session.set_id(id);
+  if (state.session.version() == 0) state.session.set_version(1);
+  if (state.session.created_unix_ms() == 0) state.session.set_created_unix_ms(now);
+  state.session.set_updated_unix_ms(now);
+  const uint64_t sequence = next_sequence_++;
+  by_sequence_.emplace(sequence, id);
+  auto [it, inserted] = by_id_.emplace(id, Entry{sequence, std::move(state)});
+  return it->second.state;
+}
+
+absl::StatusOr<SessionState> MemorySessionStore::Put(SessionState state,
+                                                     uint64_t expected_version) {
+  std::lock_guard lock(mutex_);
+  auto it = by_id_.find(state.session.id());
+  if (it == by_id_.end()) return NotFound(state.session.id());
+  const inbetween::v1::Session& current = it->second.state.session;
+  if (current.version() != expected_version) {
+    return StaleVersionError(current.id(), current.version(), expected_version);
+  }
+  state.session.set_version(current.version() + 1);
+  state.session.set_created_unix_ms(current.created_unix_ms());
+  state.session.set_updated_unix_ms(NowUnixMs());
+  it->second.state = std::move(state);
+  return it->second.state;
+}
+
+absl::StatusOr<SessionPage> MemorySessionStore::List(size_t page_size,
+                                                     absl::string_view page_token) const {
+  // The token is the sequence number of the last session of the previous page, so pages stay
+  // consistent while sessions are created and deleted in between.
+  uint64_t after = 0;
+  if (!page_token.empty()) {
+    auto [end, error] =
+        std::from_chars(page_token.data(), page_token.data() + page_token.size(), after);
+    if (error != std::errc() || end != page_token.data() + page_token.size()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("page_token '", page_token, "' is not a token from ListSessions"));
+    }
+  }
+  std::lock_guard lock(mutex_);
+  SessionPage page;
+  for (auto it = by_sequence_.upper_bound(after); it != by_sequence_.end(); ++it) {
+    if (page.sessions.size() == page_size) {
+      page.next_page_token = absl::StrCat(std::prev(it)->first);
+      break;
+    }
+    page.sessions.push_back(by_id_.find(it->second)->second.state);
+  }
+  return page;
+}
+
+absl::Status MemorySessionStore::Delete(absl::string_view id, uint64_t expected_version) {
+  std::lock_guard lock(mutex_);
+  auto it = by_id_.find(id);
+  if (it == by_id_.end()) return NotFound(id);
+  const uint64_t version = it->second.state.session.version();
+  if (expected_version != 0 && expected_version != version) {
+    return StaleVersionError(id, version, expected_version);
+  }
+  by_sequence_.erase(it->second.sequence);
+  by_id_.erase(it);
+  return absl::OkStatus();
+}
+
+}  // namespace inbetween::server

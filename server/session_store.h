@@ -1,0 +1,84 @@
+// Session storage behind one interface (memory now; disk and Redis later) with optimistic
+// locking: every mutation increments the version, a stale expected version is ABORTED.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "server/session_state.h"
+
+namespace inbetween::server {
+
+// One page of List: states in deterministic order (creation order, then id).
+struct SessionPage {
+  std::vector<SessionState> sessions;
+  std::string next_page_token;  // empty = last page
+};
+
+class SessionStore {
+ public:
+  virtual ~SessionStore() = default;
+
+  // A copy of the session, or NOT_FOUND.
+  virtual absl::StatusOr<SessionState> Get(absl::string_view id) const = 0;
+
+  // Inserts a new session. An empty state.session.id gets a fresh random id; a taken id is
+  // ALREADY_EXISTS. Sets version (>= 1; a given version is kept), created (if unset) and
+  // updated times. Returns the stored state.
+  virtual absl::StatusOr<SessionState> Create(SessionState state) = 0;
+
+  // Replaces the session with id state.session.id if its version is expected_version (else
+  // ABORTED, or NOT_FOUND), then increments the version and sets the updated time. The caller's
+  // version and created fields are ignored. Returns the stored state.
+  virtual absl::StatusOr<SessionState> Put(SessionState state, uint64_t expected_version) = 0;
+
+  // Up to page_size sessions after page_token (from a previous page; empty = the first page).
+  virtual absl::StatusOr<SessionPage> List(size_t page_size,
+                                           absl::string_view page_token) const = 0;
+
+  // Deletes the session; expected_version 0 deletes whatever the version.
+  virtual absl::Status Delete(absl::string_view id, uint64_t expected_version) = 0;
+};
+
+// The ABORTED status of a stale expected version, worded the same by every store.
+absl::Status StaleVersionError(absl::string_view id, uint64_t current, uint64_t expected);
+
+// Milliseconds since the Unix epoch (wall clock).
+int64_t NowUnixMs();
+
+// Process-local store; a mutex guards the map (callers copy states out and compute unlocked).
+class MemorySessionStore final : public SessionStore {
+ public:
+  explicit MemorySessionStore(size_t max_sessions = 10000);
+
+  absl::StatusOr<SessionState> Get(absl::string_view id) const override;
+  absl::StatusOr<SessionState> Create(SessionState state) override;
+  absl::StatusOr<SessionState> Put(SessionState state, uint64_t expected_version) override;
+  absl::StatusOr<SessionPage> List(size_t page_size, absl::string_view page_token) const override;
+  absl::Status Delete(absl::string_view id, uint64_t expected_version) override;
+
+ private:
+  struct Entry {
+    uint64_t sequence;  // insertion order; the List order and the page token
+    SessionState state;
+  };
+
+  std::string NewIdLocked();
+
+  const size_t max_sessions_;
+  mutable std::mutex mutex_;
+  std::map<std::string, Entry, std::less<>> by_id_;
+  std::map<uint64_t, std::string> by_sequence_;
+  uint64_t next_sequence_ = 1;
+  std::mt19937_64 rng_;
+};
+
+}  // namespace inbetween::server

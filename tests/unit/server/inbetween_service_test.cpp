@@ -1,0 +1,751 @@
+// The Inbetween service through a real in-process server: sessions, drawings, status codes,
+// export/import, the heavy stages and cancellation.
+#include "server/inbetween_service.h"
+
+#include <gmock/gmock.h>
+#include <grpcpp/client_context.h>
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "server/parameters.h"
+#include "solver/core/types.h"
+#include "solver/mesh/validate.h"
+#include "tests/unit/server/test_server.h"
+
+namespace inbetween::server::testing {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::SizeIs;
+
+// All messages of an Inbetween stream plus its final status.
+struct InbetweenRun {
+  std::vector<v1::InbetweenResponse> messages;
+  grpc::Status status;
+};
+
+InbetweenRun RunInbetween(v1::Inbetween::Stub& stub, const v1::InbetweenRequest& request) {
+  InbetweenRun run;
+  grpc::ClientContext context;
+  auto reader = stub.Inbetween(&context, request);
+  v1::InbetweenResponse message;
+  while (reader->Read(&message)) run.messages.push_back(message);
+  run.status = reader->Finish();
+  return run;
+}
+
+struct BuildRun {
+  std::vector<v1::Progress> progress;
+  v1::BuildMultimeshResult result;
+  int results = 0;
+  grpc::Status status;
+};
+
+BuildRun RunBuild(v1::Inbetween::Stub& stub, const v1::Session& session) {
+  BuildRun run;
+  grpc::ClientContext context;
+  v1::BuildMultimeshRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  auto reader = stub.BuildMultimesh(&context, request);
+  v1::BuildMultimeshResponse message;
+  while (reader->Read(&message)) {
+    if (message.has_progress()) {
+      EXPECT_EQ(run.results, 0) << "progress after the result";
+      run.progress.push_back(message.progress());
+    } else if (message.has_result()) {
+      run.result = message.result();
+      ++run.results;
+    }
+  }
+  run.status = reader->Finish();
+  return run;
+}
+
+solver::Points ToPoints(const google::protobuf::RepeatedPtrField<v1::Point>& points) {
+  solver::Points out;
+  for (const v1::Point& p : points) out.emplace_back(p.x(), p.y());
+  return out;
+}
+
+std::vector<solver::Triangle> ToTriangles(
+    const google::protobuf::RepeatedPtrField<v1::Triangle>& triangles) {
+  std::vector<solver::Triangle> out;
+  for (const v1::Triangle& t : triangles) {
+    out.push_back({static_cast<int>(t.a()), static_cast<int>(t.b()), static_cast<int>(t.c())});
+  }
+  return out;
+}
+
+// Checks a complete stream: header first, `frames` frames in order, keys hit the shapes exactly
+// and no frame has an inverted triangle.
+void ExpectValidAnimation(const InbetweenRun& run, const v1::Multimesh& mesh, int frames,
+                          int first_frame = 0) {
+  ASSERT_TRUE(run.status.ok()) << run.status.error_message();
+  ASSERT_THAT(run.messages, SizeIs(frames - first_frame + 1));
+  ASSERT_TRUE(run.messages[0].has_header());
+  const v1::InbetweenHeader& header = run.messages[0].header();
+  EXPECT_EQ(header.frames(), static_cast<uint32_t>(frames));
+  ASSERT_EQ(header.keys_size(), mesh.shapes_size());
+  EXPECT_EQ(header.keys(0), 0u);
+  EXPECT_EQ(header.keys(header.keys_size() - 1), static_cast<uint32_t>(frames - 1));
+  const std::vector<solver::Triangle> triangles = ToTriangles(header.triangles());
+  EXPECT_EQ(triangles, ToTriangles(mesh.triangles()));
+  for (int i = first_frame; i < frames; ++i) {
+    const v1::InbetweenResponse& message = run.messages[i - first_frame + 1];
+    ASSERT_TRUE(message.has_frame()) << "message " << i - first_frame + 1;
+    const v1::InbetweenFrame& frame = message.frame();
+    EXPECT_EQ(frame.index(), static_cast<uint32_t>(i));
+    EXPECT_EQ(frame.weights_size(), mesh.shapes_size());
+    ASSERT_EQ(frame.vertices_size(), mesh.shapes(0).vertices_size());
+    EXPECT_EQ(frame.stats().inverted_triangles(), 0u) << "frame " << i;
+    EXPECT_EQ(solver::CountInverted(triangles, ToPoints(frame.vertices())), 0) << "frame " << i;
+  }
+  for (int k = 0; k < header.keys_size(); ++k) {
+    const int index = static_cast<int>(header.keys(k));
+    if (index < first_frame) continue;
+    const v1::InbetweenFrame& frame = run.messages[index - first_frame + 1].frame();
+    const v1::ShapeGeometry& shape = mesh.shapes(k);
+    for (int v = 0; v < frame.vertices_size(); ++v) {
+      // Exactly: a key frame is the drawing's own mesh, not an approximation of it.
+      EXPECT_EQ(frame.vertices(v).x(), shape.vertices(v).x()) << "key " << k << " vertex " << v;
+      EXPECT_EQ(frame.vertices(v).y(), shape.vertices(v).y()) << "key " << k << " vertex " << v;
+    }
+  }
+}
+
+using InbetweenServiceTest = ServerTest;
+
+// ---------------------------------------------------------------------------------------------
+// Sessions
+
+TEST_F(InbetweenServiceTest, SessionCrud) {
+  v1::Session created = CreateSession("first");
+  EXPECT_FALSE(created.id().empty());
+  EXPECT_EQ(created.version(), 1u);
+  EXPECT_EQ(created.display_name(), "first");
+  EXPECT_EQ(created.stage(), v1::STAGE_UNSPECIFIED);
+
+  {
+    grpc::ClientContext context;
+    v1::GetSessionRequest request;
+    request.set_session_id(created.id());
+    v1::GetSessionResponse response;
+    ASSERT_TRUE(stub_->GetSession(&context, request, &response).ok());
+    EXPECT_EQ(response.session().id(), created.id());
+    EXPECT_EQ(response.session().display_name(), "first");
+  }
+  {
+    grpc::ClientContext context;
+    v1::DeleteSessionRequest request;
+    request.set_session_id(created.id());
+    request.set_expected_version(1);
+    v1::DeleteSessionResponse response;
+    ASSERT_TRUE(stub_->DeleteSession(&context, request, &response).ok());
+  }
+  {
+    grpc::ClientContext context;
+    v1::GetSessionRequest request;
+    request.set_session_id(created.id());
+    v1::GetSessionResponse response;
+    grpc::Status status = stub_->GetSession(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+    EXPECT_THAT(status.error_message(), HasSubstr(created.id()));
+  }
+}
+
+TEST_F(InbetweenServiceTest, ListSessionsPages) {
+  std::vector<std::string> created;
+  for (int i = 0; i < 5; ++i) created.push_back(CreateSession("s" + std::to_string(i)).id());
+  std::vector<std::string> listed;
+  std::string token;
+  int pages = 0;
+  do {
+    grpc::ClientContext context;
+    v1::ListSessionsRequest request;
+    request.set_page_size(2);
+    request.set_page_token(token);
+    v1::ListSessionsResponse response;
+    grpc::Status status = stub_->ListSessions(&context, request, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    for (const v1::Session& s : response.sessions()) {
+      listed.push_back(s.id());
+      EXPECT_EQ(s.drawings_size(), 0);  // summaries only
+    }
+    token = response.next_page_token();
+    ++pages;
+  } while (!token.empty() && pages < 10);
+  EXPECT_EQ(listed, created);
+  EXPECT_EQ(pages, 3);
+
+  grpc::ClientContext context;
+  v1::ListSessionsRequest request;
+  request.set_page_token("not-a-token");
+  v1::ListSessionsResponse response;
+  EXPECT_EQ(stub_->ListSessions(&context, request, &response).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+}
+
+TEST_F(InbetweenServiceTest, StaleExpectedVersionIsAborted) {
+  v1::Session session = CreateSession();
+  v1::PutDrawingResponse put;
+  ASSERT_TRUE(PutPolylines(session, SquareOutline(0, 0, 10), &put).ok());
+  EXPECT_EQ(put.session().version(), 2u);
+
+  // `session` still says version 1.
+  grpc::Status stale = PutPolylines(session, SquareOutline(0, 0, 10), &put);
+  EXPECT_EQ(stale.error_code(), grpc::StatusCode::ABORTED);
+  EXPECT_EQ(stale.error_message(),
+            "session " + session.id() + " is at version 2, request expected 1");
+
+  grpc::ClientContext context;
+  v1::DeleteSessionRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(1);
+  v1::DeleteSessionResponse response;
+  EXPECT_EQ(stub_->DeleteSession(&context, request, &response).error_code(),
+            grpc::StatusCode::ABORTED);
+  grpc::ClientContext context2;
+  request.set_expected_version(0);  // 0 = whatever the version
+  EXPECT_TRUE(stub_->DeleteSession(&context2, request, &response).ok());
+}
+
+TEST_F(InbetweenServiceTest, UnknownOrMissingSessionId) {
+  v1::Session ghost;
+  ghost.set_id("0123456789abcdef");
+  ghost.set_version(1);
+  v1::PutDrawingResponse put;
+  EXPECT_EQ(PutPolylines(ghost, SquareOutline(0, 0, 1), &put).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+
+  v1::InbetweenRequest request;
+  request.set_session_id(ghost.id());
+  EXPECT_EQ(RunInbetween(*stub_, request).status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(RunBuild(*stub_, ghost).status.error_code(), grpc::StatusCode::NOT_FOUND);
+
+  grpc::ClientContext context;
+  v1::GetSessionRequest get;
+  v1::GetSessionResponse response;
+  grpc::Status status = stub_->GetSession(&context, get, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("session_id"));
+}
+
+TEST_F(InbetweenServiceTest, UnimplementedRpcs) {
+  {
+    grpc::ClientContext context;
+    auto stream = stub_->EditTopology(&context);
+    v1::TopologyEdit edit;
+    edit.set_session_id("x");
+    stream->Write(edit);
+    stream->WritesDone();
+    v1::TopologyState state;
+    while (stream->Read(&state)) {
+    }
+    grpc::Status status = stream->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
+    EXPECT_THAT(status.error_message(), HasSubstr("EditTopology"));
+  }
+  {
+    grpc::ClientContext context;
+    v1::OptimizeComeshRequest request;
+    auto reader = stub_->OptimizeComesh(&context, request);
+    v1::OptimizeComeshResponse message;
+    while (reader->Read(&message)) {
+    }
+    grpc::Status status = reader->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
+    EXPECT_THAT(status.error_message(), HasSubstr("OptimizeComesh"));
+  }
+  // The server is still fine.
+  EXPECT_FALSE(CreateSession().id().empty());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Drawings
+
+TEST_F(InbetweenServiceTest, BrokenSvgIsInvalidArgumentAndOtherSessionsKeepWorking) {
+  v1::Session broken = CreateSession("broken");
+  v1::Session healthy = CreateSession("healthy");
+  v1::PutDrawingResponse response;
+  grpc::Status status = PutSvg(broken, "bad.svg", "<svg><path d='M 0 0 L", &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("drawing.svg"));
+
+  status = PutSvg(broken, "empty.svg", "<svg xmlns='http://www.w3.org/2000/svg'></svg>", &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("drawing.svg"));
+
+  status =
+      PutSvg(healthy, "square.svg", ReadExample("examples/square_hexagon/square.svg"), &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.session().version(), 2u);
+  EXPECT_EQ(response.session().stage(), v1::STAGE_DRAWINGS);
+  EXPECT_EQ(response.drawing().id(), 1u);
+  ASSERT_EQ(response.drawing().elements_size(), 1);
+  EXPECT_EQ(response.drawing().elements(0).kind(), v1::ELEMENT_KIND_OUTLINE);
+  EXPECT_EQ(response.drawing().elements(0).id(), 1u);
+  EXPECT_GE(response.drawing().elements(0).polyline().points_size(), 4);
+  EXPECT_EQ(response.equivalence_class().components(), 1u);
+  EXPECT_EQ(response.equivalence_class().holes(), 0u);
+
+  // The failed puts did not touch the broken session.
+  grpc::ClientContext context;
+  v1::GetSessionRequest get;
+  get.set_session_id(broken.id());
+  v1::GetSessionResponse got;
+  ASSERT_TRUE(stub_->GetSession(&context, get, &got).ok());
+  EXPECT_EQ(got.session().version(), 1u);
+  EXPECT_EQ(got.session().drawings_size(), 0);
+}
+
+TEST_F(InbetweenServiceTest, PolylineDrawingsAreValidated) {
+  v1::Session session = CreateSession();
+  v1::PutDrawingResponse response;
+
+  v1::TopologyElement nan_point = SquareOutline(0, 0, 1);
+  nan_point.mutable_polyline()->mutable_points(2)->set_x(std::numeric_limits<double>::infinity());
+  grpc::Status status = PutPolylines(session, nan_point, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("drawing.polylines.elements[0] point 2"));
+
+  v1::TopologyElement two_points = SquareOutline(0, 0, 1);
+  two_points.mutable_polyline()->mutable_points()->DeleteSubrange(2, 2);
+  status = PutPolylines(session, two_points, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("at least 3"));
+
+  v1::TopologyElement bowtie;  // (3,0)-(0,2) crosses (1,2)-(0,0); the area is not zero
+  bowtie.set_kind(v1::ELEMENT_KIND_OUTLINE);
+  for (auto [x, y] : {std::pair{0.0, 0.0}, {3.0, 0.0}, {0.0, 2.0}, {1.0, 2.0}}) {
+    v1::Point* p = bowtie.mutable_polyline()->add_points();
+    p->set_x(x);
+    p->set_y(y);
+  }
+  status = PutPolylines(session, bowtie, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("crosses itself"));
+
+  v1::TopologyElement cut = SquareOutline(0, 0, 1);
+  cut.set_kind(v1::ELEMENT_KIND_CUT);
+  EXPECT_EQ(PutPolylines(session, cut, &response).error_code(), grpc::StatusCode::UNIMPLEMENTED);
+
+  grpc::ClientContext context;
+  v1::PutDrawingRequest no_source;
+  no_source.set_session_id(session.id());
+  no_source.set_expected_version(session.version());
+  status = stub_->PutDrawing(&context, no_source, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("drawing.svg or drawing.polylines"));
+
+  status = PutPolylines(session, SquareOutline(0, 0, 1), &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.drawing().elements(0).polyline().points_size(), 4);
+}
+
+TEST_F(InbetweenServiceTest, AtMostSixteenDrawings) {
+  v1::Session session = CreateSession();
+  v1::PutDrawingResponse response;
+  for (int i = 0; i < kMaxDrawingsPerSession; ++i) {
+    ASSERT_TRUE(PutPolylines(session, SquareOutline(i, 0, 1), &response).ok());
+    session = response.session();
+  }
+  grpc::Status status = PutPolylines(session, SquareOutline(0, 0, 1), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("16"));
+}
+
+TEST_F(InbetweenServiceTest, ReplaceAndRemoveDrawings) {
+  v1::Session session = CreateSession();
+  v1::PutDrawingResponse put;
+  ASSERT_TRUE(PutPolylines(session, SquareOutline(0, 0, 1), &put).ok());
+  ASSERT_TRUE(PutPolylines(put.session(), SquareOutline(0, 0, 2), &put).ok());
+  session = put.session();
+  ASSERT_EQ(session.drawings_size(), 2);
+  EXPECT_EQ(session.drawings(1).id(), 2u);
+
+  {  // Replace drawing 1 in place.
+    grpc::ClientContext context;
+    v1::PutDrawingRequest request;
+    request.set_session_id(session.id());
+    request.set_expected_version(session.version());
+    request.mutable_drawing()->set_id(1);
+    *request.mutable_drawing()->mutable_polylines()->add_elements() = SquareOutline(5, 5, 3);
+    ASSERT_TRUE(stub_->PutDrawing(&context, request, &put).ok());
+    session = put.session();
+    EXPECT_EQ(session.drawings(0).id(), 1u);
+    EXPECT_EQ(session.drawings(0).elements(0).polyline().points(0).x(), 5.0);
+  }
+  {  // Unknown drawing id.
+    grpc::ClientContext context;
+    v1::RemoveDrawingRequest request;
+    request.set_session_id(session.id());
+    request.set_expected_version(session.version());
+    request.set_drawing_id(42);
+    v1::RemoveDrawingResponse response;
+    EXPECT_EQ(stub_->RemoveDrawing(&context, request, &response).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+  }
+  {
+    grpc::ClientContext context;
+    v1::RemoveDrawingRequest request;
+    request.set_session_id(session.id());
+    request.set_expected_version(session.version());
+    request.set_drawing_id(1);
+    v1::RemoveDrawingResponse response;
+    ASSERT_TRUE(stub_->RemoveDrawing(&context, request, &response).ok());
+    ASSERT_EQ(response.session().drawings_size(), 1);
+    EXPECT_EQ(response.session().drawings(0).id(), 2u);
+    session = response.session();
+  }
+  // Ids are not reused.
+  ASSERT_TRUE(PutPolylines(session, SquareOutline(0, 0, 1), &put).ok());
+  EXPECT_EQ(put.drawing().id(), 3u);
+}
+
+TEST_F(InbetweenServiceTest, SetCorrespondences) {
+  v1::Session session = ImportTwoSquares();
+  ASSERT_EQ(session.stage(), v1::STAGE_MULTIMESH);
+  grpc::ClientContext context;
+  v1::SetCorrespondencesRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  v1::Correspondence* mark = request.add_correspondences();
+  mark->add_points()->set_x(0);
+  v1::SetCorrespondencesResponse response;
+  grpc::Status status = stub_->SetCorrespondences(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("one per drawing"));
+
+  mark->add_points()->set_x(0);
+  grpc::ClientContext context2;
+  status = stub_->SetCorrespondences(&context2, request, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.session().correspondences_size(), 1);
+  EXPECT_EQ(response.session().version(), session.version() + 1);
+  EXPECT_EQ(response.session().stage(), v1::STAGE_DRAWINGS);  // the multimesh is stale now
+}
+
+// ---------------------------------------------------------------------------------------------
+// Export / import
+
+TEST_F(InbetweenServiceTest, ExportImportRoundTrip) {
+  v1::Session original = ImportTwoSquares();
+  grpc::ClientContext context;
+  v1::ExportSessionRequest request;
+  request.set_session_id(original.id());
+  v1::ExportSessionResponse exported;
+  ASSERT_TRUE(stub_->ExportSession(&context, request, &exported).ok());
+  EXPECT_FALSE(exported.data().empty());
+
+  grpc::ClientContext context2;
+  v1::ImportSessionRequest import;
+  import.set_data(exported.data());
+  import.set_session_id("my-copy");
+  v1::ImportSessionResponse imported;
+  grpc::Status status = stub_->ImportSession(&context2, import, &imported);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(imported.session().id(), "my-copy");
+
+  auto get_full = [&](const std::string& id) {
+    grpc::ClientContext c;
+    v1::GetSessionRequest get;
+    get.set_session_id(id);
+    get.set_full(true);
+    v1::GetSessionResponse response;
+    EXPECT_TRUE(stub_->GetSession(&c, get, &response).ok());
+    return response;
+  };
+  v1::GetSessionResponse a = get_full(original.id());
+  v1::GetSessionResponse b = get_full("my-copy");
+  EXPECT_EQ(a.multimesh().SerializeAsString(), b.multimesh().SerializeAsString());
+  EXPECT_EQ(b.session().version(), a.session().version());
+  EXPECT_EQ(b.session().stage(), v1::STAGE_MULTIMESH);
+  a.mutable_session()->clear_id();
+  b.mutable_session()->clear_id();
+  a.mutable_session()->clear_updated_unix_ms();
+  b.mutable_session()->clear_updated_unix_ms();
+  EXPECT_EQ(a.session().SerializeAsString(), b.session().SerializeAsString());
+
+  grpc::ClientContext context3;
+  EXPECT_EQ(stub_->ImportSession(&context3, import, &imported).error_code(),
+            grpc::StatusCode::ALREADY_EXISTS);
+}
+
+TEST_F(InbetweenServiceTest, ImportRejectsGarbage) {
+  for (const std::string data : {std::string("this is not a protobuf \xff\xff\xff", 26),
+                                 std::string(), std::string("\x08\x02", 2)}) {
+    grpc::ClientContext context;
+    v1::ImportSessionRequest request;
+    request.set_data(data);
+    v1::ImportSessionResponse response;
+    grpc::Status status = stub_->ImportSession(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("data"));
+  }
+  grpc::ClientContext context;
+  v1::ImportSessionRequest request;
+  request.set_session_id("bad id with spaces");
+  v1::ImportSessionResponse response;
+  EXPECT_EQ(stub_->ImportSession(&context, request, &response).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+}
+
+TEST_F(InbetweenServiceTest, ImportRejectsAnInvertedMultimesh) {
+  v1::Session original = ImportTwoSquares();
+  grpc::ClientContext context;
+  v1::ExportSessionRequest request;
+  request.set_session_id(original.id());
+  v1::ExportSessionResponse exported;
+  ASSERT_TRUE(stub_->ExportSession(&context, request, &exported).ok());
+  v1::SessionArchive archive;
+  ASSERT_TRUE(archive.ParseFromString(exported.data()));
+  v1::Triangle* t = archive.mutable_multimesh()->mutable_triangles(0);
+  const uint32_t a = t->a();
+  t->set_a(t->b());
+  t->set_b(a);
+
+  grpc::ClientContext context2;
+  v1::ImportSessionRequest import;
+  archive.SerializeToString(import.mutable_data());
+  v1::ImportSessionResponse imported;
+  grpc::Status status = stub_->ImportSession(&context2, import, &imported);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("data: multimesh"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Heavy stages
+
+TEST_F(InbetweenServiceTest, BuildMultimeshNeedsTwoDrawings) {
+  v1::Session session = CreateSession();
+  v1::PutDrawingResponse put;
+  ASSERT_TRUE(PutPolylines(session, SquareOutline(0, 0, 1), &put).ok());
+  BuildRun run = RunBuild(*stub_, put.session());
+  EXPECT_EQ(run.status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(run.status.error_message(), HasSubstr("at least 2 drawings"));
+}
+
+TEST_F(InbetweenServiceTest, InbetweenBeforeBuildIsFailedPrecondition) {
+  v1::Session session = CreateSession();
+  v1::PutDrawingResponse put;
+  ASSERT_TRUE(PutPolylines(session, SquareOutline(0, 0, 1), &put).ok());
+  ASSERT_TRUE(PutPolylines(put.session(), SquareOutline(0, 0, 2), &put).ok());
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  InbetweenRun run = RunInbetween(*stub_, request);
+  EXPECT_EQ(run.status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(run.status.error_message(), HasSubstr("build the multimesh first"));
+  EXPECT_TRUE(run.messages.empty());
+}
+
+TEST_F(InbetweenServiceTest, InbetweenFrameLimits) {
+  v1::Session session = ImportTwoSquares();
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(1);
+  EXPECT_EQ(RunInbetween(*stub_, request).status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  request.mutable_parameters()->set_frames(kMaxFrames + 1);
+  EXPECT_EQ(RunInbetween(*stub_, request).status.error_code(),
+            grpc::StatusCode::RESOURCE_EXHAUSTED);
+  request.mutable_parameters()->set_frames(5);
+  request.set_start_frame(5);
+  EXPECT_EQ(RunInbetween(*stub_, request).status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+}
+
+TEST_F(InbetweenServiceTest, InbetweenOnImportedMultimesh) {
+  v1::Session session = ImportTwoSquares();
+  grpc::ClientContext context;
+  v1::GetSessionRequest get;
+  get.set_session_id(session.id());
+  get.set_full(true);
+  v1::GetSessionResponse full;
+  ASSERT_TRUE(stub_->GetSession(&context, get, &full).ok());
+
+  for (v1::Method method : {v1::METHOD_ZHU17, v1::METHOD_LINEAR, v1::METHOD_ALEXA}) {
+    SCOPED_TRACE(v1::Method_Name(method));
+    v1::InbetweenRequest request;
+    request.set_session_id(session.id());
+    request.mutable_parameters()->set_frames(7);
+    request.mutable_parameters()->set_method(method);
+    InbetweenRun run = RunInbetween(*stub_, request);
+    ExpectValidAnimation(run, full.multimesh(), 7);
+    EXPECT_EQ(run.messages[0].header().session_version(), session.version());
+  }
+  // Default frame count is 24.
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  ExpectValidAnimation(RunInbetween(*stub_, request), full.multimesh(), 24);
+}
+
+TEST_F(InbetweenServiceTest, InbetweenWithStiffnessRegions) {
+  v1::Session session = ImportTwoSquares();
+  grpc::ClientContext context;
+  v1::GetSessionRequest get;
+  get.set_session_id(session.id());
+  get.set_full(true);
+  v1::GetSessionResponse full;
+  ASSERT_TRUE(stub_->GetSession(&context, get, &full).ok());
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(5);
+  v1::StiffnessRegion* region = request.mutable_parameters()->add_stiffness();
+  *region->mutable_polygon() = SquareOutline(-1, -1, 1.6).polyline();  // holds one centroid
+  region->set_kappa(50);
+  ExpectValidAnimation(RunInbetween(*stub_, request), full.multimesh(), 5);
+
+  region->set_kappa(0);  // out of range
+  EXPECT_EQ(RunInbetween(*stub_, request).status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+}
+
+TEST_F(InbetweenServiceTest, InbetweenResumesAtStartFrame) {
+  v1::Session session = ImportTwoSquares();
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(9);
+  InbetweenRun all = RunInbetween(*stub_, request);
+  ASSERT_TRUE(all.status.ok()) << all.status.error_message();
+  request.set_start_frame(4);
+  InbetweenRun resumed = RunInbetween(*stub_, request);
+  ASSERT_TRUE(resumed.status.ok()) << resumed.status.error_message();
+  ASSERT_EQ(resumed.messages.size(), 1u + 5u);
+  for (int i = 4; i < 9; ++i) {
+    const v1::InbetweenFrame& a = all.messages[i + 1].frame();
+    const v1::InbetweenFrame& b = resumed.messages[i - 4 + 1].frame();
+    EXPECT_EQ(b.index(), static_cast<uint32_t>(i));
+    for (int v = 0; v < a.vertices_size(); ++v) {
+      EXPECT_EQ(a.vertices(v).x(), b.vertices(v).x());
+      EXPECT_EQ(a.vertices(v).y(), b.vertices(v).y());
+    }
+  }
+}
+
+TEST_F(InbetweenServiceTest, KeyTimeOutOfRangeIsInvalidArgument) {
+  v1::Session session = CreateSession();
+  v1::PutDrawingResponse put;
+  ASSERT_TRUE(PutPolylines(session, SquareOutline(0, 0, 1), &put).ok());
+  grpc::ClientContext context;
+  v1::PutDrawingRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(put.session().version());
+  request.mutable_drawing()->set_key_time(2.0);
+  *request.mutable_drawing()->mutable_polylines()->add_elements() = SquareOutline(0, 0, 2);
+  grpc::Status status = stub_->PutDrawing(&context, request, &put);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("drawing.key_time"));
+}
+
+TEST_F(InbetweenServiceTest, KeyTimesComeFromTheDrawingsWhenAllAreSet) {
+  v1::InbetweenRequest request;
+  request.mutable_parameters()->set_frames(6);
+  request.set_session_id(ImportTwoSquares(2.0, {0.0, 1.0}).id());
+  InbetweenRun run = RunInbetween(*stub_, request);
+  ASSERT_TRUE(run.status.ok()) << run.status.error_message();
+  EXPECT_EQ(run.messages[0].header().keys(1), 5u);
+
+  request.set_session_id(ImportTwoSquares(2.0, {0.0, -1.0}).id());
+  run = RunInbetween(*stub_, request);
+  EXPECT_EQ(run.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(run.status.error_message(), HasSubstr("key_time is set on 1 of 2 drawings"));
+
+  request.set_session_id(ImportTwoSquares(2.0, {0.0, 0.5}).id());  // the last must be 1
+  run = RunInbetween(*stub_, request);
+  EXPECT_EQ(run.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(run.status.error_message(), HasSubstr("key_time"));
+}
+
+TEST_F(InbetweenServiceTest, FullFlowOnTheSquareHexagonExample) {
+  v1::Session session = SessionWithExamples();
+  ASSERT_EQ(session.drawings_size(), 2);
+  BuildRun build = RunBuild(*stub_, session);
+  ASSERT_TRUE(build.status.ok()) << build.status.error_message();
+  ASSERT_EQ(build.results, 1);
+  const v1::BuildMultimeshResult& result = build.result;
+  EXPECT_EQ(result.session().version(), session.version() + 1);
+  EXPECT_EQ(result.session().stage(), v1::STAGE_MULTIMESH);
+  EXPECT_EQ(result.stats().shapes(), 2u);
+  EXPECT_GT(result.stats().vertices(), 3u);
+  EXPECT_EQ(result.stats().triangles(), static_cast<uint32_t>(result.multimesh().triangles_size()));
+  EXPECT_EQ(result.stats().inverted_triangles(), 0u);
+  EXPECT_EQ(result.session().multimesh_stats().vertices(), result.stats().vertices());
+  EXPECT_FALSE(build.progress.empty());
+  for (const v1::Progress& p : build.progress) {
+    EXPECT_GE(p.fraction(), 0.0);
+    EXPECT_LE(p.fraction(), 1.0);
+  }
+
+  constexpr int kFrames = 12;
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(kFrames);
+  InbetweenRun run = RunInbetween(*stub_, request);
+  ExpectValidAnimation(run, result.multimesh(), kFrames);
+  EXPECT_EQ(run.messages[0].header().session_version(), result.session().version());
+
+  // A new drawing invalidates the multimesh.
+  v1::PutDrawingResponse put;
+  ASSERT_TRUE(PutPolylines(result.session(), SquareOutline(0, 0, 50), &put).ok());
+  EXPECT_EQ(put.session().stage(), v1::STAGE_DRAWINGS);
+  EXPECT_EQ(RunInbetween(*stub_, request).status.error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+}
+
+TEST_F(InbetweenServiceTest, BuildWithStaleVersionIsAborted) {
+  v1::Session session = SessionWithExamples();
+  v1::Session stale = session;
+  stale.set_version(session.version() - 1);
+  EXPECT_EQ(RunBuild(*stub_, stale).status.error_code(), grpc::StatusCode::ABORTED);
+}
+
+TEST_F(InbetweenServiceTest, CancellingAnInbetweenStreamStopsItAndTheServerKeepsServing) {
+  v1::Session session = ImportTwoSquares();
+  {
+    grpc::ClientContext context;
+    v1::InbetweenRequest request;
+    request.set_session_id(session.id());
+    request.mutable_parameters()->set_frames(kMaxFrames);
+    auto reader = stub_->Inbetween(&context, request);
+    v1::InbetweenResponse message;
+    ASSERT_TRUE(reader->Read(&message));
+    EXPECT_TRUE(message.has_header());
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_TRUE(reader->Read(&message));
+      EXPECT_EQ(message.frame().index(), static_cast<uint32_t>(i));
+    }
+    context.TryCancel();
+    int more = 0;
+    while (reader->Read(&message)) ++more;
+    EXPECT_LT(more, kMaxFrames - 3);
+    grpc::Status status = reader->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::CANCELLED);
+  }
+  // Still serving: the same session animates again.
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(5);
+  InbetweenRun run = RunInbetween(*stub_, request);
+  EXPECT_TRUE(run.status.ok()) << run.status.error_message();
+  EXPECT_EQ(run.messages.size(), 6u);
+}
+
+TEST_F(InbetweenServiceTest, DeadlineStopsAnInbetweenStream) {
+  v1::Session session = ImportTwoSquares();
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(200));
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(kMaxFrames);
+  auto reader = stub_->Inbetween(&context, request);
+  v1::InbetweenResponse message;
+  // Read slowly so that the stream cannot finish before the deadline.
+  while (reader->Read(&message)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_FALSE(CreateSession().id().empty());
+}
+
+}  // namespace
+}  // namespace inbetween::server::testing

@@ -1,0 +1,141 @@
+// Shared fixture for server tests: a real in-process InbetweenServer and a stub on its channel,
+// plus helpers that build sessions in common states.
+#pragma once
+
+#include <grpcpp/client_context.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "inbetween/v1/inbetween.grpc.pb.h"
+#include "server/inbetween_server.h"
+
+namespace inbetween::server::testing {
+
+namespace v1 = ::inbetween::v1;
+
+inline std::string ReadExample(const std::string& relative) {
+  std::ifstream in(std::string(INBETWEEN_SOURCE_DIR) + "/" + relative);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// An axis-aligned square outline with positive signed area (y down).
+inline v1::TopologyElement SquareOutline(double x0, double y0, double size) {
+  v1::TopologyElement element;
+  element.set_kind(v1::ELEMENT_KIND_OUTLINE);
+  for (auto [x, y] :
+       {std::pair{x0, y0}, {x0 + size, y0}, {x0 + size, y0 + size}, {x0, y0 + size}}) {
+    v1::Point* p = element.mutable_polyline()->add_points();
+    p->set_x(x);
+    p->set_y(y);
+  }
+  return element;
+}
+
+class ServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ServerOptions options;
+    options.shutdown_grace = std::chrono::milliseconds(500);
+    auto server = InbetweenServer::Start(options);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = *std::move(server);
+    stub_ = v1::Inbetween::NewStub(server_->InProcessChannel());
+  }
+
+  v1::Session CreateSession(const std::string& name = "test") {
+    grpc::ClientContext context;
+    v1::CreateSessionRequest request;
+    request.set_display_name(name);
+    v1::CreateSessionResponse response;
+    grpc::Status status = stub_->CreateSession(&context, request, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return response.session();
+  }
+
+  grpc::Status PutSvg(const v1::Session& session, const std::string& name, const std::string& svg,
+                      v1::PutDrawingResponse* response) {
+    grpc::ClientContext context;
+    v1::PutDrawingRequest request;
+    request.set_session_id(session.id());
+    request.set_expected_version(session.version());
+    request.mutable_drawing()->set_name(name);
+    request.mutable_drawing()->set_svg(svg);
+    return stub_->PutDrawing(&context, request, response);
+  }
+
+  grpc::Status PutPolylines(const v1::Session& session, const v1::TopologyElement& outline,
+                            v1::PutDrawingResponse* response) {
+    grpc::ClientContext context;
+    v1::PutDrawingRequest request;
+    request.set_session_id(session.id());
+    request.set_expected_version(session.version());
+    *request.mutable_drawing()->mutable_polylines()->add_elements() = outline;
+    return stub_->PutDrawing(&context, request, response);
+  }
+
+  // A session with the square and hexagon examples as its two drawings.
+  v1::Session SessionWithExamples() {
+    v1::Session session = CreateSession("square-hexagon");
+    for (const char* name : {"square", "hexagon"}) {
+      v1::PutDrawingResponse response;
+      grpc::Status status =
+          PutSvg(session, name,
+                 ReadExample(std::string("examples/square_hexagon/") + name + ".svg"), &response);
+      EXPECT_TRUE(status.ok()) << status.error_message();
+      session = response.session();
+    }
+    return session;
+  }
+
+  // A session imported from an archive: two square drawings and a hand-made two-triangle
+  // multimesh (shape 2 = shape 1 scaled by 2), so stream tests do not depend on meshing.
+  // key_times: empty = unset on both drawings; otherwise one value per drawing, < 0 = unset.
+  v1::Session ImportTwoSquares(double scale = 2.0, std::vector<double> key_times = {}) {
+    v1::SessionArchive archive;
+    archive.set_format_version(1);
+    v1::Session* session = archive.mutable_session();
+    session->set_display_name("two squares");
+    session->set_version(7);
+    for (uint32_t i = 1; i <= 2; ++i) {
+      v1::Drawing* drawing = session->add_drawings();
+      drawing->set_id(i);
+      drawing->set_name("square " + std::to_string(i));
+      *drawing->add_elements() = SquareOutline(0, 0, i == 1 ? 1.0 : scale);
+      drawing->mutable_elements(0)->set_id(1);
+      if (!key_times.empty() && key_times[i - 1] >= 0) drawing->set_key_time(key_times[i - 1]);
+    }
+    session->set_stage(v1::STAGE_MULTIMESH);
+    v1::Multimesh* mesh = archive.mutable_multimesh();
+    for (auto [a, b, c] : {std::tuple{0u, 1u, 2u}, {0u, 2u, 3u}}) {
+      v1::Triangle* t = mesh->add_triangles();
+      t->set_a(a);
+      t->set_b(b);
+      t->set_c(c);
+    }
+    for (double s : {1.0, scale}) {
+      v1::ShapeGeometry* shape = mesh->add_shapes();
+      *shape->mutable_vertices() = SquareOutline(0, 0, s).polyline().points();
+    }
+    for (uint32_t v : {0u, 1u, 2u, 3u}) mesh->add_boundary(v);
+
+    grpc::ClientContext context;
+    v1::ImportSessionRequest request;
+    archive.SerializeToString(request.mutable_data());
+    v1::ImportSessionResponse response;
+    grpc::Status status = stub_->ImportSession(&context, request, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return response.session();
+  }
+
+  std::unique_ptr<InbetweenServer> server_;
+  std::unique_ptr<v1::Inbetween::Stub> stub_;
+};
+
+}  // namespace inbetween::server::testing
