@@ -357,6 +357,11 @@ grpc::Status InbetweenService::PutDrawing(grpc::ServerContext*,
     absl::StatusOr<SessionState> state =
         LoadForUpdate(*store_, request->session_id(), request->expected_version());
     if (!state.ok()) return state.status();
+    if (request->topology_size() > 0) {
+      // The contract says: refuse rather than silently drop the cuts/openings.
+      return absl::UnimplementedError(
+          "PutDrawing.topology (cuts and openings) is not implemented yet in this server version");
+    }
     // SVG parsing runs here, outside the store's lock.
     absl::StatusOr<ImportedDrawing> imported =
         ImportDrawing(request->drawing(), request->flatten_tolerance(), "drawing");
