@@ -23,6 +23,11 @@ struct Outline {
 // One key drawing: its outlines in the drawing's user units (SVG y-down coordinates as given).
 struct Drawing {
   std::vector<Outline> outlines;
+  // Open polylines (S-Sec.1, "topo operations"): their segments become bi-directed edges of the
+  // planar straight-line graph. A cut is meant to separate (boundary to boundary), an opening to
+  // open a hole or a slit; both become cohesive edge pairs (solver/geometry/graph_flow.h).
+  std::vector<Points> cuts;
+  std::vector<Points> openings;
 };
 
 }  // namespace inbetween::solver

@@ -110,4 +110,24 @@ std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon) {
   return std::nullopt;
 }
 
+void OrientByNesting(std::vector<Outline>* outlines) {
+  const size_t n = outlines->size();
+  std::vector<bool> hole(n, false);
+  for (size_t i = 0; i < n; ++i) {
+    int depth = 0;
+    // Test a point just inside the first edge to avoid vertices shared with other outlines.
+    const Points& p = (*outlines)[i].points;
+    const Point probe = p[0] + 1e-9 * (p[1] - p[0]);
+    for (size_t j = 0; j < n; ++j) {
+      if (j != i && PolygonContains((*outlines)[j].points, probe)) ++depth;
+    }
+    hole[i] = depth % 2 == 1;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    Points& p = (*outlines)[i].points;
+    const bool positive = PolygonSignedArea(p) > 0;
+    if (positive == hole[i]) std::reverse(p.begin() + 1, p.end());  // keep the first point
+  }
+}
+
 }  // namespace inbetween::solver

@@ -28,4 +28,9 @@ struct SelfIntersection {
 // Sweep over x-sorted segment bounding boxes; worst case O(n^2).
 std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon);
 
+// Orients non-crossing closed outlines by even-odd nesting (types.h convention): outlines nested
+// inside an even number of others become positive (outer), the rest negative (holes). The first
+// point of each outline is kept.
+void OrientByNesting(std::vector<Outline>* outlines);
+
 }  // namespace inbetween::solver

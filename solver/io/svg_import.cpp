@@ -88,13 +88,33 @@ void FlattenCubic(const Point& p0, const Point& p1, const Point& p2, const Point
 struct Collector {
   double tolerance = 0.05;
   std::vector<Outline> outlines;
+  std::vector<Points> cuts, openings;  // from class="cut" / class="opening" elements
 };
+
+// Whether the element's class attribute lists `token` (whitespace-separated).
+bool HasClass(xmlNode* node, const std::string& token) {
+  xmlChar* value = xmlGetProp(node, reinterpret_cast<const xmlChar*>("class"));
+  if (value == nullptr) return false;
+  const std::string classes = reinterpret_cast<const char*>(value);
+  xmlFree(value);
+  size_t pos = 0;
+  while (pos < classes.size()) {
+    const size_t begin = classes.find_first_not_of(" \t\n\r", pos);
+    if (begin == std::string::npos) break;
+    size_t end = classes.find_first_of(" \t\n\r", begin);
+    if (end == std::string::npos) end = classes.size();
+    if (classes.compare(begin, end - begin, token) == 0) return true;
+    pos = end;
+  }
+  return false;
+}
 
 // A subpath as the pen drew it, in the element's local coordinates. A cubic segment is stored
 // as its three points, the two control points flagged.
 struct Subpath {
   Points points;
   std::vector<bool> is_control;
+  bool closed = false;
 };
 
 // One context per SVG element (created on the stack by SVG++): inherits the transform and the
@@ -149,12 +169,29 @@ class Context {
   }
   void path_close_subpath() {
     // The pen returns to the subpath start; a further drawing command starts a new subpath.
-    if (!subpaths_.empty()) pen_ = subpaths_.back().points.front();
+    if (!subpaths_.empty()) {
+      pen_ = subpaths_.back().points.front();
+      subpaths_.back().closed = true;
+    }
     open_ = false;
   }
   void path_exit() {}
 
   void on_exit_element() {
+    // Topology edits (docs/svg-convention.md): class="cut" / class="opening" elements are open
+    // polylines whatever their paint; they never become outlines.
+    const bool cut = node_ != nullptr && HasClass(node_, "cut");
+    const bool opening = node_ != nullptr && !cut && HasClass(node_, "opening");
+    if (cut || opening) {
+      for (const Subpath& subpath : subpaths_) {
+        Points line = Flatten(subpath);
+        if (subpath.closed && line.size() > 1 && line.back() != line.front()) {
+          line.push_back(line.front());
+        }
+        if (line.size() >= 2) (cut ? collector_->cuts : collector_->openings).push_back(line);
+      }
+      return;
+    }
     if (!filled_) return;
     for (const Subpath& subpath : subpaths_) Emit(subpath);
   }
@@ -177,8 +214,8 @@ class Context {
     if (!control) pen_ = Point(x, y);
   }
 
-  // Transforms, flattens and closes one subpath; keeps it when it encloses some area.
-  void Emit(const Subpath& subpath) const {
+  // Transforms and flattens one subpath (consecutive duplicates removed).
+  Points Flatten(const Subpath& subpath) const {
     const Points& raw = subpath.points;
     Points flat = {Apply(ctm_, raw[0].x(), raw[0].y())};
     for (size_t i = 1; i < raw.size();) {
@@ -193,12 +230,19 @@ class Context {
         ++i;
       }
     }
-    // A fill closes every subpath implicitly; drop the repeated closing point and duplicates.
-    Outline outline;
+    Points out;
     for (const Point& p : flat) {
       if (!p.allFinite()) throw ImportError("the transformed coordinates are not finite");
-      if (outline.points.empty() || p != outline.points.back()) outline.points.push_back(p);
+      if (out.empty() || p != out.back()) out.push_back(p);
     }
+    return out;
+  }
+
+  // Flattens and closes one subpath; keeps it when it encloses some area.
+  void Emit(const Subpath& subpath) const {
+    // A fill closes every subpath implicitly; drop the repeated closing point.
+    Outline outline;
+    outline.points = Flatten(subpath);
     while (outline.points.size() > 1 && outline.points.back() == outline.points.front()) {
       outline.points.pop_back();
     }
@@ -246,7 +290,8 @@ struct ErrorPolicy : sv::policy::error::raise_exception<Context> {
 using ProcessedElements =
     boost::mpl::set<sv::tag::element::svg, sv::tag::element::g, sv::tag::element::path,
                     sv::tag::element::rect, sv::tag::element::circle, sv::tag::element::ellipse,
-                    sv::tag::element::polygon, sv::tag::element::polyline>::type;
+                    sv::tag::element::polygon, sv::tag::element::polyline,
+                    sv::tag::element::line>::type;
 using ProcessedAttributes =
     boost::mpl::insert<boost::mpl::insert<sv::traits::shapes_attributes_by_element,
                                           sv::tag::attribute::transform>::type,
@@ -292,27 +337,6 @@ void AdoptSvgNamespace(xmlNode* root) {
     if (node->type != XML_ELEMENT_NODE || node->ns != nullptr) continue;
     xmlSetNs(node, ns);
     for (xmlNode* child = node->children; child; child = child->next) stack.push_back(child);
-  }
-}
-
-// Outlines nested inside an odd number of others are holes (negative), the rest positive.
-void OrientByNesting(std::vector<Outline>* outlines) {
-  const size_t n = outlines->size();
-  std::vector<bool> hole(n, false);
-  for (size_t i = 0; i < n; ++i) {
-    int depth = 0;
-    // Test a point just inside the first edge to avoid vertices shared with other outlines.
-    const Points& p = (*outlines)[i].points;
-    const Point probe = p[0] + 1e-9 * (p[1] - p[0]);
-    for (size_t j = 0; j < n; ++j) {
-      if (j != i && PolygonContains((*outlines)[j].points, probe)) ++depth;
-    }
-    hole[i] = depth % 2 == 1;
-  }
-  for (size_t i = 0; i < n; ++i) {
-    Points& p = (*outlines)[i].points;
-    const bool positive = PolygonSignedArea(p) > 0;
-    if (positive == hole[i]) std::reverse(p.begin() + 1, p.end());  // keep the first point
   }
 }
 
@@ -370,6 +394,8 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   OrientByNesting(&collector.outlines);
   Drawing drawing;
   drawing.outlines = std::move(collector.outlines);
+  drawing.cuts = std::move(collector.cuts);
+  drawing.openings = std::move(collector.openings);
   return drawing;
 }
 

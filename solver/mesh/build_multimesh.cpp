@@ -1,14 +1,19 @@
-// Stage driver: drawings -> compatible multimesh. Correspondence of the boundaries, quality
-// mesh of shape 1 (CGAL), its boundary Steiner points copied into every other boundary at the
-// same segment parameter, then an injective map of the mesh into every other shape.
+// Stage driver: drawings -> compatible multimesh (S-Sec.1, S-Fig.2). Directed graph flow per
+// drawing (S-Alg.1), equivalence check, boundary correspondence, CGAL mesh of drawing 1 cut open
+// along its cuts/openings, boundary Steiner points mirrored so every cohesive edge pairs up in
+// every drawing, then an injective map of each connected component into every other drawing.
 #include "solver/mesh/build_multimesh.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <numeric>
 #include <string>
 
 #include "absl/strings/str_cat.h"
-#include "solver/geometry/correspondence.h"
+#include "solver/geometry/boundary_correspondence.h"
+#include "solver/geometry/graph_flow.h"
 #include "solver/mesh/cgal_triangulate.h"
 #include "solver/mesh/map_to_boundary.h"
 #include "solver/mesh/split_boundary_chords.h"
@@ -17,18 +22,116 @@
 namespace inbetween::solver {
 namespace {
 
-// Vertex indices of the boundary in order: shape 1's resampled boundary vertices with the
-// boundary Steiner points of each segment after its start vertex.
-std::vector<int> BoundaryOrder(int n, const std::vector<BoundarySteiner>& steiner) {
-  std::vector<int> order;
-  size_t next = 0;  // `steiner` is sorted by (segment, t)
-  for (int s = 0; s < n; ++s) {
-    order.push_back(s);
-    for (; next < steiner.size() && steiner[next].segment == s; ++next) {
-      order.push_back(steiner[next].vertex);
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int Find(int x) { return parent[x] == x ? x : parent[x] = Find(parent[x]); }
+  void Unite(int a, int b) { parent[Find(a)] = Find(b); }
+};
+
+// One boundary vertex of the mesh: on correspondence edge `edge` at parameter t in [0, 1).
+struct BoundaryEntry {
+  int vertex;
+  int edge;
+  double t;
+};
+
+// Drawing 1's mesh with the boundary known edge by edge.
+struct CutMesh {
+  Points vertices;
+  std::vector<Triangle> triangles;
+  // entries[e]: the vertices on correspondence edge e from its start (t = 0) onwards.
+  std::vector<std::vector<BoundaryEntry>> entries;
+};
+
+// Duplicates every vertex along the cut/opening sides (one copy per fan of triangles between
+// constrained edges) and lists the boundary vertices of each correspondence edge.
+CutMesh CutAlongSeams(const DomainTriangulation& dt, const BoundaryCorrespondence& bc) {
+  const int num_tri = static_cast<int>(dt.triangles.size());
+  using Edge = std::pair<int, int>;
+  std::map<Edge, bool> constrained;
+  auto chain_of = [&](int g, int k) {
+    std::vector<int> c = {dt.loop_vertex[g][k]};
+    c.insert(c.end(), dt.edge_chain[g][k].begin(), dt.edge_chain[g][k].end());
+    c.push_back(dt.loop_vertex[g][(k + 1) % dt.loop_vertex[g].size()]);
+    return c;
+  };
+  for (size_t g = 0; g < dt.loop_vertex.size(); ++g) {
+    for (size_t k = 0; k < dt.loop_vertex[g].size(); ++k) {
+      const std::vector<int> c = chain_of(g, k);
+      for (size_t j = 0; j + 1 < c.size(); ++j) constrained[std::minmax(c[j], c[j + 1])] = true;
     }
   }
-  return order;
+  std::map<Edge, std::pair<int, int>> directed;  // (a, b) -> (triangle, corner of a)
+  for (int t = 0; t < num_tri; ++t) {
+    for (int k = 0; k < 3; ++k)
+      directed[{dt.triangles[t][k], dt.triangles[t][(k + 1) % 3]}] = {t, k};
+  }
+  UnionFind corners(3 * num_tri);
+  for (const auto& [e, tk] : directed) {
+    if (e.first > e.second || constrained.count(std::minmax(e.first, e.second))) continue;
+    auto other = directed.find({e.second, e.first});
+    if (other == directed.end()) continue;
+    const auto [t1, k1] = tk;
+    const auto [t2, k2] = other->second;
+    // a = e.first is corner k1 of t1 and corner (k2 + 1) % 3 of t2; b likewise.
+    corners.Unite(3 * t1 + k1, 3 * t2 + (k2 + 1) % 3);
+    corners.Unite(3 * t1 + (k1 + 1) % 3, 3 * t2 + k2);
+  }
+  CutMesh out;
+  std::vector<int> copy(3 * num_tri, -1);
+  out.triangles.resize(num_tri);
+  for (int t = 0; t < num_tri; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const int root = corners.Find(3 * t + k);
+      if (copy[root] < 0) {
+        copy[root] = static_cast<int>(out.vertices.size());
+        out.vertices.push_back(dt.vertices[dt.triangles[t][k]]);
+      }
+      out.triangles[t][k] = copy[root];
+    }
+  }
+  out.entries.resize(bc.num_vertices());
+  for (int g = 0; g < bc.num_loops(); ++g) {
+    for (size_t k = 0; k < dt.loop_vertex[g].size(); ++k) {
+      const std::vector<int> c = chain_of(g, k);
+      const int e = bc.loop_start[g] + static_cast<int>(k);
+      const Point a = dt.vertices[c.front()], d = dt.vertices[c.back()] - a;
+      for (size_t j = 0; j + 1 < c.size(); ++j) {
+        const auto [t, corner] = directed.at({c[j], c[j + 1]});
+        const double param = j == 0 ? 0.0 : (dt.vertices[c[j]] - a).dot(d) / d.squaredNorm();
+        out.entries[e].push_back({copy[corners.Find(3 * t + corner)], e, param});
+      }
+    }
+  }
+  return out;
+}
+
+// Inserts a boundary vertex on correspondence edge e at parameter t (drawing 1's geometry),
+// splitting the triangle on the drawing side of the boundary sub-edge it falls on.
+void SplitBoundaryEdge(CutMesh* mesh, const std::vector<int>& next_edge_start, int e, double t) {
+  std::vector<BoundaryEntry>& list = mesh->entries[e];
+  size_t j = 0;
+  while (j + 1 < list.size() && list[j + 1].t < t) ++j;
+  const int a = list[j].vertex;
+  const int b =
+      j + 1 < list.size() ? list[j + 1].vertex : mesh->entries[next_edge_start[e]][0].vertex;
+  const Point pa = mesh->vertices[list[0].vertex];
+  const Point pb = mesh->vertices[mesh->entries[next_edge_start[e]][0].vertex];
+  const int m = static_cast<int>(mesh->vertices.size());
+  mesh->vertices.push_back((1 - t) * pa + t * pb);
+  for (size_t i = 0; i < mesh->triangles.size(); ++i) {
+    Triangle& tri = mesh->triangles[i];
+    for (int k = 0; k < 3; ++k) {
+      if (tri[k] == a && tri[(k + 1) % 3] == b) {
+        const int c = tri[(k + 2) % 3];
+        tri = {a, m, c};
+        mesh->triangles.push_back({m, b, c});
+        list.insert(list.begin() + j + 1, {m, e, t});
+        return;
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -51,74 +154,217 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     for (size_t o = 0; o < outlines.size(); ++o) {
       for (size_t p = 0; p < outlines[o].points.size(); ++p) {
         if (!outlines[o].points[p].allFinite()) {
-          return absl::InvalidArgumentError(
-              absl::StrCat("drawing ", d, ", outline ", o, ", point ", p, " is not finite"));
+          return absl::InvalidArgumentError(absl::StrCat("drawing ", d + 1, ", outline ", o + 1,
+                                                         ", point ", p + 1, " is not finite"));
         }
       }
     }
   }
 
   if (cancelled()) return absl::CancelledError("BuildMultimesh cancelled");
-  notify("correspondence", 0.0, absl::StrCat(num_shapes, " drawings"));
-  CorrespondenceOptions correspondence_options;
+  notify("boundaries", 0.0, absl::StrCat(num_shapes, " drawings"));
+  std::vector<BoundaryGraph> graphs;
+  for (int d = 0; d < num_shapes; ++d) {
+    absl::StatusOr<BoundaryGraph> g = BuildBoundaries(drawings[d], d + 1);
+    if (!g.ok()) return g.status();
+    graphs.push_back(*std::move(g));
+  }
+  if (absl::Status same = CheckSameEquivalence(graphs); !same.ok()) return same;
+
+  notify("correspondence", 0.05, absl::StrCat(graphs[0].loops.size(), " boundary loops"));
+  BoundaryCorrespondenceOptions correspondence_options;
   correspondence_options.vertices = options.boundary_vertices;
-  absl::StatusOr<Correspondence> correspondence =
-      ComputeCorrespondence(drawings, correspondence_options);
-  if (!correspondence.ok()) return correspondence.status();
-  const std::vector<Points>& boundaries = correspondence->boundaries;
-  const int n = static_cast<int>(boundaries[0].size());
+  correspondence_options.corner_angle_degrees = options.corner_angle_degrees;
+  correspondence_options.marks = options.marks;
+  absl::StatusOr<BoundaryCorrespondence> bc =
+      ComputeBoundaryCorrespondence(graphs, correspondence_options);
+  if (!bc.ok()) return bc.status();
+  for (int d = 0; d < num_shapes; ++d) {
+    for (int g = 0; g < bc->num_loops(); ++g) {
+      const Points& loop = bc->shapes[d][g];
+      for (size_t k = 0; k < loop.size(); ++k) {
+        if (loop[k] == loop[(k + 1) % loop.size()]) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("drawing ", d + 1, ": two boundary vertices coincide near (",
+                           loop[k].x(), ", ", loop[k].y(), "); use more boundary vertices"));
+        }
+      }
+    }
+  }
+  const int num_edges = bc->num_vertices();
+  std::vector<int> next_edge_start(num_edges);
+  for (int g = 0; g < bc->num_loops(); ++g) {
+    for (int e = bc->loop_start[g]; e < bc->loop_start[g + 1]; ++e) {
+      next_edge_start[e] = e + 1 < bc->loop_start[g + 1] ? e + 1 : bc->loop_start[g];
+    }
+  }
+  auto sample = [&](int d, int e) -> const Point& {
+    const int g =
+        static_cast<int>(std::upper_bound(bc->loop_start.begin(), bc->loop_start.end(), e) -
+                         bc->loop_start.begin()) -
+        1;
+    return bc->shapes[d][g][e - bc->loop_start[g]];
+  };
 
   if (cancelled()) return absl::CancelledError("BuildMultimesh cancelled");
-  notify("triangulate", 0.1, absl::StrCat("drawing 0, ", n, " boundary vertices"));
+  notify("triangulate", 0.1, absl::StrCat("drawing 1, ", num_edges, " boundary vertices"));
   TriangulateOptions triangulate_options;
   triangulate_options.shape_bound = options.shape_bound;
-  if (options.max_edge_relative > 0) {
-    Point lo = boundaries[0][0], hi = lo;
-    for (const Point& p : boundaries[0]) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-    triangulate_options.max_edge = options.max_edge_relative * (hi - lo).norm();
-  } else {
-    // Automatic: interior edges about as long as the boundary spacing.
+  {
+    Point lo = bc->shapes[0][0][0], hi = lo;
     double perimeter = 0.0;
-    for (int i = 0; i < n; ++i) perimeter += (boundaries[0][(i + 1) % n] - boundaries[0][i]).norm();
-    triangulate_options.max_edge = 1.5 * perimeter / n;
+    for (const Points& loop : bc->shapes[0]) {
+      for (size_t i = 0; i < loop.size(); ++i) {
+        lo = lo.cwiseMin(loop[i]), hi = hi.cwiseMax(loop[i]);
+        perimeter += (loop[(i + 1) % loop.size()] - loop[i]).norm();
+      }
+    }
+    triangulate_options.max_edge = options.max_edge_relative > 0
+                                       ? options.max_edge_relative * (hi - lo).norm()
+                                       : 1.5 * perimeter / num_edges;  // about the spacing
   }
-  absl::StatusOr<PolygonTriangulation> triangulation =
-      CgalTriangulate(boundaries[0], triangulate_options);
+  absl::StatusOr<DomainTriangulation> triangulation =
+      CgalTriangulateDomain(bc->shapes[0], triangulate_options);
   if (!triangulation.ok()) {
     return absl::Status(triangulation.status().code(),
-                        absl::StrCat("drawing 0: ", triangulation.status().message()));
+                        absl::StrCat("drawing 1: ", triangulation.status().message()));
+  }
+  CutMesh cut = CutAlongSeams(*triangulation, *bc);
+
+  // Mirror boundary Steiner points across every pair of twin edges of every drawing.
+  for (int round = 0; round < 8; ++round) {
+    bool split = false;
+    for (int d = 0; d < num_shapes; ++d) {
+      for (int e = 0; e < num_edges; ++e) {
+        const int f = bc->edge_twin[d][e];
+        if (f < 0) continue;
+        for (const BoundaryEntry& entry : std::vector<BoundaryEntry>(cut.entries[e])) {
+          if (entry.t == 0.0) continue;
+          const double want = 1.0 - entry.t;
+          bool present = false;
+          for (const BoundaryEntry& other : cut.entries[f])
+            present |= std::abs(other.t - want) < 1e-9;
+          if (!present) SplitBoundaryEdge(&cut, next_edge_start, f, want), split = true;
+        }
+      }
+    }
+    if (!split) break;
   }
 
   Multimesh mesh;
-  mesh.boundary = BoundaryOrder(n, triangulation->boundary_steiner);
-  mesh.triangles = std::move(triangulation->triangles);
-  Points vertices = std::move(triangulation->vertices);
-  std::vector<bool> is_boundary(vertices.size(), false);
-  for (int b : mesh.boundary) is_boundary[b] = true;
-  SplitBoundaryChords(&vertices, &mesh.triangles, &is_boundary);
-  mesh.shapes.push_back(vertices);
+  std::vector<bool> is_boundary(cut.vertices.size(), false);
+  for (int g = 0; g < bc->num_loops(); ++g) {
+    std::vector<int> loop;
+    for (int e = bc->loop_start[g]; e < bc->loop_start[g + 1]; ++e) {
+      for (const BoundaryEntry& entry : cut.entries[e]) loop.push_back(entry.vertex);
+    }
+    for (int v : loop) is_boundary[v] = true;
+    mesh.boundary.insert(mesh.boundary.end(), loop.begin(), loop.end());
+    mesh.boundary_loops.push_back(std::move(loop));
+  }
+  SplitBoundaryChords(&cut.vertices, &cut.triangles, &is_boundary);
+  mesh.triangles = cut.triangles;
+  const int num_vertices = static_cast<int>(cut.vertices.size());
 
+  // Targets per drawing: boundary vertices at their edge parameter, twins made exactly equal.
+  auto targets_of = [&](int d) {
+    Points target = cut.vertices;
+    for (int e = 0; e < num_edges; ++e) {
+      const Point& a = sample(d, e);
+      const Point& b = sample(d, next_edge_start[e]);
+      for (const BoundaryEntry& entry : cut.entries[e]) {
+        target[entry.vertex] = entry.t == 0.0 ? a : Point((1 - entry.t) * a + entry.t * b);
+      }
+    }
+    for (int e = 0; e < num_edges; ++e) {
+      const int f = bc->edge_twin[d][e];
+      if (f < 0 || f < e) continue;
+      const auto& le = cut.entries[e];
+      const auto& lf = cut.entries[f];
+      for (size_t j = 1; j < le.size() && j < lf.size(); ++j) {
+        target[lf[lf.size() - j].vertex] = target[le[j].vertex];
+      }
+    }
+    return target;
+  };
+
+  // Connected components, each mapped on its own.
+  UnionFind components(num_vertices);
+  for (const Triangle& t : mesh.triangles)
+    components.Unite(t[0], t[1]), components.Unite(t[0], t[2]);
+  std::map<int, std::vector<int>> loops_of_component;
+  for (int g = 0; g < bc->num_loops(); ++g) {
+    loops_of_component[components.Find(mesh.boundary_loops[g][0])].push_back(g);
+  }
+  mesh.shapes.push_back(targets_of(0));
   for (int d = 1; d < num_shapes; ++d) {
     if (cancelled()) return absl::CancelledError("BuildMultimesh cancelled");
-    notify("map", 0.2 + 0.75 * (d - 1) / (num_shapes - 1), absl::StrCat("drawing ", d));
-    // Steiner points go to the same segment parameter of this drawing's boundary.
-    Points target(vertices.size());
-    for (int i = 0; i < n; ++i) target[i] = boundaries[d][i];
-    for (const BoundarySteiner& s : triangulation->boundary_steiner) {
-      target[s.vertex] =
-          (1 - s.t) * boundaries[d][s.segment] + s.t * boundaries[d][(s.segment + 1) % n];
+    notify("map", 0.2 + 0.75 * (d - 1) / (num_shapes - 1), absl::StrCat("drawing ", d + 1));
+    Points shape = targets_of(d);
+    const Points target = shape;
+    for (const auto& [root, loops] : loops_of_component) {
+      std::vector<int> local(num_vertices, -1), global;
+      std::vector<Triangle> triangles;
+      for (const Triangle& t : mesh.triangles) {
+        if (components.Find(t[0]) != root) continue;
+        Triangle lt;
+        for (int k = 0; k < 3; ++k) {
+          if (local[t[k]] < 0)
+            local[t[k]] = static_cast<int>(global.size()), global.push_back(t[k]);
+          lt[k] = local[t[k]];
+        }
+        triangles.push_back(lt);
+      }
+      Points source;
+      for (int v : global) source.push_back(mesh.shapes[0][v]);
+      std::vector<int> boundary;
+      Points target_boundary;
+      for (int g : loops) {
+        for (int v : mesh.boundary_loops[g]) {
+          boundary.push_back(local[v]);
+          target_boundary.push_back(target[v]);
+        }
+      }
+      MapToBoundaryOptions map_options;
+      map_options.tutte_when_convex = loops.size() == 1;
+      absl::StatusOr<Points> mapped =
+          MapToBoundary(source, triangles, boundary, target_boundary, map_options, cancel);
+      if (!mapped.ok()) {
+        if (absl::IsCancelled(mapped.status())) return mapped.status();
+        return absl::FailedPreconditionError(absl::StrCat(
+            "cannot map drawing 1's mesh into drawing ", d + 1, ": ", mapped.status().message()));
+      }
+      for (size_t i = 0; i < global.size(); ++i) shape[global[i]] = (*mapped)[i];
     }
-    Points target_boundary;
-    for (int b : mesh.boundary) target_boundary.push_back(target[b]);
-    absl::StatusOr<Points> mapped =
-        MapToBoundary(vertices, mesh.triangles, mesh.boundary, target_boundary, {}, cancel);
-    if (!mapped.ok()) {
-      if (absl::IsCancelled(mapped.status())) return mapped.status();
-      return absl::FailedPreconditionError(
-          absl::StrCat("cannot map mesh into drawing ", d, ": ", mapped.status().message()));
-    }
-    mesh.shapes.push_back(*std::move(mapped));
+    mesh.shapes.push_back(std::move(shape));
   }
+
+  // Cohesive edges: sub-edges of twin edges, closed in the drawings where they are collocated.
+  std::map<std::array<int, 4>, int> cohesive_index;
+  mesh.cohesive_closed.assign(num_shapes, {});
+  for (int d = 0; d < num_shapes; ++d) {
+    for (int e = 0; e < num_edges; ++e) {
+      const int f = bc->edge_twin[d][e];
+      if (f < 0 || f < e) continue;
+      std::vector<int> le, lf;
+      for (const BoundaryEntry& x : cut.entries[e]) le.push_back(x.vertex);
+      le.push_back(cut.entries[next_edge_start[e]][0].vertex);
+      for (const BoundaryEntry& x : cut.entries[f]) lf.push_back(x.vertex);
+      lf.push_back(cut.entries[next_edge_start[f]][0].vertex);
+      if (le.size() != lf.size()) {
+        return absl::InternalError("cohesive sides have different vertex counts");
+      }
+      const size_t m = le.size() - 1;
+      for (size_t j = 0; j < m; ++j) {
+        const std::array<int, 4> c = {le[j], le[j + 1], lf[m - j], lf[m - j - 1]};
+        auto [it, inserted] =
+            cohesive_index.emplace(c, static_cast<int>(mesh.cohesive_edges.size()));
+        if (inserted) mesh.cohesive_edges.push_back(c);
+        mesh.cohesive_closed[d].push_back(it->second);
+      }
+    }
+  }
+  if (mesh.cohesive_edges.empty()) mesh.cohesive_closed.clear();
 
   notify("validate", 0.95, absl::StrCat(mesh.num_vertices(), " vertices"));
   if (absl::Status valid = ValidateMultimesh(mesh); !valid.ok()) {
@@ -127,6 +373,10 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   if (report != nullptr) {
     report->vertices = mesh.num_vertices();
     report->triangles = static_cast<int>(mesh.triangles.size());
+    report->boundary_loops = static_cast<int>(mesh.boundary_loops.size());
+    report->cohesive_edges = static_cast<int>(mesh.cohesive_edges.size());
+    report->equivalence.clear();
+    for (const BoundaryGraph& g : graphs) report->equivalence.push_back(g.equivalence.ToString());
     report->seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }

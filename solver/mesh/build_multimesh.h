@@ -1,6 +1,7 @@
 // Stage driver: drawings -> compatible multimesh (correspondence, mesh of shape 1, mapping).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -17,16 +18,31 @@ struct MultimeshOptions {
   double max_edge_relative = 0.0;
   // CGAL Delaunay_mesh_size_criteria_2 shape bound B (0.125 is a minimum angle of ~20.7 deg).
   double shape_bound = 0.125;
+  // Correspondence marks: marks[m][d] is mark m's point in drawing d (one point per drawing).
+  // Each pins a boundary point across drawings; between marks, boundaries are reparameterized
+  // with equal vertex counts (solver/geometry/boundary_correspondence.h). Empty = automatic.
+  std::vector<std::vector<Point>> marks;
+  // Boundary vertices turning by more than this many degrees are kept as mesh vertices.
+  double corner_angle_degrees = 30.0;
 };
 
 struct MultimeshReport {
   int vertices = 0;
   int triangles = 0;
   double seconds = 0.0;
+  // Per drawing: its equivalence class after cuts and openings, e.g. "1 component, 1 hole".
+  std::vector<std::string> equivalence;
+  int boundary_loops = 0;
+  int cohesive_edges = 0;
 };
 
-// Builds one compatible mesh across all drawings (>= 2). Errors: INVALID_ARGUMENT naming the
-// drawing and what is wrong, FAILED_PRECONDITION when a shape cannot be reached, CANCELLED.
+// Builds one compatible mesh across all drawings (>= 2): S-Alg.1 boundaries of each drawing
+// (outlines, cuts, openings), loop matching and compatible reparameterization, CGAL mesh of
+// drawing 1 (holes, several components, cut sides duplicated into cohesive edge pairs), boundary
+// Steiner points mirrored across every cohesive zone, then an injective map of each component
+// into every other drawing. Drawings are named 1-based in messages ("drawing 2"). Errors:
+// INVALID_ARGUMENT naming the drawing and what is wrong (including drawings of different
+// equivalence class), FAILED_PRECONDITION when a shape cannot be reached, CANCELLED.
 absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
                                          const MultimeshOptions& options,
                                          const CancelToken* cancel = nullptr,

@@ -20,6 +20,7 @@
 #include <map>
 
 #include "absl/strings/str_cat.h"
+#include "solver/geometry/polygon.h"
 
 namespace inbetween::solver {
 namespace {
@@ -114,6 +115,117 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
               [](const BoundarySteiner& a, const BoundarySteiner& b) {
                 return a.segment < b.segment || (a.segment == b.segment && a.t < b.t);
               });
+  } catch (const std::exception& e) {
+    return absl::InternalError(absl::StrCat("triangulate: CGAL failed: ", e.what()));
+  }
+  if (out.triangles.empty()) return absl::InternalError("triangulate: no triangle inside");
+  return out;
+}
+
+absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Points>& loops,
+                                                          const TriangulateOptions& options) {
+  if (loops.empty()) return absl::InvalidArgumentError("triangulate: no boundary loop");
+  for (const Points& loop : loops) {
+    if (loop.size() < 2) return absl::InvalidArgumentError("triangulate: a loop has < 2 points");
+  }
+  if (!(options.shape_bound > 0)) {
+    return absl::InvalidArgumentError("triangulate: shape_bound must be > 0");
+  }
+  DomainTriangulation out;
+  try {
+    Cdt cdt;
+    std::map<std::pair<double, double>, VertexHandle> by_point;
+    std::vector<VertexHandle> handles;
+    std::vector<std::vector<VertexHandle>> loop_handles(loops.size());
+    for (size_t l = 0; l < loops.size(); ++l) {
+      for (const Point& p : loops[l]) {
+        auto [it, inserted] = by_point.emplace(std::make_pair(p.x(), p.y()), VertexHandle());
+        if (inserted) {
+          it->second = cdt.insert(CgalPoint(p.x(), p.y()));
+          handles.push_back(it->second);
+        }
+        loop_handles[l].push_back(it->second);
+      }
+    }
+    const size_t distinct = cdt.number_of_vertices();
+    if (distinct != handles.size()) {
+      return absl::InvalidArgumentError("triangulate: loop points are too close to each other");
+    }
+    for (const auto& lh : loop_handles) {
+      for (size_t k = 0; k < lh.size(); ++k) {
+        if (lh[k] != lh[(k + 1) % lh.size()]) cdt.insert_constraint(lh[k], lh[(k + 1) % lh.size()]);
+      }
+    }
+    if (cdt.number_of_vertices() != distinct) {
+      return absl::InvalidArgumentError("triangulate: boundary loops cross each other");
+    }
+    // Refinement of every region enclosed by constraints (CGAL's default domain, which also
+    // fills holes: marking the domain ourselves made the 5.5 mesher loop on concave shapes),
+    // then faces kept by the even-odd rule at their centroid.
+    const double size = options.max_edge > 0 ? options.max_edge : 0.0;
+    CGAL::refine_Delaunay_mesh_2(cdt, Criteria(options.shape_bound, size));
+    auto in_domain = [&](const Point& q) {
+      bool in = false;
+      for (const Points& loop : loops) in ^= PolygonContains(loop, q);
+      return in;
+    };
+    std::map<VertexHandle, int> index;
+    for (VertexHandle h : handles) {
+      index[h] = static_cast<int>(out.vertices.size());
+      out.vertices.emplace_back(h->point().x(), h->point().y());
+    }
+    for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
+      if (index.count(v)) continue;
+      index[v] = static_cast<int>(out.vertices.size());
+      out.vertices.emplace_back(v->point().x(), v->point().y());
+    }
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+      if (!f->is_in_domain()) continue;
+      Triangle t = {index.at(f->vertex(0)), index.at(f->vertex(1)), index.at(f->vertex(2))};
+      if (!in_domain((out.vertices[t[0]] + out.vertices[t[1]] + out.vertices[t[2]]) / 3.0)) {
+        continue;
+      }
+      const Point e1 = out.vertices[t[1]] - out.vertices[t[0]];
+      const Point e2 = out.vertices[t[2]] - out.vertices[t[0]];
+      if (Cross(e1, e2) < 0) std::swap(t[1], t[2]);
+      out.triangles.push_back(t);
+    }
+    // Steiner chains: walk constrained edges from each loop edge's start to its end.
+    out.loop_vertex.resize(loops.size());
+    out.edge_chain.resize(loops.size());
+    for (size_t l = 0; l < loops.size(); ++l) {
+      const auto& lh = loop_handles[l];
+      for (size_t k = 0; k < lh.size(); ++k) {
+        out.loop_vertex[l].push_back(index.at(lh[k]));
+        std::vector<int> chain;
+        const VertexHandle target = lh[(k + 1) % lh.size()];
+        const Point a = loops[l][k], d = loops[l][(k + 1) % lh.size()] - a;
+        const double len2 = d.squaredNorm();
+        VertexHandle current = lh[k];
+        double current_t = 0.0;
+        for (int guard = 0; current != target && guard < 1000000; ++guard) {
+          VertexHandle best;
+          double best_t = 2.0;
+          auto e = cdt.incident_edges(current), done = e;
+          do {
+            if (cdt.is_infinite(*e) || !cdt.is_constrained(*e)) continue;
+            VertexHandle w = e->first->vertex(Cdt::cw(e->second));
+            if (w == current) w = e->first->vertex(Cdt::ccw(e->second));
+            const Point q(w->point().x(), w->point().y());
+            const double t = (q - a).dot(d) / len2;
+            const double off = std::abs(Cross(d, q - a)) / std::sqrt(len2);
+            if (t > current_t && t < best_t && off <= 1e-9 * std::sqrt(len2)) best = w, best_t = t;
+          } while (++e != done);
+          if (best == VertexHandle()) {
+            return absl::InternalError("triangulate: lost a boundary edge during refinement");
+          }
+          if (best != target) chain.push_back(index.at(best));
+          current = best;
+          current_t = best_t;
+        }
+        out.edge_chain[l].push_back(std::move(chain));
+      }
+    }
   } catch (const std::exception& e) {
     return absl::InternalError(absl::StrCat("triangulate: CGAL failed: ", e.what()));
   }

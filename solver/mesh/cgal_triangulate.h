@@ -36,4 +36,21 @@ struct PolygonTriangulation {
 absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
                                                      const TriangulateOptions& options = {});
 
+// A domain bounded by several closed loops (outer loops positive, holes negative, slits and
+// cut sides walked both ways with exactly equal points), triangulated as one CDT: every distinct
+// point once, every loop edge a constraint. Faces are in the domain by the even-odd rule over
+// the loops (slits and cuts, walked twice, do not change it).
+struct DomainTriangulation {
+  Points vertices;                            // distinct loop points first, then Steiner points
+  std::vector<Triangle> triangles;            // in the domain, all positive
+  std::vector<std::vector<int>> loop_vertex;  // [loop][k]: vertex of loop point k
+  // [loop][k]: Steiner vertices on loop edge k (point k -> k+1), in order from point k.
+  std::vector<std::vector<std::vector<int>>> edge_chain;
+};
+
+// Errors: INVALID_ARGUMENT for loops with fewer than 3 points, constraints that cross (the
+// loops are not a valid planar graph), INTERNAL if CGAL fails.
+absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Points>& loops,
+                                                          const TriangulateOptions& options = {});
+
 }  // namespace inbetween::solver

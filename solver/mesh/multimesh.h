@@ -13,6 +13,12 @@ struct Multimesh {
   std::vector<int> boundary;        // boundary vertex indices, in boundary order
   // Cohesive edge pairs {a, b, c, d}: a-b on one side, c-d its collocated twin (later issues).
   std::vector<std::array<int, 4>> cohesive_edges;
+  // Each closed boundary loop (S-Alg.1) as vertex indices in order, interior on the left (outer
+  // loops positive, holes negative in every shape). `boundary` is their concatenation.
+  std::vector<std::vector<int>> boundary_loops;
+  // cohesive_closed[s]: indices into cohesive_edges whose two sides are collocated in shape s
+  // (the cut or opening is closed there). Empty when there are no cohesive edges.
+  std::vector<std::vector<int>> cohesive_closed;
 
   int num_vertices() const { return shapes.empty() ? 0 : static_cast<int>(shapes[0].size()); }
   int num_shapes() const { return static_cast<int>(shapes.size()); }

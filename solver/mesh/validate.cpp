@@ -2,6 +2,8 @@
 #include "solver/mesh/validate.h"
 
 #include <cmath>
+#include <set>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 
@@ -56,6 +58,8 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
           absl::StrCat("multimesh boundary vertex ", v, " out of range [0, ", n, ")"));
     }
   }
+  if (absl::Status s = ValidateBoundaryLoops(mesh); !s.ok()) return s;
+  if (absl::Status s = ValidateCohesiveEdges(mesh); !s.ok()) return s;
   for (int s = 0; s < mesh.num_shapes(); ++s) {
     for (size_t t = 0; t < mesh.triangles.size(); ++t) {
       const double a = SignedArea2(mesh.triangles[t], mesh.shapes[s]);
@@ -63,6 +67,75 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
         return absl::InvalidArgumentError(absl::StrCat("multimesh shape ", s, " triangle ", t,
                                                        a == 0 ? " is degenerate" : " is inverted",
                                                        " (signed area ", 0.5 * a, ")"));
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ValidateBoundaryLoops(const Multimesh& mesh) {
+  if (mesh.boundary_loops.empty()) return absl::OkStatus();
+  const int n = mesh.num_vertices();
+  std::set<std::pair<int, int>> directed;
+  for (const Triangle& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) directed.insert({t[k], t[(k + 1) % 3]});
+  }
+  size_t on_loops = 0;
+  for (size_t l = 0; l < mesh.boundary_loops.size(); ++l) {
+    const std::vector<int>& loop = mesh.boundary_loops[l];
+    on_loops += loop.size();
+    for (size_t k = 0; k < loop.size(); ++k) {
+      const int a = loop[k], b = loop[(k + 1) % loop.size()];
+      if (a < 0 || a >= n) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("multimesh boundary loop ", l, " vertex ", a, " out of range"));
+      }
+      // A boundary edge has the mesh on its left and nothing on its right.
+      if (!directed.count({a, b}) || directed.count({b, a})) {
+        return absl::InvalidArgumentError(absl::StrCat("multimesh boundary loop ", l, ": edge ", a,
+                                                       "-", b, " is not a boundary edge"));
+      }
+    }
+  }
+  size_t boundary_edges = 0;
+  for (const auto& [a, b] : directed) boundary_edges += directed.count({b, a}) ? 0 : 1;
+  if (boundary_edges != on_loops) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "multimesh has ", boundary_edges, " boundary edges but its loops list ", on_loops));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ValidateCohesiveEdges(const Multimesh& mesh, double relative_tolerance) {
+  const int n = mesh.num_vertices();
+  for (size_t c = 0; c < mesh.cohesive_edges.size(); ++c) {
+    for (int v : mesh.cohesive_edges[c]) {
+      if (v < 0 || v >= n) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("multimesh cohesive edge ", c, " vertex ", v, " out of range"));
+      }
+    }
+  }
+  if (mesh.cohesive_closed.empty()) return absl::OkStatus();
+  if (mesh.cohesive_closed.size() != mesh.shapes.size()) {
+    return absl::InvalidArgumentError("multimesh cohesive_closed needs one list per shape");
+  }
+  for (int s = 0; s < mesh.num_shapes(); ++s) {
+    const Points& x = mesh.shapes[s];
+    if (x.empty()) continue;
+    Point lo = x[0], hi = x[0];
+    for (const Point& p : x) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double tolerance = relative_tolerance * (hi - lo).norm();
+    for (int c : mesh.cohesive_closed[s]) {
+      if (c < 0 || c >= static_cast<int>(mesh.cohesive_edges.size())) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("multimesh shape ", s, " lists cohesive edge ", c, " out of range"));
+      }
+      const auto& [a, b, cc, d] = mesh.cohesive_edges[c];
+      if ((x[a] - x[cc]).norm() > tolerance || (x[b] - x[d]).norm() > tolerance) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "multimesh shape ", s, ": cohesive edge ", c, " is closed there but its sides are ",
+            std::max((x[a] - x[cc]).norm(), (x[b] - x[d]).norm()), " apart"));
       }
     }
   }

@@ -1,4 +1,5 @@
-// Validators for meshes and multimeshes, used by tests and by the server before it hands out a mesh.
+// Validators for meshes and multimeshes, used by tests and by the server before it hands out a
+// mesh.
 #pragma once
 
 #include <vector>
@@ -15,8 +16,18 @@ double SignedArea2(const Triangle& t, const Points& x);
 // Number of triangles with signed area <= min_area2 / 2 (inverted or degenerate).
 int CountInverted(const std::vector<Triangle>& triangles, const Points& x, double min_area2 = 0.0);
 
-// Checks shared topology (indices in range, every shape has the same vertex count), no inverted
-// or degenerate triangle in any shape. Errors name the shape and the triangle.
+// Checks shared topology (indices in range, every shape has the same vertex count), boundary
+// loops and cohesive edges (below, when present), no inverted or degenerate triangle in any
+// shape. Errors name the shape and the triangle.
 absl::Status ValidateMultimesh(const Multimesh& mesh);
+
+// Boundary vertices on their boundaries: every consecutive pair of every boundary loop is an
+// edge with a triangle on its left only, and the loops hold every boundary edge of the mesh.
+// OK when boundary_loops is empty.
+absl::Status ValidateBoundaryLoops(const Multimesh& mesh);
+
+// Cohesive pairs in range, and collocated (within relative_tolerance of the shape's bounding-box
+// diagonal) in every shape where cohesive_closed says they are closed.
+absl::Status ValidateCohesiveEdges(const Multimesh& mesh, double relative_tolerance = 1e-9);
 
 }  // namespace inbetween::solver

@@ -227,3 +227,24 @@ TEST(SvgImportTest, ExampleFilesImport) {
 
 }  // namespace
 }  // namespace inbetween::solver
+
+namespace inbetween::solver {
+namespace {
+
+TEST(SvgImportTest, CutAndOpeningClassesBecomePolylines) {
+  absl::StatusOr<Drawing> d = ImportSvg(R"(<svg xmlns="http://www.w3.org/2000/svg">
+    <rect x="0" y="0" width="10" height="10"/>
+    <path class="cut" d="M 5 -1 L 5 11" stroke="red" fill="none"/>
+    <polyline class="mouth opening" points="2,5 5,6 8,5" fill="none"/>
+    <line class="cut" x1="-1" y1="2" x2="11" y2="2"/>
+  </svg>)");
+  ASSERT_TRUE(d.ok()) << d.status();
+  EXPECT_EQ(d->outlines.size(), 1u);
+  ASSERT_EQ(d->cuts.size(), 2u);
+  EXPECT_EQ(d->cuts[0], (Points{{5, -1}, {5, 11}}));
+  ASSERT_EQ(d->openings.size(), 1u);
+  EXPECT_EQ(d->openings[0].size(), 3u);
+}
+
+}  // namespace
+}  // namespace inbetween::solver

@@ -105,19 +105,20 @@ TEST(BuildMultimeshTest, ErrorsNameTheDrawing) {
   Drawing two = square;
   two.outlines.push_back({{{200, 0}, {210, 0}, {210, 10}}});
   absl::Status s = BuildMultimesh({square, square, two}, {}).status();
-  EXPECT_EQ(s.code(), absl::StatusCode::kUnimplemented);
-  EXPECT_THAT(s.message(), HasSubstr("drawing 2 has 2 outlines"));
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("drawing 1: 1 component, 0 holes; drawing 2: 1 component, "
+                                     "0 holes; drawing 3: 2 components, 0 holes"));
 
   const Drawing bow_tie{{Outline{{{0, 0}, {10, 10}, {10, 0}, {0, 10}}}}};
   s = BuildMultimesh({square, bow_tie}, {}).status();
   EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(s.message(), HasSubstr("drawing 1: outline crosses itself at (5, 5)"));
+  EXPECT_THAT(s.message(), HasSubstr("drawing 2: outline crosses itself at (5, 5)"));
 
   Drawing nan = square;
   nan.outlines[0].points[2].x() = std::numeric_limits<double>::quiet_NaN();
   s = BuildMultimesh({square, nan}, {}).status();
   EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(s.message(), HasSubstr("drawing 1, outline 0, point 2 is not finite"));
+  EXPECT_THAT(s.message(), HasSubstr("drawing 2, outline 1, point 3 is not finite"));
 }
 
 TEST(BuildMultimeshTest, Cancelled) {

@@ -1,0 +1,586 @@
+// S-Sec.1 "Boundary Tool" and "Initial Meshing" (compatible reparameterization): loop matching,
+// marks or automatic alignment, common breakpoints (marks, corners and cut/opening ends of every
+// drawing, mirrored across each cohesive zone), equal vertex counts per segment between them.
+#include "solver/geometry/boundary_correspondence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "solver/geometry/polygon.h"
+#include "solver/geometry/resample_outline.h"
+
+namespace inbetween::solver {
+namespace {
+
+constexpr int kDefaultVertices = 64;
+constexpr int kAlignSamples = 128;
+constexpr double kSameT = 1e-9;
+
+double Wrap01(double t) {
+  t -= std::floor(t);
+  return t >= 1.0 ? 0.0 : t;
+}
+
+// A closed polyline with its cumulative arc length.
+struct Curve {
+  Points p;
+  std::vector<double> cum;  // cum[k] = arc length at p[k]; cum[n] = perimeter
+  double length() const { return cum.back(); }
+  Point At(double u) const {
+    const double total = length();
+    u = std::fmod(u, total);
+    if (u < 0) u += total;
+    const size_t n = p.size();
+    size_t i = std::upper_bound(cum.begin(), cum.end(), u) - cum.begin();
+    i = std::clamp<size_t>(i, 1, n) - 1;
+    const double len = cum[i + 1] - cum[i];
+    const double t = len > 0 ? std::clamp((u - cum[i]) / len, 0.0, 1.0) : 0.0;
+    if (t == 0.0) return p[i];
+    if (t == 1.0) return p[(i + 1) % n];
+    return p[i] + t * (p[(i + 1) % n] - p[i]);
+  }
+  double Project(const Point& q, double* distance) const {
+    double best = std::numeric_limits<double>::infinity(), at = 0;
+    for (size_t i = 0; i < p.size(); ++i) {
+      const Point a = p[i], d = p[(i + 1) % p.size()] - a;
+      const double t = std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      const double dist = (a + t * d - q).norm();
+      if (dist < best) best = dist, at = cum[i] + t * (cum[i + 1] - cum[i]);
+    }
+    if (distance) *distance = best;
+    return at;
+  }
+};
+
+Curve MakeCurve(const Points& p) {
+  Curve c;
+  c.p = p;
+  c.cum.assign(p.size() + 1, 0.0);
+  for (size_t i = 0; i < p.size(); ++i)
+    c.cum[i + 1] = c.cum[i] + (p[(i + 1) % p.size()] - p[i]).norm();
+  return c;
+}
+
+// Common parameter t in [0, 1) -> arc length on one drawing's loop: piecewise linear through
+// knots (t_j, a_j), t_0 = 0, closing at (1, a_0 + length).
+struct Param {
+  std::vector<double> t, a;
+  double length = 1;
+  double Forward(double u) const {  // u may be in [0, 1]
+    const size_t m = t.size();
+    size_t j = std::upper_bound(t.begin(), t.end(), u) - t.begin();
+    j = std::max<size_t>(j, 1) - 1;
+    const double t1 = j + 1 < m ? t[j + 1] : 1.0;
+    const double a1 = j + 1 < m ? a[j + 1] : a[0] + length;
+    const double f = t1 > t[j] ? (u - t[j]) / (t1 - t[j]) : 0.0;
+    return a[j] + f * (a1 - a[j]);
+  }
+  double Inverse(double arc) const {
+    arc = a[0] + std::fmod(std::fmod(arc - a[0], length) + length, length);
+    const size_t m = a.size();
+    size_t j = std::upper_bound(a.begin(), a.end(), arc) - a.begin();
+    j = std::max<size_t>(j, 1) - 1;
+    const double t1 = j + 1 < m ? t[j + 1] : 1.0;
+    const double a1 = j + 1 < m ? a[j + 1] : a[0] + length;
+    const double f = a1 > a[j] ? (arc - a[j]) / (a1 - a[j]) : 0.0;
+    return Wrap01(t[j] + f * (t1 - t[j]));
+  }
+};
+
+// One side of a cut/opening run of a drawing: arc lengths [a0, a1] on loop `group`, collocated
+// with [b0, b1] of `twin_group` walked the other way.
+struct Run {
+  int group, twin_group;
+  double a0, a1, b0, b1;
+  // Mirror of arc length x (a0 < x < a1, unwrapped past the loop start if needed).
+  double Mirror(double x) const { return b1 - (x - a0); }
+};
+
+std::vector<Run> SeamRuns(const BoundaryGraph& g, const std::vector<int>& group_of_loop,
+                          const std::vector<Curve>& curves) {
+  std::vector<Run> runs;
+  for (size_t l = 0; l < g.loops.size(); ++l) {
+    const BoundaryLoop& loop = g.loops[l];
+    const int n = static_cast<int>(loop.points.size());
+    auto continues = [&](int k) {  // edge k+1 continues the run of edge k
+      const int k1 = (k + 1) % n;
+      const auto [tl, te] = loop.twin[k];
+      const auto [ul, ue] = loop.twin[k1];
+      if (tl < 0 || ul < 0 || tl != ul) return false;
+      if (tl == static_cast<int>(l) && te == k1) return false;  // a tip
+      const int m = static_cast<int>(g.loops[tl].points.size());
+      return ue == (te + m - 1) % m;
+    };
+    int start = -1;
+    for (int k = 0; k < n && start < 0; ++k) {
+      if (loop.twin[k].first >= 0 && !continues((k + n - 1) % n)) start = k;
+    }
+    if (start < 0) {
+      if (loop.twin[0].first < 0) continue;
+      start = 0;  // the whole loop is one run (a closed cut)
+    }
+    for (int i = 0; i < n;) {
+      const int k = (start + i) % n;
+      if (loop.twin[k].first < 0) {
+        ++i;
+        continue;
+      }
+      int count = 1;
+      while (i + count < n && continues((k + count - 1) % n)) ++count;
+      const int last = (k + count - 1) % n;
+      const auto [tl, te_first] = loop.twin[k];
+      const int te_last = loop.twin[last].second;
+      const Curve& a = curves[l];
+      const Curve& b = curves[tl];
+      Run r;
+      r.group = group_of_loop[l];
+      r.twin_group = group_of_loop[tl];
+      r.a0 = a.cum[k];
+      r.a1 = r.a0;
+      for (int c = 0; c < count; ++c) {
+        const int e = (k + c) % n;
+        r.a1 += a.cum[e + 1] - a.cum[e];
+      }
+      r.b0 = b.cum[te_last];
+      r.b1 = r.b0 + (r.a1 - r.a0);
+      (void)te_first;
+      runs.push_back(r);
+      i += count;
+    }
+  }
+  return runs;
+}
+
+Point Centroid(const Points& p) {
+  const double area = PolygonSignedArea(p);
+  Point lo = p[0], hi = p[0];
+  for (const Point& q : p) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  const size_t n = p.size();
+  if (std::abs(area) > 1e-9 * (hi - lo).squaredNorm()) {
+    Point c = Point::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      const Point& a = p[i];
+      const Point& b = p[(i + 1) % n];
+      c += (a + b) * (a.x() * b.y() - b.x() * a.y());
+    }
+    return c / (6 * area);
+  }
+  Point c = Point::Zero();
+  double total = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double len = (p[(i + 1) % n] - p[i]).norm();
+    c += len * 0.5 * (p[i] + p[(i + 1) % n]);
+    total += len;
+  }
+  return total > 0 ? Point(c / total) : p[0];
+}
+
+// Assignment of `a` items to `b` items (same count) minimising total cost; brute force up to 8,
+// greedy beyond.
+std::vector<int> Assign(const std::vector<std::vector<double>>& cost) {
+  const int k = static_cast<int>(cost.size());
+  std::vector<int> perm(k), best;
+  std::iota(perm.begin(), perm.end(), 0);
+  if (k <= 8) {
+    double best_cost = std::numeric_limits<double>::infinity();
+    do {
+      double c = 0;
+      for (int i = 0; i < k; ++i) c += cost[i][perm[i]];
+      if (c < best_cost) best_cost = c, best = perm;
+    } while (std::next_permutation(perm.begin(), perm.end()));
+    return best;
+  }
+  best.assign(k, -1);
+  std::vector<bool> taken(k, false);
+  for (int i = 0; i < k; ++i) {
+    int pick = -1;
+    for (int j = 0; j < k; ++j) {
+      if (!taken[j] && (pick < 0 || cost[i][j] < cost[i][pick])) pick = j;
+    }
+    best[i] = pick, taken[pick] = true;
+  }
+  return best;
+}
+
+// Best start (arc length) of `b` against `a` (both normalised): turning angle + position.
+double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, const Point& cb,
+                  double sb) {
+  const int m = kAlignSamples;
+  Points pa(m), pb(m);
+  std::vector<double> ta(m), tb(m);
+  for (int k = 0; k < m; ++k) {
+    pa[k] = (a.At(a.length() * k / m) - ca) / sa;
+    pb[k] = (b.At(b.length() * k / m) - cb) / sb;
+  }
+  for (int k = 0; k < m; ++k) {
+    const Point da = a.At(a.length() * (k + 0.5) / m) - a.At(a.length() * (k - 0.5) / m);
+    const Point db = b.At(b.length() * (k + 0.5) / m) - b.At(b.length() * (k - 0.5) / m);
+    ta[k] = std::atan2(da.y(), da.x());
+    tb[k] = std::atan2(db.y(), db.x());
+  }
+  Point mean = Point::Zero();
+  for (const Point& p : pa) mean += p / m;
+  double radius2 = 0;
+  for (const Point& p : pa) radius2 += (p - mean).squaredNorm() / m;
+  radius2 = std::max(radius2, 1e-12);
+  int best = 0;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int s = 0; s < m; ++s) {
+    double sn = 0, cs = 0, position = 0;
+    for (int k = 0; k < m; ++k) {
+      const double d = ta[k] - tb[(k + s) % m];
+      sn += std::sin(d), cs += std::cos(d);
+      position += (pa[k] - pb[(k + s) % m]).squaredNorm();
+    }
+    // sum_k (1 - cos(d_k - rotation)) at the best rotation = m - |sum e^{i d_k}|.
+    const double turning = m - std::hypot(sn, cs);
+    const double cost = turning / m + position / (m * radius2);
+    if (cost < best_cost) best_cost = cost, best = s;
+  }
+  return b.length() * best / m;
+}
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int Find(int x) { return parent[x] == x ? x : parent[x] = Find(parent[x]); }
+  void Unite(int a, int b) { parent[Find(a)] = Find(b); }
+};
+
+}  // namespace
+
+absl::Status CheckSameEquivalence(const std::vector<BoundaryGraph>& graphs) {
+  bool same = true;
+  for (const BoundaryGraph& g : graphs) same = same && g.equivalence == graphs[0].equivalence;
+  if (same) return absl::OkStatus();
+  std::string message;
+  for (size_t d = 0; d < graphs.size(); ++d) {
+    absl::StrAppend(&message, d ? "; " : "", "drawing ", d + 1, ": ",
+                    graphs[d].equivalence.ToString());
+  }
+  absl::StrAppend(&message,
+                  " — the drawings must have the same topology: add an opening (a slit that "
+                  "becomes a hole) where a drawing has fewer holes, or a cut where it has fewer "
+                  "components");
+  return absl::InvalidArgumentError(message);
+}
+
+absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
+    const std::vector<BoundaryGraph>& graphs, const BoundaryCorrespondenceOptions& options) {
+  const int num_shapes = static_cast<int>(graphs.size());
+  if (num_shapes == 0) return absl::InvalidArgumentError("no drawings");
+  if (absl::Status s = CheckSameEquivalence(graphs); !s.ok()) return s;
+
+  // Normalisation and centroids.
+  std::vector<Point> centre(num_shapes);
+  std::vector<double> scale(num_shapes);
+  std::vector<std::vector<Point>> centroid(num_shapes);
+  std::vector<std::vector<Curve>> curves(num_shapes);
+  for (int d = 0; d < num_shapes; ++d) {
+    Point lo = graphs[d].loops[0].points[0], hi = lo;
+    for (const BoundaryLoop& l : graphs[d].loops) {
+      for (const Point& p : l.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    }
+    centre[d] = 0.5 * (lo + hi);
+    scale[d] = std::max((hi - lo).norm(), 1e-300);
+    for (const BoundaryLoop& l : graphs[d].loops) {
+      centroid[d].push_back((Centroid(l.points) - centre[d]) / scale[d]);
+      curves[d].push_back(MakeCurve(l.points));
+    }
+  }
+
+  // Loop groups: drawing 1's components in order, each followed by its holes.
+  std::vector<std::vector<int>> group_loops;  // [g][d]
+  auto loops_of = [&](int d, int component, bool outer) {
+    std::vector<int> out;
+    for (size_t l = 0; l < graphs[d].loops.size(); ++l) {
+      const BoundaryLoop& loop = graphs[d].loops[l];
+      if (loop.outer == outer && (outer || loop.component == component)) {
+        out.push_back(static_cast<int>(l));
+      }
+    }
+    return out;
+  };
+  const std::vector<int> outer0 = loops_of(0, 0, true);
+  std::vector<std::vector<int>> component_match(num_shapes);  // [d][c0] -> outer loop in d
+  for (int d = 0; d < num_shapes; ++d) {
+    const std::vector<int> outer = loops_of(d, 0, true);
+    std::vector<std::vector<double>> cost(outer0.size(), std::vector<double>(outer.size()));
+    for (size_t i = 0; i < outer0.size(); ++i) {
+      const int h0 =
+          static_cast<int>(loops_of(0, graphs[0].loops[outer0[i]].component, false).size());
+      for (size_t j = 0; j < outer.size(); ++j) {
+        const int hd =
+            static_cast<int>(loops_of(d, graphs[d].loops[outer[j]].component, false).size());
+        cost[i][j] =
+            (centroid[0][outer0[i]] - centroid[d][outer[j]]).squaredNorm() + (h0 != hd ? 1e6 : 0.0);
+      }
+    }
+    const std::vector<int> assignment = Assign(cost);
+    for (size_t i = 0; i < outer0.size(); ++i) component_match[d].push_back(outer[assignment[i]]);
+  }
+  BoundaryCorrespondence out;
+  for (size_t i = 0; i < outer0.size(); ++i) {
+    std::vector<int> g(num_shapes);
+    for (int d = 0; d < num_shapes; ++d) g[d] = component_match[d][i];
+    group_loops.push_back(g);
+    out.loop_outer.push_back(true);
+    out.loop_component.push_back(static_cast<int>(i));
+    std::vector<std::vector<int>> holes(num_shapes);
+    for (int d = 0; d < num_shapes; ++d) {
+      holes[d] = loops_of(d, graphs[d].loops[g[d]].component, false);
+      if (holes[d].size() != holes[0].size()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("drawing ", d + 1, ": the component matched to drawing 1's component ",
+                         i + 1, " has ", holes[d].size(), " holes instead of ", holes[0].size()));
+      }
+    }
+    std::vector<std::vector<int>> hole_match(num_shapes);
+    for (int d = 0; d < num_shapes; ++d) {
+      std::vector<std::vector<double>> cost(holes[0].size(), std::vector<double>(holes[d].size()));
+      for (size_t a = 0; a < holes[0].size(); ++a) {
+        for (size_t b = 0; b < holes[d].size(); ++b) {
+          cost[a][b] = (centroid[0][holes[0][a]] - centroid[d][holes[d][b]]).squaredNorm();
+        }
+      }
+      const std::vector<int> assignment = Assign(cost);
+      for (size_t a = 0; a < holes[0].size(); ++a) hole_match[d].push_back(holes[d][assignment[a]]);
+    }
+    for (size_t a = 0; a < holes[0].size(); ++a) {
+      std::vector<int> hg(num_shapes);
+      for (int d = 0; d < num_shapes; ++d) hg[d] = hole_match[d][a];
+      group_loops.push_back(hg);
+      out.loop_outer.push_back(false);
+      out.loop_component.push_back(static_cast<int>(i));
+    }
+  }
+  const int num_groups = static_cast<int>(group_loops.size());
+  std::vector<std::vector<int>> group_of_loop(num_shapes);
+  for (int d = 0; d < num_shapes; ++d) {
+    group_of_loop[d].assign(graphs[d].loops.size(), -1);
+    for (int g = 0; g < num_groups; ++g) group_of_loop[d][group_loops[g][d]] = g;
+  }
+  auto curve = [&](int d, int g) -> const Curve& { return curves[d][group_loops[g][d]]; };
+
+  // Parameterizations: marks, else automatic alignment.
+  std::vector<std::vector<Param>> param(num_shapes, std::vector<Param>(num_groups));
+  std::vector<std::vector<std::pair<double, std::vector<double>>>> marks_on(num_groups);
+  for (size_t m = 0; m < options.marks.size(); ++m) {
+    if (static_cast<int>(options.marks[m].size()) != num_shapes) {
+      return absl::InvalidArgumentError(absl::StrCat("mark ", m + 1, " has ",
+                                                     options.marks[m].size(), " points for ",
+                                                     num_shapes, " drawings"));
+    }
+    int group = -1;
+    double best = std::numeric_limits<double>::infinity(), at0 = 0;
+    for (int g = 0; g < num_groups; ++g) {
+      double dist;
+      const double a = curve(0, g).Project(options.marks[m][0], &dist);
+      if (dist < best) best = dist, group = g, at0 = a;
+    }
+    std::vector<double> at(num_shapes, at0);
+    for (int d = 1; d < num_shapes; ++d)
+      at[d] = curve(d, group).Project(options.marks[m][d], nullptr);
+    marks_on[group].push_back({at0, at});
+  }
+  for (int g = 0; g < num_groups; ++g) {
+    auto& marks = marks_on[g];
+    std::sort(marks.begin(), marks.end());
+    for (int d = 0; d < num_shapes; ++d) {
+      Param& p = param[d][g];
+      p.length = curve(d, g).length();
+      if (marks.empty()) {
+        p.t = {0.0};
+        p.a = {d == 0 ? 0.0
+                      : AlignStart(curve(0, g), curve(d, g), centre[0], scale[0], centre[d],
+                                   scale[d])};
+        continue;
+      }
+      const double len0 = curve(0, g).length();
+      const double base0 = marks[0].first, based = marks[0].second[d];
+      for (size_t j = 0; j < marks.size(); ++j) {
+        double a = marks[j].second[d] - based;
+        a = std::fmod(a + p.length, p.length);
+        if (j > 0 && !(a > p.a.back() - based)) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("drawing ", d + 1,
+                           ": correspondence marks on one boundary are not in the same "
+                           "order as in drawing 1 (or two marks coincide)"));
+        }
+        p.t.push_back((marks[j].first - base0) / len0);
+        p.a.push_back(based + a);
+      }
+    }
+  }
+
+  // Seam runs per drawing.
+  std::vector<std::vector<Run>> runs(num_shapes);
+  for (int d = 0; d < num_shapes; ++d) runs[d] = SeamRuns(graphs[d], group_of_loop[d], curves[d]);
+
+  // Breakpoints (common parameter) per group.
+  std::vector<std::vector<double>> breaks(num_groups);
+  auto add_break = [&](int g, double t) {
+    t = Wrap01(t);
+    std::vector<double>& b = breaks[g];
+    auto it = std::lower_bound(b.begin(), b.end(), t);
+    const bool near_next = it != b.end() && *it - t < kSameT;
+    const bool near_prev = it != b.begin() && t - *(it - 1) < kSameT;
+    const bool near_wrap = !b.empty() && (t + 1 - b.back() < kSameT || b.front() + 1 - t < kSameT);
+    if (near_next || near_prev || near_wrap) return false;
+    b.insert(it, t);
+    return true;
+  };
+  for (int g = 0; g < num_groups; ++g) {
+    breaks[g].push_back(0.0);
+    for (int d = 0; d < num_shapes; ++d) {
+      for (double t : param[d][g].t) add_break(g, t);
+      const Curve& c = curve(d, g);
+      for (int k : FindCorners(c.p, options.corner_angle_degrees)) {
+        add_break(g, param[d][g].Inverse(c.cum[k]));
+      }
+    }
+  }
+  for (int d = 0; d < num_shapes; ++d) {
+    for (const Run& r : runs[d]) {
+      add_break(r.group, param[d][r.group].Inverse(r.a0));
+      add_break(r.group, param[d][r.group].Inverse(r.a1));
+    }
+  }
+  // Where the two sides of a run must agree: mirror every breakpoint inside a run.
+  auto inside_run = [&](const Run& r, const Param& p, double t, double* arc) {
+    double a = p.Forward(t);
+    while (a < r.a0) a += p.length;
+    while (a >= r.a0 + p.length) a -= p.length;
+    *arc = a;
+    const double eps = 1e-9 * p.length;
+    return a > r.a0 + eps && a < r.a1 - eps;
+  };
+  for (int round = 0; round < 16; ++round) {
+    bool added = false;
+    for (int d = 0; d < num_shapes; ++d) {
+      for (const Run& r : runs[d]) {
+        const std::vector<double> current = breaks[r.group];
+        for (double t : current) {
+          double a;
+          if (!inside_run(r, param[d][r.group], t, &a)) continue;
+          added |= add_break(r.twin_group, param[d][r.twin_group].Inverse(r.Mirror(a)));
+        }
+      }
+    }
+    if (!added) break;
+  }
+
+  // Intervals, their twins and vertex counts.
+  std::vector<int> interval_start(num_groups + 1, 0);
+  for (int g = 0; g < num_groups; ++g) {
+    interval_start[g + 1] = interval_start[g] + static_cast<int>(breaks[g].size());
+  }
+  const int num_intervals = interval_start.back();
+  auto interval_end_t = [&](int g, int i) {
+    return i + 1 < static_cast<int>(breaks[g].size()) ? breaks[g][i + 1] : breaks[g][0] + 1.0;
+  };
+  auto interval_of = [&](int g, double t) {
+    t = Wrap01(t);
+    const std::vector<double>& b = breaks[g];
+    int i = static_cast<int>(std::upper_bound(b.begin(), b.end(), t) - b.begin()) - 1;
+    return i < 0 ? static_cast<int>(b.size()) - 1 : i;
+  };
+  // twin_interval[d][global interval] = global twin interval in drawing d or -1.
+  std::vector<std::vector<int>> twin_interval(num_shapes, std::vector<int>(num_intervals, -1));
+  UnionFind classes(num_intervals);
+  for (int d = 0; d < num_shapes; ++d) {
+    for (const Run& r : runs[d]) {
+      for (int i = 0; i < static_cast<int>(breaks[r.group].size()); ++i) {
+        const double mid = 0.5 * (breaks[r.group][i] + interval_end_t(r.group, i));
+        double a;
+        if (!inside_run(r, param[d][r.group], mid, &a)) continue;
+        const int j = interval_of(r.twin_group, param[d][r.twin_group].Inverse(r.Mirror(a)));
+        const int gi = interval_start[r.group] + i, gj = interval_start[r.twin_group] + j;
+        twin_interval[d][gi] = gj;
+        twin_interval[d][gj] = gi;
+        classes.Unite(gi, gj);
+      }
+    }
+  }
+  int total_corners = 0;
+  for (int g = 0; g < num_groups; ++g) total_corners += static_cast<int>(breaks[g].size());
+  const int budget =
+      options.vertices > 0 ? options.vertices : std::max(kDefaultVertices, 2 * total_corners);
+  std::vector<double> spacing(num_shapes);
+  for (int d = 0; d < num_shapes; ++d) {
+    double perimeter = 0;
+    for (int g = 0; g < num_groups; ++g) perimeter += curve(d, g).length();
+    spacing[d] = perimeter / budget;
+  }
+  std::vector<int> count(num_intervals, 1);
+  for (int g = 0; g < num_groups; ++g) {
+    const int m = static_cast<int>(breaks[g].size());
+    const int minimum = m == 1 ? 4 : m <= 3 ? 2 : 1;
+    for (int i = 0; i < m; ++i) {
+      int c = minimum;
+      for (int d = 0; d < num_shapes; ++d) {
+        const double len =
+            param[d][g].Forward(interval_end_t(g, i)) - param[d][g].Forward(breaks[g][i]);
+        c = std::max(c, static_cast<int>(std::lround(len / spacing[d])));
+      }
+      count[interval_start[g] + i] = c;
+    }
+  }
+  std::vector<int> class_count(num_intervals, 0);
+  for (int i = 0; i < num_intervals; ++i) {
+    class_count[classes.Find(i)] = std::max(class_count[classes.Find(i)], count[i]);
+  }
+  for (int i = 0; i < num_intervals; ++i) count[i] = class_count[classes.Find(i)];
+
+  // Vertex numbering and sampling.
+  std::vector<int> first_vertex(num_intervals + 1, 0);
+  for (int i = 0; i < num_intervals; ++i) first_vertex[i + 1] = first_vertex[i] + count[i];
+  out.loop_start.resize(num_groups + 1);
+  for (int g = 0; g <= num_groups; ++g) out.loop_start[g] = first_vertex[interval_start[g]];
+  const int num_vertices = first_vertex.back();
+  out.shapes.assign(num_shapes, std::vector<Points>(num_groups));
+  out.edge_twin.assign(num_shapes, std::vector<int>(num_vertices, -1));
+  for (int d = 0; d < num_shapes; ++d) {
+    Points flat(num_vertices);
+    for (int g = 0; g < num_groups; ++g) {
+      for (int i = 0; i < static_cast<int>(breaks[g].size()); ++i) {
+        const int gi = interval_start[g] + i;
+        const double a0 = param[d][g].Forward(breaks[g][i]);
+        const double a1 = param[d][g].Forward(interval_end_t(g, i));
+        for (int k = 0; k < count[gi]; ++k) {
+          flat[first_vertex[gi] + k] = curve(d, g).At(a0 + (a1 - a0) * k / count[gi]);
+        }
+      }
+    }
+    // Collocate the two sides of each cut/opening of drawing d exactly, and pair their edges.
+    auto next_in_loop = [&](int gi) {  // the interval after gi in its loop
+      int g = static_cast<int>(std::upper_bound(interval_start.begin(), interval_start.end(), gi) -
+                               interval_start.begin()) -
+              1;
+      return gi + 1 < interval_start[g + 1] ? gi + 1 : interval_start[g];
+    };
+    for (int gi = 0; gi < num_intervals; ++gi) {
+      const int gj = twin_interval[d][gi];
+      if (gj < 0) continue;
+      const int n = count[gi];
+      for (int k = 0; k < n; ++k) {
+        out.edge_twin[d][first_vertex[gi] + k] = first_vertex[gj] + (n - 1 - k);
+      }
+      if (gi > gj) continue;  // copy positions from the lower interval
+      for (int k = 1; k < n; ++k) flat[first_vertex[gj] + (n - k)] = flat[first_vertex[gi] + k];
+      flat[first_vertex[next_in_loop(gj)]] = flat[first_vertex[gi]];
+      flat[first_vertex[gj]] = flat[first_vertex[next_in_loop(gi)]];
+    }
+    for (int g = 0; g < num_groups; ++g) {
+      out.shapes[d][g].assign(flat.begin() + out.loop_start[g],
+                              flat.begin() + out.loop_start[g + 1]);
+    }
+  }
+  return out;
+}
+
+}  // namespace inbetween::solver

@@ -1,0 +1,53 @@
+// S-Sec.1 "Boundary Tool": boundaries of all drawings matched loop to loop (components, then
+// their holes), pinned by user marks or aligned automatically, and compatibly reparameterized so
+// that every boundary segment between breakpoints has the same vertex count in every drawing.
+#pragma once
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "solver/core/types.h"
+#include "solver/geometry/graph_flow.h"
+
+namespace inbetween::solver {
+
+struct BoundaryCorrespondenceOptions {
+  // Boundary vertices per drawing (all loops); 0 = automatic (64, more with many corners).
+  int vertices = 0;
+  // Vertices turning by more than this (degrees) are corners: kept as vertices.
+  double corner_angle_degrees = 30.0;
+  // marks[m][d]: where correspondence mark m sits in drawing d (one point per drawing). Each mark
+  // pins the nearest boundary point of drawing 1 to the nearest point of the matching loop in
+  // every other drawing; marks on a loop must keep their cyclic order in every drawing.
+  std::vector<std::vector<Point>> marks;
+};
+
+// Loops are matched as follows (documented default): each drawing is normalised by its
+// bounding box (centre, diagonal); components are matched to drawing 1's by the assignment of
+// least total squared distance between normalised area centroids (components with a different
+// hole count never match); holes within matched components likewise. Without marks, each loop
+// gets the cyclic shift that best matches drawing 1's loop in normalised turning angle and
+// position over arc length (orientation is fixed: the drawing is on the left of every loop).
+struct BoundaryCorrespondence {
+  // Loop g's vertices are the global indices loop_start[g] .. loop_start[g + 1] - 1; edge e joins
+  // vertex e to the next vertex of its loop.
+  std::vector<int> loop_start;
+  std::vector<bool> loop_outer;
+  std::vector<int> loop_component;          // component index (drawing 1's numbering)
+  std::vector<std::vector<Points>> shapes;  // shapes[d][g]: loop g in drawing d
+  // edge_twin[d][e]: the edge collocated with e and walked the other way in drawing d (the two
+  // sides of a cut or opening of drawing d), or -1.
+  std::vector<std::vector<int>> edge_twin;
+  int num_loops() const { return static_cast<int>(loop_start.size()) - 1; }
+  int num_vertices() const { return loop_start.back(); }
+};
+
+// All graphs must have the same equivalence class (else INVALID_ARGUMENT naming each drawing's
+// class). Marks that cannot be used give INVALID_ARGUMENT naming the mark and the drawing.
+absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
+    const std::vector<BoundaryGraph>& graphs, const BoundaryCorrespondenceOptions& options = {});
+
+// "drawing 1: 1 component, 0 holes; drawing 2: 1 component, 1 hole" and a hint, or OK.
+absl::Status CheckSameEquivalence(const std::vector<BoundaryGraph>& graphs);
+
+}  // namespace inbetween::solver
