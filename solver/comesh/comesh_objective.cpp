@@ -1,18 +1,20 @@
 // Comesh objective: (1 - w) * normalized ODT (S-eq.1) + w * normalized cyclic MIPS (S-eq.2).
 #include "solver/comesh/comesh_objective.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 
 #include "absl/strings/str_cat.h"
 #include "solver/comesh/mips_energy.h"
 #include "solver/comesh/odt_energy.h"
+#include "solver/comesh/parallel_chunks.h"
 
 namespace inbetween::solver {
 
 absl::StatusOr<ComeshObjective> ComeshObjective::Create(const std::vector<Triangle>& triangles,
                                                         const std::vector<Points>& rest,
-                                                        double map_weight) {
+                                                        double map_weight, int threads) {
   if (rest.empty()) return absl::InvalidArgumentError("comesh objective needs at least one shape");
   if (!(map_weight >= 0.0 && map_weight <= 1.0)) {
     return absl::InvalidArgumentError(
@@ -54,48 +56,116 @@ absl::StatusOr<ComeshObjective> ComeshObjective::Create(const std::vector<Triang
     o.areas_.push_back(area);
     o.odt_normalizer_.push_back(OdtNormalization(triangles, rest[s]));
   }
+  o.threads_ = ResolveThreads(threads);
+  o.corner_begin_.assign(n + 1, 0);
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) ++o.corner_begin_[t[k] + 1];
+  }
+  for (int v = 0; v < n; ++v) o.corner_begin_[v + 1] += o.corner_begin_[v];
+  o.corners_.resize(3 * triangles.size());
+  std::vector<int> fill(o.corner_begin_.begin(), o.corner_begin_.end() - 1);
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) o.corners_[fill[triangles[t][k]]++] = static_cast<int>(3 * t + k);
+  }
   return o;
+}
+
+void ComeshObjective::TriangleTerms(const Triangle& t, const std::vector<Points>& shapes,
+                                    double* odt, double* mips) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const int n = num_shapes();
+  *odt = 0.0;
+  *mips = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const Points& xi = shapes[i];
+    const double d = OdtTriangleEnergy(xi[t[0]], xi[t[1]], xi[t[2]]);
+    const Points& xj = shapes[(i + 1) % n];
+    const double c =
+        MipsTriangleEnergy({xi[t[0]], xi[t[1]], xi[t[2]]}, {xj[t[0]], xj[t[1]], xj[t[2]]});
+    if (!std::isfinite(d) || !std::isfinite(c)) {
+      *odt = *mips = kInf;
+      return;
+    }
+    *odt += d / odt_normalizer_[i];
+    *mips += c / areas_[i];
+  }
+}
+
+double ComeshObjective::TriangleTerm(const Triangle& t, const std::vector<Points>& shapes) const {
+  double odt, mips;
+  TriangleTerms(t, shapes, &odt, &mips);
+  return (1.0 - map_weight_) * odt + map_weight_ * mips;
 }
 
 double ComeshObjective::Evaluate(const std::vector<Points>& shapes, std::vector<Points>* gradient,
                                  ComeshEnergies* energies) const {
   constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr int kChunk = 2048;  // triangles per chunk (fixed: results independent of threads)
   const int n = num_shapes();
+  const int num_triangles = static_cast<int>(triangles_.size());
   const double w = map_weight_;
-  if (gradient != nullptr) {
-    gradient->assign(n, Points(num_vertices_, Point::Zero()));
-  }
-  Points gi, gj;
-  double mesh_sum = 0.0;
-  double map_sum = 0.0;
-  for (int i = 0; i < n; ++i) {
-    // Mesh term of shape i.
-    if (gradient != nullptr) gi.assign(num_vertices_, Point::Zero());
-    const double d = OdtEnergy(triangles_, shapes[i], gradient ? &gi : nullptr);
-    if (!std::isfinite(d)) return kInf;
-    mesh_sum += d / odt_normalizer_[i];
-    if (gradient != nullptr && w < 1.0) {
-      const double scale = (1.0 - w) / odt_normalizer_[i];
-      for (int v = 0; v < num_vertices_; ++v) (*gradient)[i][v] += scale * gi[v];
-    }
-    // Map term from shape i to shape j = i + 1 (mod n).
-    const int j = (i + 1) % n;
-    if (gradient != nullptr) {
-      gi.assign(num_vertices_, Point::Zero());
-      gj.assign(num_vertices_, Point::Zero());
-    }
-    Points* gj_ptr = (j == i) ? &gi : &gj;  // one shape: both derivatives land on X_i
-    const double c = MipsEnergy(triangles_, shapes[i], shapes[j], gradient ? &gi : nullptr,
-                                gradient ? gj_ptr : nullptr);
-    if (!std::isfinite(c)) return kInf;
-    map_sum += c / areas_[i];
-    if (gradient != nullptr && w > 0.0) {
-      const double scale = w / areas_[i];
-      for (int v = 0; v < num_vertices_; ++v) (*gradient)[i][v] += scale * gi[v];
-      if (j != i) {
-        for (int v = 0; v < num_vertices_; ++v) (*gradient)[j][v] += scale * gj[v];
+  const bool want_gradient = gradient != nullptr;
+  if (want_gradient) corner_gradient_.resize(static_cast<size_t>(3) * num_triangles * n);
+  const int chunks = NumChunks(num_triangles, kChunk);
+  // Per chunk: sum of D_t / N_i and of C_t / A_i over its triangles and shapes; NaN if invalid.
+  std::vector<double> mesh_part(chunks, 0.0), map_part(chunks, 0.0);
+  ParallelChunks(num_triangles, kChunk, threads_, [&](int chunk, int begin, int end) {
+    double mesh_sum = 0.0, map_sum = 0.0;
+    std::array<Point, 3> g_odt, g_i, g_j;
+    for (int t = begin; t < end; ++t) {
+      const Triangle& tri = triangles_[t];
+      Point* cg = want_gradient ? &corner_gradient_[static_cast<size_t>(3) * t * n] : nullptr;
+      if (want_gradient) {
+        for (int k = 0; k < 3 * n; ++k) cg[k].setZero();
+      }
+      for (int i = 0; i < n; ++i) {
+        const Points& xi = shapes[i];
+        const int j = (i + 1) % n;
+        const Points& xj = shapes[j];
+        const std::array<Point, 3> ci = {xi[tri[0]], xi[tri[1]], xi[tri[2]]};
+        const std::array<Point, 3> cj = {xj[tri[0]], xj[tri[1]], xj[tri[2]]};
+        const double d = OdtTriangleEnergy(ci[0], ci[1], ci[2], want_gradient ? &g_odt : nullptr);
+        const double c = MipsTriangleEnergy(ci, cj, want_gradient ? &g_i : nullptr,
+                                            want_gradient ? &g_j : nullptr);
+        if (!std::isfinite(d) || !std::isfinite(c)) {
+          mesh_part[chunk] = map_part[chunk] = kInf;
+          return;
+        }
+        mesh_sum += d / odt_normalizer_[i];
+        map_sum += c / areas_[i];
+        if (want_gradient) {
+          const double sd = (1.0 - w) / odt_normalizer_[i];
+          const double sc = w / areas_[i];
+          for (int k = 0; k < 3; ++k) {
+            cg[k * n + i] += sd * g_odt[k] + sc * g_i[k];
+            cg[k * n + j] += sc * g_j[k];
+          }
+        }
       }
     }
+    mesh_part[chunk] = mesh_sum;
+    map_part[chunk] = map_sum;
+  });
+  double mesh_sum = 0.0, map_sum = 0.0;
+  for (int c = 0; c < chunks; ++c) {
+    mesh_sum += mesh_part[c];
+    map_sum += map_part[c];
+  }
+  if (!std::isfinite(mesh_sum) || !std::isfinite(map_sum)) return kInf;
+  if (want_gradient) {
+    gradient->resize(n);
+    for (Points& g : *gradient) g.resize(num_vertices_);
+    ParallelChunks(num_vertices_, 4096, threads_, [&](int, int begin, int end) {
+      for (int v = begin; v < end; ++v) {
+        for (int i = 0; i < n; ++i) {
+          Point sum = Point::Zero();
+          for (int c = corner_begin_[v]; c < corner_begin_[v + 1]; ++c) {
+            sum += corner_gradient_[static_cast<size_t>(corners_[c]) * n + i];
+          }
+          (*gradient)[i][v] = sum;
+        }
+      }
+    });
   }
   const double objective = (1.0 - w) * mesh_sum + w * map_sum;
   if (energies != nullptr) {

@@ -7,6 +7,15 @@
 // geometry so that E is a plain sum of per-triangle terms; with a fixed boundary they equal the
 // current values anyway. The cyclic sum suffices by the transitivity of MIPS (S §6).
 //
+// The ODT normalizer N_i = A_i^2 / (sqrt(3) T) depends on the triangle count T of the topology
+// the objective is created for; the outer topology loop recreates the objective after it changes
+// the topology, so E stays comparable across vertex counts (it is a mean quality, not a sum).
+//
+// Evaluation is a fused pass over triangles (ODT of every shape and the cyclic MIPS terms of one
+// triangle at once) in fixed-size chunks that may run on several threads; corner gradients go to
+// a per-corner buffer and are summed per vertex in triangle order, and chunk sums are reduced in
+// chunk order, so results are bit-identical for any thread count.
+//
 // Reported numbers (the paper's columns):
 //   mesh energy = (1/n) sum_i D_hat(X_i)   (1 = tiling by equal equilateral triangles)
 //   map energy  = (1/n) sum_i C_hat(X_i, X_{i+1})  = mean over the cycle of the area-weighted
@@ -32,17 +41,28 @@ class ComeshObjective {
   // of range or repeated, on w outside [0, 1], or on a shape of zero area.
   static absl::StatusOr<ComeshObjective> Create(const std::vector<Triangle>& triangles,
                                                 const std::vector<Points>& rest,
-                                                double map_weight = 0.5);
+                                                double map_weight = 0.5, int threads = 1);
 
   // E(shapes); +inf if any triangle is inverted or degenerate in any shape. If `gradient` is
   // given it is overwritten with dE/dX (same layout as `shapes`; not meaningful when E = +inf).
+  // Uses internal scratch buffers: do not call concurrently on one object.
   double Evaluate(const std::vector<Points>& shapes, std::vector<Points>* gradient = nullptr,
                   ComeshEnergies* energies = nullptr) const;
+
+  // The contribution of one triangle (any vertex triple, e.g. a candidate after a flip) to E
+  // with this objective's normalizers: (1 - w) sum_i D_t(X_i) / N_i + w sum_i C_t(X_i, X_i+1) /
+  // A_i. +inf if the triangle is not positive in some shape.
+  double TriangleTerm(const Triangle& t, const std::vector<Points>& shapes) const;
+  // The same split into its ODT part sum_i D_t(X_i) / N_i and MIPS part sum_i C_t / A_i.
+  void TriangleTerms(const Triangle& t, const std::vector<Points>& shapes, double* odt,
+                     double* mips) const;
 
   int num_shapes() const { return static_cast<int>(areas_.size()); }
   int num_vertices() const { return num_vertices_; }
   double map_weight() const { return map_weight_; }
   double rest_area(int shape) const { return areas_[shape]; }
+  double odt_normalizer(int shape) const { return odt_normalizer_[shape]; }
+  int threads() const { return threads_; }
   const std::vector<Triangle>& triangles() const { return triangles_; }
 
  private:
@@ -53,6 +73,11 @@ class ComeshObjective {
   double map_weight_ = 0.5;
   std::vector<double> areas_;           // A_i
   std::vector<double> odt_normalizer_;  // N_i
+  int threads_ = 1;
+  // Vertex -> corners (3 t + k) in increasing order, CSR.
+  std::vector<int> corner_begin_;
+  std::vector<int> corners_;
+  mutable std::vector<Point> corner_gradient_;  // [(3 t + k) * num_shapes + shape]
 };
 
 }  // namespace inbetween::solver

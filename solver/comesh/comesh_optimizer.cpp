@@ -1,9 +1,9 @@
-// Comesh optimization inner loop: L-BFGS with a Laplacian initial Hessian and an
-// inversion-free line search over all shapes at once (see comesh_optimizer.h).
+// Comesh optimization: inner loop (L-BFGS with a scalar CHOLMOD Laplacian initial Hessian,
+// blending, curing and an inversion-free line search over all shapes at once) alternating with
+// the outer topology loop (comesh_topology.h). See comesh_optimizer.h.
 #include "solver/comesh/comesh_optimizer.h"
 
 #include <Eigen/Core>
-#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <chrono>
@@ -12,11 +12,15 @@
 #include <limits>
 #include <memory>
 #include <set>
+#include <string>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "solver/comesh/comesh_objective.h"
+#include "solver/comesh/comesh_topology.h"
+#include "solver/comesh/parallel_chunks.h"
+#include "solver/core/sparse_cholesky.h"
 
 namespace inbetween::solver {
 namespace {
@@ -75,6 +79,7 @@ class Layout {
  public:
   Layout(const Multimesh& mesh, bool slide_boundary) {
     const int n = mesh.num_vertices();
+    num_vertices_ = n;
     num_shapes_ = mesh.num_shapes();
     std::vector<char> used(n, 0), pinned(n, 0);
     std::set<std::pair<int, int>> once;
@@ -135,6 +140,7 @@ class Layout {
 
   int size() const { return size_; }
   int num_shapes() const { return num_shapes_; }
+  int num_vertices() const { return num_vertices_; }
   const std::vector<Var>& vars() const { return vars_; }
   int index(int shape, int v) const { return index_[shape][v]; }
 
@@ -179,205 +185,288 @@ class Layout {
 
  private:
   int num_shapes_ = 0;
+  int num_vertices_ = 0;
   int size_ = 0;
   std::vector<Var> vars_;
   std::vector<std::vector<int>> index_;  // [shape][vertex] -> var or -1
 };
 
-// Largest step t such that every triangle of every shape keeps positive area on (0, t).
+// Largest step t such that every triangle of every shape keeps positive area on (0, t). A min
+// over triangles, so the chunked parallel evaluation gives the same value for any thread count.
 double MaxNonInvertingStep(const std::vector<Triangle>& triangles,
                            const std::vector<Points>& shapes, const Layout& layout,
-                           const VectorXd& d) {
-  double best = std::numeric_limits<double>::infinity();
+                           const VectorXd& d, int threads) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr int kChunk = 4096;
   auto cross = [](const Point& u, const Point& v) { return u.x() * v.y() - u.y() * v.x(); };
-  for (int s = 0; s < static_cast<int>(shapes.size()); ++s) {
-    for (const Triangle& t : triangles) {
-      Point p[3], q[3];
-      bool moves = false;
-      for (int k = 0; k < 3; ++k) {
-        p[k] = shapes[s][t[k]];
-        moves |= layout.index(s, t[k]) >= 0;
-        q[k] = layout.Displacement(d, s, t[k]);
-      }
-      if (!moves) continue;
-      const Point e1 = p[1] - p[0], e2 = p[2] - p[0];
-      const Point f1 = q[1] - q[0], f2 = q[2] - q[0];
-      // 2 area(t) = c0 + c1 t + c2 t^2, c0 > 0.
-      const double c0 = cross(e1, e2);
-      const double c1 = cross(e1, f2) + cross(f1, e2);
-      const double c2 = cross(f1, f2);
-      double root = std::numeric_limits<double>::infinity();
-      if (std::abs(c2) <= 1e-14 * (std::abs(c1) + std::abs(c0))) {
-        if (c1 < 0.0) root = -c0 / c1;
-      } else {
-        const double disc = c1 * c1 - 4.0 * c2 * c0;
-        if (disc >= 0.0) {
-          const double sq = std::sqrt(disc);
-          const double qq = -0.5 * (c1 + (c1 >= 0.0 ? sq : -sq));
-          const double r1 = qq / c2;
-          const double r2 = (qq != 0.0) ? c0 / qq : std::numeric_limits<double>::infinity();
-          if (r1 > 0.0) root = std::min(root, r1);
-          if (r2 > 0.0) root = std::min(root, r2);
+  const int num_triangles = static_cast<int>(triangles.size());
+  std::vector<double> part(NumChunks(num_triangles, kChunk), kInf);
+  ParallelChunks(num_triangles, kChunk, threads, [&](int chunk, int begin, int end) {
+    double best = kInf;
+    for (int s = 0; s < static_cast<int>(shapes.size()); ++s) {
+      for (int ti = begin; ti < end; ++ti) {
+        const Triangle& t = triangles[ti];
+        Point p[3], q[3];
+        bool moves = false;
+        for (int k = 0; k < 3; ++k) {
+          p[k] = shapes[s][t[k]];
+          moves |= layout.index(s, t[k]) >= 0;
+          q[k] = layout.Displacement(d, s, t[k]);
         }
+        if (!moves) continue;
+        const Point e1 = p[1] - p[0], e2 = p[2] - p[0];
+        const Point f1 = q[1] - q[0], f2 = q[2] - q[0];
+        // 2 area(t) = c0 + c1 t + c2 t^2, c0 > 0.
+        const double c0 = cross(e1, e2);
+        const double c1 = cross(e1, f2) + cross(f1, e2);
+        const double c2 = cross(f1, f2);
+        double root = kInf;
+        if (std::abs(c2) <= 1e-14 * (std::abs(c1) + std::abs(c0))) {
+          if (c1 < 0.0) root = -c0 / c1;
+        } else {
+          const double disc = c1 * c1 - 4.0 * c2 * c0;
+          if (disc >= 0.0) {
+            const double sq = std::sqrt(disc);
+            const double qq = -0.5 * (c1 + (c1 >= 0.0 ? sq : -sq));
+            const double r1 = qq / c2;
+            const double r2 = (qq != 0.0) ? c0 / qq : kInf;
+            if (r1 > 0.0) root = std::min(root, r1);
+            if (r2 > 0.0) root = std::min(root, r2);
+          }
+        }
+        best = std::min(best, root);
       }
-      best = std::min(best, root);
     }
-  }
+    part[chunk] = best;
+  });
+  double best = kInf;
+  for (double b : part) best = std::min(best, b);
   return best;
 }
 
-// B0 = blockdiag_s(K_s / A_s) (or identity) and H0 = B0^{-1}, before the scalar beta.
-// K_s = J_s^T (L kron I_2) J_s: L the uniform graph Laplacian of the shared topology, J_s the
-// linear map from shape s's unknowns to its vertex positions (identity for a 2D unknown, the
-// slide direction for a slider, zero for fixed vertices, which thus act as Dirichlet values).
-// Without sliders K_s is L restricted to the free vertices, once for x and once for y.
+// Initial inverse Hessian H0 (before the scalar 1 / beta) after BCQN: the uniform graph
+// Laplacian L of the shared topology, restricted to the vertices that are movable in EVERY shape
+// (interior vertices and vertices that slide in every shape; all others act as Dirichlet values),
+// factored ONCE as a scalar matrix with CHOLMOD and applied to x and y of every shape in one
+// multi-column solve. Shape s's block is H0_s = A_s J_s^T L^{-1} J_s, J_s lifting a slider's
+// scalar to 2D along its direction (projection onto the slider tangent after the solve), so H0 is
+// SPD on the reduced unknowns without ever coupling x and y in the factor. Unknowns of vertices
+// that are movable in some shapes only get the Jacobi value A_s / deg(v) (deg = L's diagonal).
+// The forward operator B0 (for the curvature scaling and blending) is the matching
+// J_s^T L J_s / A_s product, and deg(v) / A_s on the Jacobi unknowns.
 class InitialHessian {
  public:
-  using Solver = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>;
-
   static absl::StatusOr<InitialHessian> Create(const std::vector<Triangle>& triangles,
                                                const Layout& layout, std::vector<double> areas,
                                                bool use_laplacian) {
     InitialHessian h;
     h.areas_ = std::move(areas);
     h.use_laplacian_ = use_laplacian;
+    h.layout_ = &layout;
     if (!use_laplacian) return h;
+    const int n = layout.num_vertices();
     const int num_shapes = layout.num_shapes();
-    h.blocks_.resize(num_shapes);
-    // Unknowns are stored shape after shape: find each shape's contiguous range of z.
-    for (Block& b : h.blocks_) b.begin = b.end = -1;
-    for (const Layout::Var& var : layout.vars()) {
-      Block& b = h.blocks_[var.shape];
-      if (b.begin < 0) b.begin = var.offset;
-      b.end = var.offset + (var.slider ? 1 : 2);
+    h.compact_.assign(n, -1);
+    for (int v = 0; v < n; ++v) {
+      bool everywhere = true;
+      for (int s = 0; s < num_shapes && everywhere; ++s) everywhere = layout.index(s, v) >= 0;
+      if (everywhere) h.compact_[v] = h.size_++;
     }
-    for (int s = 0; s < num_shapes; ++s) {
-      Block& block = h.blocks_[s];
-      if (block.begin < 0) continue;
-      const int m = block.end - block.begin;
-      // (local row, direction) pairs of the unknowns of vertex v: J's nonzero columns.
-      auto columns = [&](int v, std::pair<int, Point> out[2]) -> int {
-        const int i = layout.index(s, v);
-        if (i < 0) return 0;
-        const Layout::Var& var = layout.vars()[i];
-        const int r = var.offset - block.begin;
-        if (var.slider) {
-          out[0] = {r, var.direction};
-          return 1;
-        }
-        out[0] = {r, Point(1, 0)};
-        out[1] = {r + 1, Point(0, 1)};
-        return 2;
-      };
-      std::vector<Eigen::Triplet<double>> trip;
-      std::vector<double> diag(m, 0.0);
-      std::pair<int, Point> ca[2], cb[2];
-      for (const Triangle& t : triangles) {
-        for (int k = 0; k < 3; ++k) {
-          // Each interior edge is seen from two triangles: weight 1/2 each.
-          constexpr double w = 0.5;
-          const int na = columns(t[k], ca), nb = columns(t[(k + 1) % 3], cb);
-          for (int i = 0; i < na; ++i) {
-            for (int j = 0; j < na; ++j)
-              trip.emplace_back(ca[i].first, ca[j].first, w * ca[i].second.dot(ca[j].second));
-          }
-          for (int i = 0; i < nb; ++i) {
-            for (int j = 0; j < nb; ++j)
-              trip.emplace_back(cb[i].first, cb[j].first, w * cb[i].second.dot(cb[j].second));
-          }
-          for (int i = 0; i < na; ++i) {
-            for (int j = 0; j < nb; ++j) {
-              const double value = -w * ca[i].second.dot(cb[j].second);
-              trip.emplace_back(ca[i].first, cb[j].first, value);
-              trip.emplace_back(cb[j].first, ca[i].first, value);
-            }
-          }
+    h.degree_.assign(n, 0.0);
+    std::vector<Eigen::Triplet<double>> trip;
+    for (const Triangle& t : triangles) {
+      for (int k = 0; k < 3; ++k) {
+        constexpr double w = 0.5;  // each interior edge is seen from two triangles
+        const int a = t[k], b = t[(k + 1) % 3];
+        h.degree_[a] += w;
+        h.degree_[b] += w;
+        const int ca = h.compact_[a], cb = h.compact_[b];
+        if (ca >= 0) trip.emplace_back(ca, ca, w);
+        if (cb >= 0) trip.emplace_back(cb, cb, w);
+        if (ca >= 0 && cb >= 0) {
+          trip.emplace_back(ca, cb, -w);
+          trip.emplace_back(cb, ca, -w);
         }
       }
-      block.matrix.resize(m, m);
-      block.matrix.setFromTriplets(trip.begin(), trip.end());
-      // A free component touching no fixed vertex would make K singular: regularize slightly.
-      for (int k = 0; k < m; ++k) block.matrix.coeffRef(k, k) *= 1.0 + 1e-8;
-      block.solver = std::make_unique<Solver>(block.matrix);
-      if (block.solver->info() != Eigen::Success) {
-        return absl::InternalError("factorizing the comesh Laplacian preconditioner failed");
-      }
+    }
+    if (h.size_ == 0) return h;
+    h.matrix_.resize(h.size_, h.size_);
+    h.matrix_.setFromTriplets(trip.begin(), trip.end());
+    // A component touching no Dirichlet vertex would make L singular: regularize slightly.
+    for (int k = 0; k < h.size_; ++k) h.matrix_.coeffRef(k, k) *= 1.0 + 1e-8;
+    h.matrix_.makeCompressed();
+    h.solver_ = std::make_unique<SparseCholesky>();
+    if (absl::Status st = h.solver_->Compute(h.matrix_); !st.ok()) {
+      return absl::InternalError(
+          absl::StrCat("factorizing the comesh Laplacian preconditioner: ", st.message()));
     }
     return h;
   }
 
-  VectorXd ApplyInverse(const VectorXd& g) const { return Apply(g, /*inverse=*/true); }  // H0 g
-  VectorXd Apply(const VectorXd& x) const { return Apply(x, /*inverse=*/false); }        // B0 x
-
- private:
-  struct Block {
-    int begin = -1, end = -1;  // this shape's range of z
-    Eigen::SparseMatrix<double> matrix;
-    std::unique_ptr<Solver> solver;  // by pointer: Eigen's factorizations are not movable
-  };
-
-  VectorXd Apply(const VectorXd& x, bool inverse) const {
-    if (!use_laplacian_) return x;
-    VectorXd out(x.size());
-    for (size_t s = 0; s < blocks_.size(); ++s) {
-      const Block& b = blocks_[s];
-      if (b.begin < 0) continue;
-      const int m = b.end - b.begin;
-      if (inverse) {
-        out.segment(b.begin, m) = areas_[s] * b.solver->solve(x.segment(b.begin, m));
+  // H0 g (without 1 / beta).
+  VectorXd ApplyInverse(const VectorXd& g) const {
+    if (!use_laplacian_) return g;
+    const Layout& layout = *layout_;
+    const int num_shapes = layout.num_shapes();
+    VectorXd out(g.size());
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(size_, 2 * num_shapes);
+    for (const Layout::Var& var : layout.vars()) {
+      const int c = compact_[var.vertex];
+      const double a = areas_[var.shape];
+      if (c < 0) {
+        const double jacobi = a / std::max(degree_[var.vertex], 1e-300);
+        if (var.slider) {
+          out[var.offset] = jacobi * g[var.offset];
+        } else {
+          out.segment<2>(var.offset) = jacobi * g.segment<2>(var.offset);
+        }
+        continue;
+      }
+      const Point lifted =
+          var.slider ? Point(g[var.offset] * var.direction) : Point(g.segment<2>(var.offset));
+      rhs(c, 2 * var.shape) = lifted.x();
+      rhs(c, 2 * var.shape + 1) = lifted.y();
+    }
+    if (size_ > 0) {
+      absl::StatusOr<Eigen::MatrixXd> sol = solver_->Solve(rhs);
+      if (sol.ok()) rhs = *std::move(sol);  // cannot fail after a successful factorization
+    }
+    for (const Layout::Var& var : layout.vars()) {
+      const int c = compact_[var.vertex];
+      if (c < 0) continue;
+      const Point p(rhs(c, 2 * var.shape), rhs(c, 2 * var.shape + 1));
+      const double a = areas_[var.shape];
+      if (var.slider) {
+        out[var.offset] = a * p.dot(var.direction);
       } else {
-        out.segment(b.begin, m) = b.matrix * x.segment(b.begin, m) / areas_[s];
+        out.segment<2>(var.offset) = a * p;
       }
     }
     return out;
   }
 
+  // B0 x.
+  VectorXd Apply(const VectorXd& x) const {
+    if (!use_laplacian_) return x;
+    const Layout& layout = *layout_;
+    const int num_shapes = layout.num_shapes();
+    Eigen::MatrixXd lifted = Eigen::MatrixXd::Zero(size_, 2 * num_shapes);
+    VectorXd out(x.size());
+    for (const Layout::Var& var : layout.vars()) {
+      const int c = compact_[var.vertex];
+      if (c < 0) {
+        const double d = degree_[var.vertex] / areas_[var.shape];
+        if (var.slider) {
+          out[var.offset] = d * x[var.offset];
+        } else {
+          out.segment<2>(var.offset) = d * x.segment<2>(var.offset);
+        }
+        continue;
+      }
+      const Point p =
+          var.slider ? Point(x[var.offset] * var.direction) : Point(x.segment<2>(var.offset));
+      lifted(c, 2 * var.shape) = p.x();
+      lifted(c, 2 * var.shape + 1) = p.y();
+    }
+    const Eigen::MatrixXd product = matrix_ * lifted;
+    for (const Layout::Var& var : layout.vars()) {
+      const int c = compact_[var.vertex];
+      if (c < 0) continue;
+      const Point p =
+          Point(product(c, 2 * var.shape), product(c, 2 * var.shape + 1)) / areas_[var.shape];
+      if (var.slider) {
+        out[var.offset] = p.dot(var.direction);
+      } else {
+        out.segment<2>(var.offset) = p;
+      }
+    }
+    return out;
+  }
+
+ private:
   std::vector<double> areas_;
   bool use_laplacian_ = true;
-  std::vector<Block> blocks_;
+  const Layout* layout_ = nullptr;
+  int size_ = 0;
+  std::vector<int> compact_;    // vertex -> row of L, or -1
+  std::vector<double> degree_;  // L's diagonal over all vertices (Jacobi fallback)
+  Eigen::SparseMatrix<double> matrix_;
+  std::unique_ptr<SparseCholesky> solver_;  // by pointer: keeps InitialHessian movable
 };
 
-}  // namespace
-
-absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOptions& options,
-                                         const CancelToken* cancel, const ProgressFn& progress,
-                                         ComeshReport* report) {
-  const auto start = std::chrono::steady_clock::now();
-  if (absl::Status st = ValidateInput(mesh); !st.ok()) return st;
-  if (options.max_iterations < 0 || options.history < 0 || !(options.max_step_fraction > 0.0) ||
-      !(options.max_step_fraction < 1.0)) {
-    return absl::InvalidArgumentError(
-        "comesh options: max_iterations and history must be >= 0, max_step_fraction in (0, 1)");
+// BCQN-style curing of a search direction: for every triangle of every shape, the linearised
+// doubled area along d is c0 + c1 t. If the unit step would shrink it below cure_keep * c0, the
+// displacements of its moving corners are scaled by (1 - cure_keep) c0 / (-c1) (the factor that
+// keeps the linearised area at cure_keep * c0 if all corners are scaled alike; a vertex takes the
+// smallest factor of its triangles). A few blocking triangles then no longer shrink the step of
+// the whole mesh. Returns the number of scaled unknowns.
+int CureDirection(const std::vector<Triangle>& triangles, const std::vector<Points>& shapes,
+                  const Layout& layout, double cure_keep, VectorXd* d) {
+  auto cross = [](const Point& u, const Point& v) { return u.x() * v.y() - u.y() * v.x(); };
+  std::vector<double> factor(layout.vars().size(), 1.0);
+  for (int s = 0; s < layout.num_shapes(); ++s) {
+    for (const Triangle& t : triangles) {
+      Point p[3], q[3];
+      for (int k = 0; k < 3; ++k) {
+        p[k] = shapes[s][t[k]];
+        q[k] = layout.Displacement(*d, s, t[k]);
+      }
+      const Point e1 = p[1] - p[0], e2 = p[2] - p[0];
+      const Point f1 = q[1] - q[0], f2 = q[2] - q[0];
+      const double c0 = cross(e1, e2);
+      const double c1 = cross(e1, f2) + cross(f1, e2);
+      if (!(c0 + c1 < cure_keep * c0)) continue;
+      const double c = (1.0 - cure_keep) * c0 / (-c1);
+      for (int k = 0; k < 3; ++k) {
+        const int i = layout.index(s, t[k]);
+        if (i >= 0) factor[i] = std::min(factor[i], c);
+      }
+    }
   }
-  absl::StatusOr<ComeshObjective> objective =
-      ComeshObjective::Create(mesh.triangles, mesh.shapes, options.map_weight);
-  if (!objective.ok()) return objective.status();
+  int cured = 0;
+  for (size_t i = 0; i < factor.size(); ++i) {
+    if (factor[i] >= 1.0) continue;
+    const Layout::Var& var = layout.vars()[i];
+    const int m = var.slider ? 1 : 2;
+    d->segment(var.offset, m) *= factor[i];
+    cured += m;
+  }
+  return cured;
+}
 
-  ComeshReport rep;
-  rep.vertices_before = rep.vertices_after = mesh.num_vertices();
-  const Layout layout(mesh, options.slide_boundary);
-  std::vector<Points> shapes = mesh.shapes;
+// Accumulated over inner runs (one per outer iteration).
+struct InnerStats {
+  int iterations = 0;
+  int evaluations = 0;
+  std::string stop_reason;
+  ComeshEnergies energies;
+  double objective = 0.0;
+};
+
+// The inner loop on a fixed topology: optimizes mesh->shapes in place. `iteration_base` numbers
+// iterations globally for callbacks.
+absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int threads,
+                       const CancelToken* cancel, const ProgressFn& progress, int iteration_base,
+                       InnerStats* stats) {
+  absl::StatusOr<ComeshObjective> objective =
+      ComeshObjective::Create(mesh->triangles, mesh->shapes, options.map_weight, threads);
+  if (!objective.ok()) return objective.status();
+  const Layout layout(*mesh, options.slide_boundary);
+  std::vector<Points>& shapes = mesh->shapes;
   std::vector<Points> grad_shapes;
   ComeshEnergies energies;
   double f = objective->Evaluate(shapes, &grad_shapes, &energies);
-  rep.energy_evaluations = 1;
-  rep.map_energy_before = rep.map_energy = energies.map;
-  rep.mesh_energy_before = rep.mesh_energy = energies.mesh;
-  rep.objective_before = rep.objective_after = f;
-  auto finish = [&](std::string reason) -> absl::StatusOr<Multimesh> {
-    rep.stop_reason = std::move(reason);
-    rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (report != nullptr) *report = rep;
-    Multimesh out = mesh;
-    out.shapes = shapes;
-    return out;
-  };
-  if (layout.size() == 0) return finish("no_free");
-
+  ++stats->evaluations;
+  stats->energies = energies;
+  stats->objective = f;
+  if (layout.size() == 0) {
+    stats->stop_reason = "no_free";
+    return absl::OkStatus();
+  }
   std::vector<double> areas;
-  for (int s = 0; s < mesh.num_shapes(); ++s) areas.push_back(objective->rest_area(s));
+  for (int s = 0; s < mesh->num_shapes(); ++s) areas.push_back(objective->rest_area(s));
   absl::StatusOr<InitialHessian> h0 = InitialHessian::Create(
-      mesh.triangles, layout, std::move(areas), options.laplacian_preconditioner);
+      mesh->triangles, layout, std::move(areas), options.laplacian_preconditioner);
   if (!h0.ok()) return h0.status();
 
   VectorXd z = layout.Gather(shapes);
@@ -389,7 +478,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   };
   std::deque<Pair> pairs;
   double beta = 1.0;
-  int small_decreases = 0;
+  std::vector<double> history = {f};  // objective per iteration, for the stopping window
   std::vector<Points> trial = shapes;
   std::vector<Points> trial_grad;
   ComeshEnergies trial_energies;
@@ -397,13 +486,18 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   for (int iter = 0;; ++iter) {
     if (cancel != nullptr && cancel->IsCancelled()) {
       return absl::CancelledError(
-          absl::StrCat("comesh optimization cancelled at iteration ", iter));
+          absl::StrCat("comesh optimization cancelled at iteration ", iteration_base + iter));
     }
-    if (g.norm() <= options.gradient_tolerance * g0) return finish("gradient");
-    if (iter >= options.max_iterations) return finish("max_iterations");
+    if (g.norm() <= options.gradient_tolerance * g0) {
+      stats->stop_reason = "gradient";
+      return absl::OkStatus();
+    }
+    if (iter >= options.max_iterations) {
+      stats->stop_reason = "max_iterations";
+      return absl::OkStatus();
+    }
 
     // L-BFGS two-loop recursion with H0 = B0^{-1} / beta.
-    VectorXd d;
     auto direction = [&]() {
       VectorXd q = g;
       std::vector<double> alpha(pairs.size());
@@ -418,7 +512,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       }
       return VectorXd(-r);
     };
-    d = direction();
+    VectorXd d = direction();
     double slope = g.dot(d);
     if (!(slope < 0.0)) {  // lost descent (non-convexity): restart from the preconditioned gradient
       pairs.clear();
@@ -429,9 +523,20 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
         slope = -g.squaredNorm();
       }
     }
+    if (options.cure) {
+      VectorXd cured = d;
+      if (CureDirection(mesh->triangles, shapes, layout, options.cure_keep, &cured) > 0) {
+        const double cured_slope = g.dot(cured);
+        if (cured_slope < 0.0) {
+          d = std::move(cured);
+          slope = cured_slope;
+        }
+      }
+    }
 
     // Inversion-free backtracking line search.
-    const double max_step = MaxNonInvertingStep(mesh.triangles, shapes, layout, d);
+    const double max_step =
+        MaxNonInvertingStep(mesh->triangles, shapes, layout, d, objective->threads());
     double step = std::min(1.0, options.max_step_fraction * max_step);
     bool accepted = false;
     double f_new = f;
@@ -440,43 +545,152 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       z_new = z + step * d;
       layout.Scatter(z_new, &trial);
       f_new = objective->Evaluate(trial, &trial_grad, &trial_energies);
-      ++rep.energy_evaluations;
+      ++stats->evaluations;
       if (std::isfinite(f_new) && f_new <= f + options.armijo * step * slope) {
         accepted = true;
         break;
       }
     }
-    if (!accepted) return finish("line_search");
+    if (!accepted) {
+      stats->stop_reason = "line_search";
+      return absl::OkStatus();
+    }
 
     const VectorXd g_new = layout.GatherGradient(trial_grad);
     Pair p{z_new - z, g_new - g, 0.0};
     const double sy = p.s.dot(p.y);
     if (sy > 1e-12 * p.s.norm() * p.y.norm() && options.history > 0) {
+      const VectorXd b0s = h0->Apply(p.s);
+      if (options.scaling_by_inverse) {
+        beta = p.y.dot(h0->ApplyInverse(p.y)) / sy;
+      } else {
+        beta = sy / p.s.dot(b0s);
+      }
+      if (options.blend > 0.0) {
+        // Blend the measured gradient difference with the (scaled) Laplacian prediction; both
+        // have curvature s^T y along s, so the pair stays positive. The weight decays with the
+        // relative gradient norm: Laplacian (Sobolev) far from the minimum, L-BFGS near it.
+        const double theta = std::min(1.0, options.blend * g_new.norm() / g0);
+        p.y = (1.0 - theta) * p.y + theta * beta * b0s;
+      }
       p.rho = 1.0 / sy;
-      beta = sy / p.s.dot(h0->Apply(p.s));
       pairs.push_back(std::move(p));
       if (static_cast<int>(pairs.size()) > options.history) pairs.pop_front();
     }
-    const double decrease = (f - f_new) / std::max(std::abs(f_new), 1e-300);
-    small_decreases = decrease < options.relative_decrease_tolerance ? small_decreases + 1 : 0;
+    history.push_back(f_new);
+    const int window = std::max(1, options.decrease_window);
+    // A step capped by the inversion bound is "blocked": slow progress there is not convergence.
+    const bool blocked = options.max_step_fraction * max_step < 1.0;
+    const bool stalled =
+        !blocked && static_cast<int>(history.size()) > window &&
+        history[history.size() - 1 - window] - f_new <=
+            options.relative_decrease_tolerance * std::max(std::abs(f_new), 1e-300);
     z = z_new;
     g = g_new;
     f = f_new;
     std::swap(shapes, trial);
-    rep.inner = iter + 1;
-    rep.objective_after = f;
-    rep.map_energy = trial_energies.map;
-    rep.mesh_energy = trial_energies.mesh;
-    if (options.on_iterate) options.on_iterate(rep.inner, shapes);
+    ++stats->iterations;
+    stats->objective = f;
+    stats->energies = trial_energies;
+    const int global_iteration = iteration_base + iter + 1;
+    if (options.on_iterate) options.on_iterate(global_iteration, shapes);
     if (progress) {
       progress("comesh",
-               options.max_iterations > 0 ? static_cast<double>(rep.inner) / options.max_iterations
-                                          : 1.0,
-               absl::StrFormat("iteration %d: objective %.6g, map %.5f, mesh %.5f, step %.3g",
-                               rep.inner, f, rep.map_energy, rep.mesh_energy, step));
+               options.max_iterations > 0
+                   ? std::min(1.0, static_cast<double>(iter + 1) / options.max_iterations)
+                   : 1.0,
+               absl::StrFormat("iteration %d: objective %.6g, map %.5f, mesh %.5f, vertices %d, "
+                               "step %.3g of %.3g",
+                               global_iteration, f, trial_energies.map, trial_energies.mesh,
+                               mesh->num_vertices(), step, max_step));
     }
-    if (small_decreases >= std::max(1, options.decrease_patience)) return finish("decrease");
+    if (stalled) {
+      stats->stop_reason = "decrease";
+      return absl::OkStatus();
+    }
   }
+}
+
+}  // namespace
+
+absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOptions& options,
+                                         const CancelToken* cancel, const ProgressFn& progress,
+                                         ComeshReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  if (absl::Status st = ValidateInput(mesh); !st.ok()) return st;
+  if (options.max_iterations < 0 || options.history < 0 || !(options.max_step_fraction > 0.0) ||
+      !(options.max_step_fraction < 1.0) || options.max_outer < 0 ||
+      !(options.cure_keep >= 0.0 && options.cure_keep < 1.0) || !(options.blend >= 0.0)) {
+    return absl::InvalidArgumentError(
+        "comesh options: max_iterations, history and max_outer must be >= 0, max_step_fraction "
+        "in (0, 1), cure_keep in [0, 1), blend >= 0");
+  }
+  const int threads = ResolveThreads(options.threads);
+  absl::StatusOr<ComeshObjective> objective =
+      ComeshObjective::Create(mesh.triangles, mesh.shapes, options.map_weight, threads);
+  if (!objective.ok()) return objective.status();
+
+  ComeshReport rep;
+  rep.vertices_before = rep.vertices_after = mesh.num_vertices();
+  ComeshEnergies energies;
+  rep.objective_before = objective->Evaluate(mesh.shapes, nullptr, &energies);
+  rep.map_energy_before = energies.map;
+  rep.mesh_energy_before = energies.mesh;
+
+  Multimesh current = mesh;
+  InnerStats stats;
+  auto inner = [&](int max_iterations) {
+    ComeshOptions run = options;
+    run.max_iterations = max_iterations;
+    absl::Status st = InnerLoop(&current, run, threads, cancel, progress, stats.iterations, &stats);
+    if (st.ok()) rep.objective_trace.push_back(stats.objective);
+    return st;
+  };
+  // Topology passes, each after a short inner run (positions only need to be roughly relaxed for
+  // the operations' decisions), then one inner run to convergence on the final topology.
+  double pass_start_objective = rep.objective_before;
+  for (int outer = 0; outer < options.max_outer; ++outer) {
+    if (absl::Status st = inner(std::min(options.max_iterations, options.outer_inner_iterations));
+        !st.ok()) {
+      return st;
+    }
+    if (outer > 0 && pass_start_objective - stats.objective <=
+                         options.outer_tolerance * std::abs(stats.objective)) {
+      break;
+    }
+    pass_start_objective = stats.objective;
+    if (cancel != nullptr && cancel->IsCancelled()) {
+      return absl::CancelledError(absl::StrCat("comesh optimization cancelled at outer ", outer));
+    }
+    TopologyReport topo;
+    absl::StatusOr<Multimesh> improved =
+        ImproveTopology(current, options.map_weight, options.topology, &topo);
+    if (!improved.ok()) return improved.status();
+    if (topo.flips + topo.collapses + topo.splits == 0) break;
+    rep.flips += topo.flips;
+    rep.collapses += topo.collapses;
+    rep.splits += topo.splits;
+    ++rep.outer;
+    current = *std::move(improved);
+    rep.objective_trace.push_back(topo.objective_after);
+    if (progress) {
+      progress(
+          "comesh", 1.0,
+          absl::StrFormat("outer %d: %d flips, %d collapses, %d splits, vertices %d", rep.outer,
+                          topo.flips, topo.collapses, topo.splits, current.num_vertices()));
+    }
+  }
+  if (absl::Status st = inner(options.max_iterations); !st.ok()) return st;
+  rep.inner = stats.iterations;
+  rep.energy_evaluations = stats.evaluations + 1;
+  rep.stop_reason = stats.stop_reason;
+  rep.objective_after = stats.objective;
+  rep.map_energy = stats.energies.map;
+  rep.mesh_energy = stats.energies.mesh;
+  rep.vertices_after = current.num_vertices();
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (report != nullptr) *report = rep;
+  return current;
 }
 
 }  // namespace inbetween::solver

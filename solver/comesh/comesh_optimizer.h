@@ -1,36 +1,46 @@
-// Comesh optimization, inner loop (DESIGN "Comesh optimization", S-eq.1/2): minimise the comesh
-// objective (comesh_objective.h) over every shape's interior vertices at once with L-BFGS.
+// Comesh optimization (DESIGN "Comesh optimization", S-eq.1/2, S-Tables 1-4): minimise the comesh
+// objective (comesh_objective.h) over every shape's vertices at once, alternating an inner
+// quasi-Newton loop on a fixed topology with an outer loop of topology operations applied
+// identically to every shape (comesh_topology.h).
 //
-// - Initial inverse Hessian (after Blended Cured Quasi-Newton, Zhu, Bridson & Kaufman 2018): per
-//   shape i, H0_i = A_i L^{-1} / beta, L the uniform graph Laplacian of the shared topology
-//   restricted to free vertices (SPD; factored once and applied to x and y of every shape), A_i
-//   the rest area of shape i (the objective is area-normalized, so its Hessian scales as L / A_i;
-//   a sliding boundary unknown gets its Laplacian diagonal),
-//   beta = s^T y / s^T B0 s refreshed from the newest curvature pair.
-// - Line search: for each triangle of each shape the largest step before its signed area reaches
-//   0 is the smallest positive root of a quadratic in the step; the search starts at
-//   min(1, max_step_fraction * that bound) and backtracks (Armijo). Every accepted iterate has
-//   strictly positive area in every triangle of every shape.
-// - Stops when (first that holds): ||g|| <= gradient_tolerance * ||g_0||; the relative decrease
-//   (f_prev - f) / |f| stays below relative_decrease_tolerance for decrease_patience consecutive
-//   iterations; max_iterations is reached; or the line search finds no decrease (at a minimum up
-//   to round-off). Deterministic (single thread, fixed order).
+// Inner loop: Blended Cured Quasi-Newton (after Zhu, Bridson & Kaufman 2018), i.e. L-BFGS with
+// - initial inverse Hessian H0_s = A_s J_s^T L^{-1} J_s / beta: L the uniform graph Laplacian of
+//   the shared topology restricted to the vertices movable in every shape, factored ONCE as a
+//   scalar matrix (CHOLMOD, solver/core/sparse_cholesky.h) and applied to x and y of all shapes
+//   in one multi-column solve; J_s lifts a sliding boundary unknown to 2D along its line (so the
+//   solved 2D direction is projected onto the slider tangent). Vertices movable only in some
+//   shapes get the Jacobi value A_s / deg. beta = s^T y / s^T B0 s from the newest pair.
+// - blending: y <- (1 - theta) y + theta beta B0 s with theta = min(1, blend ||g|| / ||g_0||):
+//   the Sobolev (Laplacian) model dominates far from the minimum, measured curvature near it.
+// - curing: per triangle and shape, corners whose unit step would shrink the linearised area
+//   below cure_keep of its current value are scaled down (CureDirection), so a few blocking
+//   triangles do not shrink the step of the whole mesh; kept only if still a descent direction.
+// - line search: the largest step t_max before any triangle of any shape reaches zero area
+//   (smallest positive root of a quadratic per triangle); start at min(1, max_step_fraction *
+//   t_max) and backtrack (Armijo). Every accepted iterate is strictly positive everywhere.
+// - stops when (first that holds): ||g|| <= gradient_tolerance ||g_0||; the relative decrease
+//   over the last decrease_window iterations is below relative_decrease_tolerance; max_iterations
+//   (per inner run) is reached; or the line search finds no decrease.
 //
-// Unknowns, per shape: interior vertices move in 2D. With slide_boundary, a boundary vertex
-// (on an edge used by one triangle) that lies strictly inside the straight segment between its two
-// boundary neighbours in that shape slides along that line (one unknown); its neighbours cannot
-// be passed, since the triangle on the boundary edge would have to degenerate first. So the
-// domain of every shape is preserved exactly. Fixed: boundary corners, every vertex of a cohesive
-// edge, vertices listed in Multimesh::boundary that are not on the topological boundary, and
-// vertices used by no triangle.
+// Outer loop: a short inner run (outer_inner_iterations) then one topology pass (flips,
+// collapses, splits; each accepted only if valid in every shape and the objective does not
+// increase), repeated until a pass changes nothing, max_outer passes were made, or a pass plus
+// its short run lowered the objective by less than outer_tolerance (relative); then one inner run
+// to convergence on the final topology. The objective is a mean quality (the ODT normalizer uses
+// the current triangle count), so it is comparable across passes and never increases.
 //
-// TODO(issue 5): sliding across polyline corners / along curved outlines (re-projection onto the
-//   input outline) and pinned correspondence marks once the multimesh carries them.
-// TODO(issue 5): outer topology loop applied to all shapes at once - edge flips, collapses of
-//   short edges, splits - each accepted only if valid in every shape and the objective drops
-//   (ComeshReport::outer counts its passes; 0 until then, vertices_after == vertices_before).
-// TODO(issue 5): BCQN's gradient blending and per-triangle direction curing; CHOLMOD backend
-//   (solver/core/sparse_cholesky.h) for the Laplacian; threading of the energy sum.
+// Unknowns, per shape: interior vertices move in 2D. With slide_boundary, a boundary vertex that
+// lies strictly inside the straight segment between its two boundary neighbours in that shape
+// slides along that line (one unknown), so the domain of every shape is preserved exactly.
+// Fixed: boundary corners, every vertex of a cohesive edge, vertices listed in
+// Multimesh::boundary that are not on the topological boundary, and unused vertices.
+//
+// Threads: the objective, gradient and step bound are computed over fixed-size chunks of
+// triangles, reduced in a fixed order, so the result is bit-identical for ANY thread count
+// (options.threads only changes speed). threads <= 0 uses std::thread::hardware_concurrency().
+//
+// TODO(issue 5): sliding across polyline corners / along curved outlines and pinned
+//   correspondence marks once the multimesh carries them; boundary edge splits.
 #pragma once
 
 #include <functional>
@@ -38,6 +48,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "solver/comesh/comesh_topology.h"
 #include "solver/core/cancel.h"
 #include "solver/core/types.h"
 #include "solver/mesh/multimesh.h"
@@ -45,27 +56,40 @@
 namespace inbetween::solver {
 
 struct ComeshOptions {
-  double map_weight = 0.5;  // w of the objective (S-Table 1 default)
-  int max_iterations = 1000;
-  double gradient_tolerance = 1e-6;           // relative to the initial gradient norm
-  double relative_decrease_tolerance = 1e-9;  // per iteration, (f_prev - f) / |f|
-  int decrease_patience = 3;                  // consecutive small decreases before stopping
-  int history = 8;                            // L-BFGS curvature pairs kept
-  bool laplacian_preconditioner = true;       // false: H0 = identity (plain L-BFGS)
+  double map_weight = 0.5;           // w of the objective (S-Table 1 default)
+  int max_iterations = 1000;         // per inner run
+  double gradient_tolerance = 1e-6;  // relative to the inner run's initial gradient
+  // Stop when the objective fell by less than relative_decrease_tolerance * |f| over the last
+  // decrease_window iterations (a window, not one iteration: single steps can be tiny while the
+  // run still makes progress). 1e-6 over 10 changes the map energy in the 5th digit at most.
+  double relative_decrease_tolerance = 1e-6;
+  int decrease_window = 10;
+  int history = 8;                       // L-BFGS curvature pairs kept
+  bool laplacian_preconditioner = true;  // false: H0 = identity (plain L-BFGS)
+  bool scaling_by_inverse = false;       // beta = y^T H0 y / s^T y (else s^T y / s^T B0 s)
+  double blend = 1.0;                    // blending strength (0 = plain L-BFGS pairs), see above
+  bool cure = true;                      // BCQN curing of the direction
+  double cure_keep = 0.5;          // curing keeps at least this fraction of each linearised area
   bool slide_boundary = true;      // boundary vertices on straight runs slide (see above)
   double max_step_fraction = 0.8;  // line search starts at this fraction of the inversion bound
   double armijo = 1e-4;            // sufficient decrease constant c1
   int max_backtracks = 50;
-  // Called after every accepted iterate (iteration >= 1) with all shapes' positions; for tests,
-  // traces and visualisation. Not called for the input.
+  int threads = 0;  // <= 0: hardware concurrency; results do not depend on it
+  // Outer topology loop: 0 = inner loop only (topology and vertex count unchanged).
+  int max_outer = 30;
+  double outer_tolerance = 1e-4;    // stop when a pass + short run gains less (relative)
+  int outer_inner_iterations = 20;  // inner iterations between topology passes
+  TopologyOptions topology;
+  // Called after every accepted inner iterate (numbered globally from 1) with all shapes'
+  // positions (of the current topology); for tests, traces and visualisation.
   std::function<void(int iteration, const std::vector<Points>& shapes)> on_iterate;
 };
 
 struct ComeshReport {
   int vertices_before = 0;
   int vertices_after = 0;
-  int inner = 0;  // accepted L-BFGS iterations
-  int outer = 0;  // topology passes (none yet, see TODO)
+  int inner = 0;  // accepted L-BFGS iterations, summed over inner runs
+  int outer = 0;  // topology passes that changed the mesh
   double seconds = 0.0;
   double map_energy = 0.0;   // after; mean area-weighted sigma*, 2 = conformal
   double mesh_energy = 0.0;  // after; normalized ODT, 1 = equal equilateral triangles
@@ -73,14 +97,22 @@ struct ComeshReport {
   double mesh_energy_before = 0.0;
   double objective_before = 0.0;
   double objective_after = 0.0;
+  // Objective after each inner run and each topology pass, in order (non-increasing).
+  std::vector<double> objective_trace;
+  int flips = 0;
+  int collapses = 0;
+  int splits = 0;
   int energy_evaluations = 0;
-  std::string stop_reason;  // "gradient", "decrease", "max_iterations", "line_search", "no_free"
+  std::string stop_reason;  // last inner run: "gradient", "decrease", "max_iterations",
+                            // "line_search", "no_free"
 };
 
-// Optimizes the interior vertex positions of every shape of `mesh` (topology unchanged).
+// Optimizes every shape of `mesh` (positions, and with max_outer > 0 the shared topology).
 // InvalidArgument if the multimesh is inconsistent or a triangle is inverted or degenerate in
 // some shape (the message names shape and triangle); Cancelled if `cancel` fires (checked every
 // iteration). `progress` (may be empty) is called once per iteration; `report` may be null.
+// The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are remapped to
+// the compacted vertex numbering.
 absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOptions& options,
                                          const CancelToken* cancel, const ProgressFn& progress,
                                          ComeshReport* report);

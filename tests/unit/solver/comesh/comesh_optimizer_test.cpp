@@ -6,8 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "solver/comesh/comesh_objective.h"
+#include "solver/mesh/build_multimesh.h"
+#include "solver/mesh/validate.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
 
 namespace inbetween::solver {
@@ -36,6 +39,7 @@ TEST(ComeshOptimizerTest, DecreasesObjectiveWithoutInvertingAnyIterate) {
   double previous = objective->Evaluate(m.shapes);
   int iterates = 0, inverted = 0, increases = 0;
   ComeshOptions options;
+  options.max_outer = 0;  // the inner loop alone: topology (and thus the objective) fixed
   options.on_iterate = [&](int, const std::vector<Points>& shapes) {
     ++iterates;
     for (const Points& x : shapes) inverted += testing::CountNonPositive(m.triangles, x);
@@ -162,6 +166,127 @@ TEST(ComeshOptimizerTest, NothingFreeReturnsInput) {
   ASSERT_TRUE(out.ok());
   EXPECT_EQ(out->shapes, m.shapes);
   EXPECT_EQ(report.stop_reason, "no_free");
+}
+
+// A real multimesh (BuildMultimesh) from generated polygons: unit square -> regular hexagon.
+absl::StatusOr<Multimesh> BuiltSquareToHexagon(int boundary_vertices) {
+  Drawing square, hexagon;
+  square.outlines.push_back({{Point(0, 0), Point(1, 0), Point(1, 1), Point(0, 1)}});
+  Points hex;
+  for (int k = 0; k < 6; ++k) {
+    const double a = k * std::numbers::pi / 3.0;
+    hex.push_back(Point(0.5, 0.5) + 0.6 * Point(std::cos(a), std::sin(a)));
+  }
+  hexagon.outlines.push_back({hex});
+  MultimeshOptions options;
+  options.boundary_vertices = boundary_vertices;
+  return BuildMultimesh({square, hexagon}, options);
+}
+
+TEST(ComeshOptimizerTest, OuterLoopOnRealSquareToHexagonDropsVerticesAndStaysValid) {
+  auto m = BuiltSquareToHexagon(48);
+  ASSERT_TRUE(m.ok()) << m.status();
+  ComeshOptions options;
+  int iterates = 0;
+  options.on_iterate = [&](int, const std::vector<Points>&) { ++iterates; };
+  ComeshReport report;
+  auto out = OptimizeComesh(*m, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_GT(report.outer, 0);
+  EXPECT_EQ(report.vertices_before, m->num_vertices());
+  EXPECT_EQ(report.vertices_after, out->num_vertices());
+  EXPECT_LT(report.vertices_after, report.vertices_before);
+  EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
+  for (const Points& x : out->shapes) EXPECT_EQ(CountInverted(out->triangles, x), 0);
+  // Objective non-increasing across inner runs and topology passes.
+  ASSERT_GE(report.objective_trace.size(), 2u);
+  double previous = report.objective_before;
+  for (double f : report.objective_trace) {
+    EXPECT_LE(f, previous * (1 + 1e-12));
+    previous = f;
+  }
+  EXPECT_EQ(report.objective_trace.back(), report.objective_after);
+  EXPECT_LT(report.map_energy, report.map_energy_before);
+  EXPECT_LT(report.mesh_energy, report.mesh_energy_before);
+  // Boundary kept, in order, at the same positions.
+  ASSERT_EQ(out->boundary.size(), m->boundary.size());
+  for (int s = 0; s < m->num_shapes(); ++s) {
+    for (size_t b = 0; b < m->boundary.size(); ++b) {
+      const Point before = m->shapes[s][m->boundary[b]];
+      const Point after = out->shapes[s][out->boundary[b]];
+      // Sliders move along their straight side; corners stay.
+      EXPECT_LT((before - after).norm(), 0.5) << "shape " << s << " boundary " << b;
+    }
+  }
+  EXPECT_EQ(iterates, report.inner);
+}
+
+TEST(ComeshOptimizerTest, ResultDoesNotDependOnThreadCount) {
+  // 2 * 66^2 = 8712 triangles: above the parallel cut-off, so threads really run.
+  Multimesh m = SquareToHexagon(66);
+  ComeshOptions options;
+  options.max_iterations = 15;
+  options.max_outer = 1;
+  options.outer_inner_iterations = 5;
+  ComeshReport r1, r2;
+  options.threads = 1;
+  auto a = OptimizeComesh(m, options, nullptr, nullptr, &r1);
+  options.threads = 2;
+  auto b = OptimizeComesh(m, options, nullptr, nullptr, &r2);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->triangles, b->triangles);
+  EXPECT_EQ(a->shapes, b->shapes);
+  EXPECT_EQ(r1.objective_after, r2.objective_after);
+  EXPECT_EQ(r1.inner, r2.inner);
+}
+
+TEST(ComeshOptimizerTest, ObjectiveDoesNotDependOnThreadCount) {
+  Multimesh m = SquareToHexagon(70);
+  std::vector<Points> g1, g3;
+  ComeshEnergies e1, e3;
+  auto o1 = ComeshObjective::Create(m.triangles, m.shapes, 0.5, 1);
+  auto o3 = ComeshObjective::Create(m.triangles, m.shapes, 0.5, 3);
+  ASSERT_TRUE(o1.ok() && o3.ok());
+  EXPECT_EQ(o1->Evaluate(m.shapes, &g1, &e1), o3->Evaluate(m.shapes, &g3, &e3));
+  EXPECT_EQ(g1, g3);
+  EXPECT_EQ(e1.map, e3.map);
+}
+
+TEST(ComeshOptimizerTest, BlendingAndCuringKeepEveryIterateValid) {
+  const Multimesh m = SquareToHexagon(10);
+  ComeshOptions options;
+  options.blend = 1.0;
+  options.cure = true;
+  options.max_outer = 0;
+  int inverted = 0;
+  options.on_iterate = [&](int, const std::vector<Points>& shapes) {
+    for (const Points& x : shapes) inverted += testing::CountNonPositive(m.triangles, x);
+  };
+  ComeshReport report;
+  auto out = OptimizeComesh(m, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_EQ(inverted, 0);
+  EXPECT_GT(report.inner, 5);
+  EXPECT_LT(report.objective_after, report.objective_before);
+}
+
+TEST(ComeshOptimizerTest, CancelDuringOuterLoopStopsWithCancelled) {
+  auto m = BuiltSquareToHexagon(32);
+  ASSERT_TRUE(m.ok()) << m.status();
+  CancelToken cancel;
+  ProgressFn progress = [&](const std::string&, double, const std::string& detail) {
+    if (detail.rfind("outer", 0) == 0) cancel.Cancel();
+  };
+  auto out = OptimizeComesh(*m, ComeshOptions{}, &cancel, progress, nullptr);
+  EXPECT_TRUE(absl::IsCancelled(out.status())) << out.status();
+}
+
+TEST(ComeshOptimizerTest, RejectsBadOuterOptions) {
+  const Multimesh m = SquareToHexagon(4);
+  ComeshOptions options;
+  options.max_outer = -1;
+  EXPECT_EQ(OptimizeComesh(m, options, nullptr, nullptr, nullptr).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 }  // namespace

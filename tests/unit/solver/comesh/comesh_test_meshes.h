@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -119,6 +120,46 @@ inline Points Similar(const Points& x, double angle, double scale, Point shift) 
   Points out;
   for (const Point& p : x) out.push_back(scale * (r * p) + shift);
   return out;
+}
+
+// Generated drawings for the benchmarks and the BuildMultimesh-based tests (positive orientation).
+inline Drawing RegularPolygon(int sides, double radius, Point center, double phase = 0.0) {
+  Drawing d;
+  Outline o;
+  for (int k = 0; k < sides; ++k) {
+    const double a = phase + 2.0 * std::numbers::pi * k / sides;
+    o.points.push_back(center + radius * Point(std::cos(a), std::sin(a)));
+  }
+  d.outlines.push_back(o);
+  return d;
+}
+inline Drawing UnitSquare() {
+  Drawing d;
+  d.outlines.push_back({{Point(0, 0), Point(1, 0), Point(1, 1), Point(0, 1)}});
+  return d;
+}
+// A five-pointed star, inner radius = inner_ratio * outer radius (1 = a regular decagon).
+inline Drawing Star(double radius, double inner_ratio, Point center) {
+  Drawing d;
+  Outline o;
+  for (int k = 0; k < 10; ++k) {
+    const double a = -std::numbers::pi / 2 + std::numbers::pi * k / 5;
+    const double r = (k % 2 == 0) ? radius : inner_ratio * radius;
+    o.points.push_back(center + r * Point(std::cos(a), std::sin(a)));
+  }
+  d.outlines.push_back(o);
+  return d;
+}
+// MultimeshOptions for about `vertices` vertices on a shape of area ~1 and bounding-box diagonal
+// `diagonal`: edge h with 2 / (sqrt(3) h^2) vertices, boundary spacing h; CGAL's size bound is
+// an upper bound, so the requested h is 1.5 times that (calibrated on square -> hexagon).
+struct SizedMeshOptions {
+  int boundary_vertices;
+  double max_edge_relative;
+};
+inline SizedMeshOptions SizeFor(int vertices, double perimeter, double diagonal, double area) {
+  const double h = 1.5 * std::sqrt(2.0 * area / (std::sqrt(3.0) * std::max(vertices, 4)));
+  return {std::max(8, static_cast<int>(std::lround(perimeter / h))), h / diagonal};
 }
 
 // Number of triangles with non-positive signed area.

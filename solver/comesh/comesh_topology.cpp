@@ -1,0 +1,426 @@
+// Comesh outer loop: flips, collapses and splits applied to every shape at once, each accepted
+// only if valid in every shape and not raising the comesh objective (see comesh_topology.h).
+#include "solver/comesh/comesh_topology.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "solver/comesh/comesh_objective.h"
+
+namespace inbetween::solver {
+namespace {
+
+double Area2(const Point& a, const Point& b, const Point& c) {
+  const Point ab = b - a, ac = c - a;
+  return ab.x() * ac.y() - ab.y() * ac.x();
+}
+
+// Mutable triangle soup with vertex -> triangle incidence and the running objective sums.
+class Editor {
+ public:
+  Editor(const Multimesh& mesh, const ComeshObjective& objective, const TopologyOptions& options)
+      : objective_(objective),
+        options_(options),
+        triangles_(mesh.triangles),
+        alive_(mesh.triangles.size(), 1),
+        shapes_(mesh.shapes),
+        t0_(static_cast<double>(mesh.triangles.size())),
+        t_(static_cast<int>(mesh.triangles.size())) {
+    const int n = mesh.num_vertices();
+    const int num_shapes = mesh.num_shapes();
+    incident_.resize(n);
+    removed_.assign(n, 0);
+    locked_.assign(n, 0);
+    protected_.assign(n, 0);
+    std::map<std::pair<int, int>, int> uses;
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        incident_[triangles_[t][k]].push_back(static_cast<int>(t));
+        ++uses[std::minmax(triangles_[t][k], triangles_[t][(k + 1) % 3])];
+      }
+      double odt, mips;
+      objective_.TriangleTerms(triangles_[t], shapes_, &odt, &mips);
+      odt_sum_ += odt;
+      mips_sum_ += mips;
+    }
+    for (const auto& [edge, count] : uses) {
+      if (count != 2) protected_[edge.first] = protected_[edge.second] = 1;
+    }
+    for (int v : mesh.boundary) protected_[v] = 1;
+    for (const auto& c : mesh.cohesive_edges) {
+      for (int v : c) protected_[v] = 1;
+    }
+    for (int s = 0; s < num_shapes; ++s) {
+      double area = 0.0, length = 0.0;
+      for (const Triangle& t : triangles_)
+        area += 0.5 * Area2(shapes_[s][t[0]], shapes_[s][t[1]], shapes_[s][t[2]]);
+      for (const auto& [edge, count] : uses) {
+        length += (shapes_[s][edge.first] - shapes_[s][edge.second]).norm();
+      }
+      min_area2_.push_back(2.0 * options.min_area_ratio * area / t0_);
+      mean_edge_.push_back(length / static_cast<double>(uses.size()));
+    }
+  }
+
+  double Objective() const { return Objective(t_, odt_sum_, mips_sum_); }
+  int num_triangles() const { return t_; }
+
+  // Interior edges (each once) as (a, b) with a < b.
+  std::vector<std::pair<int, int>> InteriorEdges() const {
+    std::map<std::pair<int, int>, int> uses;
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+      if (!alive_[t]) continue;
+      for (int k = 0; k < 3; ++k) ++uses[std::minmax(triangles_[t][k], triangles_[t][(k + 1) % 3])];
+    }
+    std::vector<std::pair<int, int>> edges;
+    for (const auto& [edge, count] : uses) {
+      if (count == 2) edges.push_back(edge);
+    }
+    return edges;
+  }
+
+  // Length of edge (a, b) relative to the mean edge length, max (or min) over shapes.
+  double RelativeLength(int a, int b, bool max) const {
+    double r = max ? 0.0 : std::numeric_limits<double>::infinity();
+    for (size_t s = 0; s < shapes_.size(); ++s) {
+      const double l = (shapes_[s][a] - shapes_[s][b]).norm() / mean_edge_[s];
+      r = max ? std::max(r, l) : std::min(r, l);
+    }
+    return r;
+  }
+
+  // The two live triangles sharing edge (a, b), or false.
+  bool EdgeTriangles(int a, int b, int* t1, int* t2) const {
+    int found = 0;
+    for (int t : incident_[a]) {
+      const Triangle& tri = triangles_[t];
+      if (tri[0] == b || tri[1] == b || tri[2] == b) {
+        if (found == 0) *t1 = t;
+        if (found == 1) *t2 = t;
+        ++found;
+      }
+    }
+    return found == 2;
+  }
+
+  bool TryFlip(int a, int b) {
+    int t1 = -1, t2 = -1;
+    if (!EdgeTriangles(a, b, &t1, &t2)) return false;
+    // Orient: t1 = (a, b, c) and t2 = (b, a, d) up to rotation.
+    if (Opposite(triangles_[t1], a, b) < 0) std::swap(t1, t2);
+    const int cc = Opposite(triangles_[t1], a, b);
+    const int dd = Opposite(triangles_[t2], b, a);
+    if (cc < 0 || dd < 0 || cc == dd || Adjacent(cc, dd)) return false;
+    const Triangle n1 = {a, dd, cc}, n2 = {dd, b, cc};
+    if (!Positive(n1) || !Positive(n2)) return false;
+    double odt_old, mips_old, odt_new, mips_new;
+    Terms({triangles_[t1], triangles_[t2]}, &odt_old, &mips_old);
+    Terms({n1, n2}, &odt_new, &mips_new);
+    const double before = Objective();
+    const double after =
+        Objective(t_, odt_sum_ - odt_old + odt_new, mips_sum_ - mips_old + mips_new);
+    if (!(after < before - 1e-12 * std::abs(before))) return false;
+    Replace(t1, n1);
+    Replace(t2, n2);
+    odt_sum_ += odt_new - odt_old;
+    mips_sum_ += mips_new - mips_old;
+    return true;
+  }
+
+  // Removes b (interior) by merging it into a.
+  bool TryCollapse(int a, int b) {
+    if (removed_[a] || removed_[b] || protected_[b] || locked_[a] || locked_[b]) return false;
+    int t1 = -1, t2 = -1;
+    if (!EdgeTriangles(a, b, &t1, &t2)) return false;
+    // Link condition: the common neighbours of a and b are exactly the two opposite vertices.
+    const std::vector<int> na = Neighbours(a), nb = Neighbours(b);
+    std::vector<int> common;
+    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
+    if (common.size() != 2) return false;
+    // Affected triangles: the one-rings of a and b (the two on edge ab disappear).
+    std::vector<int> affected = incident_[a];
+    for (int t : incident_[b]) {
+      if (t != t1 && t != t2) affected.push_back(t);
+    }
+    std::vector<Triangle> old_tris, new_tris;
+    for (int t : affected) {
+      old_tris.push_back(triangles_[t]);
+      if (t == t1 || t == t2) continue;
+      Triangle tri = triangles_[t];
+      for (int k = 0; k < 3; ++k) {
+        if (tri[k] == b) tri[k] = a;
+      }
+      new_tris.push_back(tri);
+    }
+    double odt_old, mips_old;
+    Terms(old_tris, &odt_old, &mips_old);
+    const double before = Objective();
+    // Candidate places for the merged vertex: a's own, or (a free) the midpoint, in every shape.
+    const int num_shapes = static_cast<int>(shapes_.size());
+    std::vector<Point> saved(num_shapes);
+    for (int s = 0; s < num_shapes; ++s) saved[s] = shapes_[s][a];
+    double best = std::numeric_limits<double>::infinity();
+    int best_place = -1;
+    double best_odt = 0.0, best_mips = 0.0;
+    for (int place = 0; place < (protected_[a] ? 1 : 2); ++place) {
+      for (int s = 0; s < num_shapes; ++s) {
+        shapes_[s][a] = place == 0 ? saved[s] : Point(0.5 * (saved[s] + shapes_[s][b]));
+      }
+      bool ok = true;
+      for (const Triangle& tri : new_tris) ok = ok && Positive(tri);
+      if (ok) {
+        double odt_new, mips_new;
+        Terms(new_tris, &odt_new, &mips_new);
+        const double after =
+            Objective(t_ - 2, odt_sum_ - odt_old + odt_new, mips_sum_ - mips_old + mips_new);
+        if (after < best) {
+          best = after;
+          best_place = place;
+          best_odt = odt_new - odt_old;
+          best_mips = mips_new - mips_old;
+        }
+      }
+    }
+    for (int s = 0; s < num_shapes; ++s) {
+      shapes_[s][a] = best_place == 1 ? Point(0.5 * (saved[s] + shapes_[s][b])) : saved[s];
+    }
+    if (best_place < 0 || !(best <= before)) {
+      for (int s = 0; s < num_shapes; ++s) shapes_[s][a] = saved[s];
+      return false;
+    }
+    // Apply.
+    for (int t : {t1, t2}) Kill(t);
+    const std::vector<int> moved = incident_[b];
+    for (int t : moved) {
+      Triangle tri = triangles_[t];
+      for (int k = 0; k < 3; ++k) {
+        if (tri[k] == b) tri[k] = a;
+      }
+      Replace(t, tri);
+    }
+    removed_[b] = 1;
+    t_ -= 2;
+    odt_sum_ += best_odt;
+    mips_sum_ += best_mips;
+    locked_[a] = locked_[b] = 1;
+    for (int v : na) locked_[v] = 1;
+    for (int v : nb) locked_[v] = 1;
+    return true;
+  }
+
+  // Inserts a new vertex at the midpoint of interior edge (a, b) in every shape.
+  bool TrySplit(int a, int b) {
+    if (locked_[a] || locked_[b]) return false;
+    int t1 = -1, t2 = -1;
+    if (!EdgeTriangles(a, b, &t1, &t2)) return false;
+    const int m = static_cast<int>(removed_.size());
+    for (Points& x : shapes_) x.push_back(0.5 * (x[a] + x[b]));
+    std::vector<Triangle> new_tris;
+    for (int t : {t1, t2}) {
+      const Triangle& tri = triangles_[t];
+      for (int end : {a, b}) {
+        Triangle half = tri;
+        for (int k = 0; k < 3; ++k) {
+          if (half[k] == (end == a ? b : a)) half[k] = m;
+        }
+        new_tris.push_back(half);
+      }
+    }
+    bool ok = true;
+    for (const Triangle& tri : new_tris) ok = ok && Positive(tri);
+    double odt_old, mips_old, odt_new = 0.0, mips_new = 0.0;
+    Terms({triangles_[t1], triangles_[t2]}, &odt_old, &mips_old);
+    if (ok) Terms(new_tris, &odt_new, &mips_new);
+    const double before = Objective();
+    const double after =
+        Objective(t_ + 2, odt_sum_ - odt_old + odt_new, mips_sum_ - mips_old + mips_new);
+    if (!ok || !(after < before - 1e-12 * std::abs(before))) {
+      for (Points& x : shapes_) x.pop_back();
+      return false;
+    }
+    removed_.push_back(0);
+    protected_.push_back(0);
+    locked_.push_back(1);
+    incident_.emplace_back();
+    Replace(t1, new_tris[0]);
+    Replace(t2, new_tris[2]);
+    Add(new_tris[1]);
+    Add(new_tris[3]);
+    t_ += 2;
+    odt_sum_ += odt_new - odt_old;
+    mips_sum_ += mips_new - mips_old;
+    locked_[a] = locked_[b] = 1;
+    return true;
+  }
+
+  Multimesh Compact(const Multimesh& input) const {
+    const int n = static_cast<int>(removed_.size());
+    std::vector<int> index(n, -1);
+    int next = 0;
+    for (int v = 0; v < n; ++v) {
+      if (!removed_[v]) index[v] = next++;
+    }
+    Multimesh out;
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+      if (!alive_[t]) continue;
+      const Triangle& tri = triangles_[t];
+      out.triangles.push_back({index[tri[0]], index[tri[1]], index[tri[2]]});
+    }
+    for (const Points& x : shapes_) {
+      Points y;
+      y.reserve(next);
+      for (int v = 0; v < n; ++v) {
+        if (!removed_[v]) y.push_back(x[v]);
+      }
+      out.shapes.push_back(std::move(y));
+    }
+    for (int v : input.boundary) out.boundary.push_back(index[v]);
+    for (const auto& c : input.cohesive_edges) {
+      out.cohesive_edges.push_back({index[c[0]], index[c[1]], index[c[2]], index[c[3]]});
+    }
+    return out;
+  }
+
+ private:
+  double Objective(int t, double odt, double mips) const {
+    const double w = objective_.map_weight();
+    return (1.0 - w) * (t / t0_) * odt + w * mips;
+  }
+
+  void Terms(const std::vector<Triangle>& tris, double* odt, double* mips) const {
+    *odt = *mips = 0.0;
+    for (const Triangle& t : tris) {
+      double o, m;
+      objective_.TriangleTerms(t, shapes_, &o, &m);
+      *odt += o;
+      *mips += m;
+    }
+  }
+
+  bool Positive(const Triangle& t) const {
+    for (size_t s = 0; s < shapes_.size(); ++s) {
+      const Points& x = shapes_[s];
+      if (!(Area2(x[t[0]], x[t[1]], x[t[2]]) > min_area2_[s])) return false;
+    }
+    return true;
+  }
+
+  // The third vertex of `tri` if it contains the directed edge a -> b, else -1.
+  static int Opposite(const Triangle& tri, int a, int b) {
+    for (int k = 0; k < 3; ++k) {
+      if (tri[k] == a && tri[(k + 1) % 3] == b) return tri[(k + 2) % 3];
+    }
+    return -1;
+  }
+
+  bool Adjacent(int a, int b) const {
+    for (int t : incident_[a]) {
+      const Triangle& tri = triangles_[t];
+      if (tri[0] == b || tri[1] == b || tri[2] == b) return true;
+    }
+    return false;
+  }
+
+  std::vector<int> Neighbours(int v) const {
+    std::vector<int> out;
+    for (int t : incident_[v]) {
+      for (int u : triangles_[t]) {
+        if (u != v) out.push_back(u);
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+  void Detach(int t) {
+    for (int v : triangles_[t]) {
+      auto& list = incident_[v];
+      list.erase(std::find(list.begin(), list.end(), t));
+    }
+  }
+  void Attach(int t) {
+    for (int v : triangles_[t]) incident_[v].push_back(t);
+  }
+  void Replace(int t, const Triangle& tri) {
+    Detach(t);
+    triangles_[t] = tri;
+    Attach(t);
+  }
+  void Kill(int t) {
+    Detach(t);
+    alive_[t] = 0;
+  }
+  void Add(const Triangle& tri) {
+    triangles_.push_back(tri);
+    alive_.push_back(1);
+    Attach(static_cast<int>(triangles_.size()) - 1);
+  }
+
+  const ComeshObjective& objective_;
+  const TopologyOptions& options_;
+  std::vector<Triangle> triangles_;
+  std::vector<char> alive_;
+  std::vector<Points> shapes_;
+  std::vector<std::vector<int>> incident_;
+  std::vector<char> removed_, locked_, protected_;
+  std::vector<double> min_area2_, mean_edge_;
+  double t0_;
+  int t_;
+  double odt_sum_ = 0.0, mips_sum_ = 0.0;
+};
+
+}  // namespace
+
+absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
+                                          const TopologyOptions& options, TopologyReport* report) {
+  absl::StatusOr<ComeshObjective> objective =
+      ComeshObjective::Create(mesh.triangles, mesh.shapes, map_weight);
+  if (!objective.ok()) return objective.status();
+  Editor editor(mesh, *objective, options);
+  TopologyReport rep;
+  rep.objective_before = editor.Objective();
+  if (!std::isfinite(rep.objective_before)) {
+    return absl::InvalidArgumentError("ImproveTopology: a triangle is not positive in some shape");
+  }
+  auto flip_sweeps = [&] {
+    for (int sweep = 0; options.flips && sweep < options.flip_sweeps; ++sweep) {
+      int flips = 0;
+      for (const auto& [a, b] : editor.InteriorEdges()) flips += editor.TryFlip(a, b);
+      rep.flips += flips;
+      if (flips == 0) break;
+    }
+  };
+  flip_sweeps();
+  if (options.collapses) {
+    std::vector<std::pair<double, std::pair<int, int>>> candidates;
+    for (const auto& [a, b] : editor.InteriorEdges()) {
+      const double r = editor.RelativeLength(a, b, /*max=*/true);
+      if (r < options.collapse_ratio) candidates.push_back({r, {a, b}});
+    }
+    std::sort(candidates.begin(), candidates.end());
+    for (const auto& [r, edge] : candidates) {
+      rep.collapses += editor.TryCollapse(edge.first, edge.second) ||
+                       editor.TryCollapse(edge.second, edge.first);
+    }
+  }
+  if (options.splits) {
+    std::vector<std::pair<double, std::pair<int, int>>> candidates;
+    for (const auto& [a, b] : editor.InteriorEdges()) {
+      const double r = editor.RelativeLength(a, b, /*max=*/true);
+      if (r > options.split_ratio) candidates.push_back({-r, {a, b}});
+    }
+    std::sort(candidates.begin(), candidates.end());
+    for (const auto& [r, edge] : candidates) rep.splits += editor.TrySplit(edge.first, edge.second);
+  }
+  if (rep.collapses + rep.splits > 0) flip_sweeps();
+  rep.objective_after = editor.Objective();
+  if (report != nullptr) *report = rep;
+  return editor.Compact(mesh);
+}
+
+}  // namespace inbetween::solver

@@ -1,0 +1,52 @@
+// Comesh optimization, outer loop: one pass of topology operations applied identically to every
+// shape of a multimesh (DESIGN "Comesh optimization", S-Tables 1-4 "Outer"): edge flips, collapses
+// of short interior edges, splits of long interior edges. Each operation is accepted only if
+//   - every new triangle is positive in EVERY shape, with area at least min_area_ratio times
+//     that shape's mean triangle area (no slivers), and
+//   - the comesh objective (comesh_objective.h) does not increase: flips and splits must lower
+//     it, collapses must not raise it. The objective is evaluated as a mean quality for the
+//     current triangle count T, E(T) = (1 - w) (T / T0) O + w M, with O, M the sums of the
+//     per-triangle ODT and MIPS terms normalized for the pass's starting count T0, so that
+//     removing or adding triangles is compared fairly.
+// Collapses only remove interior vertices: topological boundary vertices, Multimesh::boundary
+// vertices and cohesive-edge vertices are never removed (a boundary endpoint keeps its place;
+// two interior endpoints merge at the better of the midpoint and the kept vertex's position);
+// the link condition keeps the mesh a manifold. A vertex touched by a collapse or split is not
+// used by another one in the same pass, so each pass changes the mesh locally; the optimizer
+// alternates passes with inner runs. The result is renumbered compactly (vertex order kept);
+// Multimesh::boundary and cohesive_edges are remapped.
+#pragma once
+
+#include "absl/status/statusor.h"
+#include "solver/mesh/multimesh.h"
+
+namespace inbetween::solver {
+
+struct TopologyOptions {
+  bool flips = true;
+  bool collapses = true;
+  bool splits = true;
+  // An interior edge is a collapse candidate when its length is below collapse_ratio times the
+  // mean edge length in EVERY shape, a split candidate when above split_ratio times it in SOME
+  // shape; the objective decides (see above).
+  double collapse_ratio = 0.8;
+  double split_ratio = 2.0;
+  double min_area_ratio = 1e-2;  // new triangles: area >= this * mean triangle area, every shape
+  int flip_sweeps = 3;           // flip sweeps over all edges per pass (until none is accepted)
+};
+
+struct TopologyReport {
+  int flips = 0;
+  int collapses = 0;
+  int splits = 0;
+  double objective_before = 0.0;  // E of the input (for its own triangle count)
+  double objective_after = 0.0;   // E of the output (for its own triangle count)
+};
+
+// One topology pass. `mesh` must be valid (positive triangles in every shape). The returned
+// multimesh is valid too and has objective_after <= objective_before.
+absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
+                                          const TopologyOptions& options,
+                                          TopologyReport* report = nullptr);
+
+}  // namespace inbetween::solver

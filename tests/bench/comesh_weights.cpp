@@ -1,0 +1,86 @@
+// Benchmark (S-Table 1): square -> hexagon (467 vertices, as in the paper) optimized with the map
+// weight w swept over the paper's values. Prints our row beside the paper's; --json FILE.
+//
+//   comesh_weights [--threads T] [--json FILE]
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "solver/comesh/comesh_optimizer.h"
+#include "solver/mesh/build_multimesh.h"
+#include "tests/unit/solver/comesh/comesh_test_meshes.h"
+
+namespace {
+
+namespace sv = inbetween::solver;
+
+// S-Table 1: weight, vertices after (467 before), seconds, map, mesh.
+struct PaperRow {
+  double weight;
+  int after;
+  double seconds, map, mesh;
+};
+constexpr PaperRow kPaper[] = {{0.13, 358, 2.329, 2.114, 0.494}, {0.21, 331, 1.881, 2.095, 0.494},
+                               {0.33, 340, 2.034, 2.065, 0.494}, {0.44, 332, 3.473, 2.054, 0.494},
+                               {0.5, 345, 2.0, 2.056, 0.494},    {0.62, 337, 2.245, 2.052, 0.494},
+                               {0.7, 335, 1.186, 2.055, 0.494},  {0.85, 327, 1.263, 2.050, 0.495},
+                               {0.93, 360, 1.072, 2.046, 0.495}};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string json_path;
+  sv::ComeshOptions options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--json" && i + 1 < argc) {
+      json_path = argv[++i];
+    } else if (a == "--threads" && i + 1 < argc) {
+      options.threads = std::atoi(argv[++i]);
+    } else {
+      std::fprintf(stderr, "usage: %s [--threads T] [--json FILE]\n", argv[0]);
+      return 2;
+    }
+  }
+  const auto size = sv::testing::SizeFor(467, 4.0, std::sqrt(2.0), 1.0);
+  sv::MultimeshOptions mesh_options;
+  mesh_options.boundary_vertices = size.boundary_vertices;
+  mesh_options.max_edge_relative = size.max_edge_relative;
+  absl::StatusOr<sv::Multimesh> mesh = sv::BuildMultimesh(
+      {sv::testing::UnitSquare(), sv::testing::RegularPolygon(6, 0.6, sv::Point(0.5, 0.5))},
+      mesh_options);
+  if (!mesh.ok()) {
+    std::fprintf(stderr, "%s\n", mesh.status().ToString().c_str());
+    return 1;
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  std::printf("%-6s %13s %11s %6s %9s %9s %7s %15s %15s\n", "weight", "ver ours", "paper", "outer",
+              "seconds", "paper_s", "ratio", "map ours/paper", "mesh ours/paper");
+  for (const PaperRow& paper : kPaper) {
+    options.map_weight = paper.weight;
+    sv::ComeshReport r;
+    absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(*mesh, options, nullptr, nullptr, &r);
+    if (!out.ok()) {
+      std::fprintf(stderr, "w = %g: %s\n", paper.weight, out.status().ToString().c_str());
+      return 1;
+    }
+    std::printf("%-6.2f %6d/%-6d %4d/%-6d %6d %9.3f %9.3f %7.1f %7.4f/%-7.3f %7.4f/%-7.3f\n",
+                paper.weight, r.vertices_before, r.vertices_after, 467, paper.after, r.outer,
+                r.seconds, paper.seconds, paper.seconds / r.seconds, r.map_energy, paper.map,
+                r.mesh_energy, paper.mesh);
+    std::fflush(stdout);
+    rows.push_back({{"case", "square-hexagon-w" + std::to_string(paper.weight).substr(0, 4)},
+                    {"vertices_before", r.vertices_before},
+                    {"vertices_after", r.vertices_after},
+                    {"inner", r.inner},
+                    {"outer", r.outer},
+                    {"seconds", r.seconds},
+                    {"map_energy", r.map_energy},
+                    {"mesh_energy", r.mesh_energy},
+                    {"paper_seconds", paper.seconds}});
+  }
+  if (!json_path.empty()) std::ofstream(json_path) << rows.dump(2) << "\n";
+  return 0;
+}

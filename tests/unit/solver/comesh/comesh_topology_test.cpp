@@ -1,0 +1,115 @@
+// Tests for the comesh outer loop's topology pass: flips and collapses valid in every shape,
+// objective never increases, boundary and cohesive vertices kept and renumbered consistently.
+#include "solver/comesh/comesh_topology.h"
+
+#include <gtest/gtest.h>
+
+#include "solver/comesh/comesh_objective.h"
+#include "solver/mesh/validate.h"
+#include "tests/unit/solver/comesh/comesh_test_meshes.h"
+
+namespace inbetween::solver {
+namespace {
+
+double Objective(const Multimesh& m, double w = 0.5) {
+  auto o = ComeshObjective::Create(m.triangles, m.shapes, w);
+  EXPECT_TRUE(o.ok()) << o.status();
+  return o.ok() ? o->Evaluate(m.shapes) : 0.0;
+}
+
+void ExpectValidEverywhere(const Multimesh& m) {
+  EXPECT_TRUE(ValidateMultimesh(m).ok()) << ValidateMultimesh(m);
+  for (const Points& x : m.shapes) EXPECT_EQ(CountInverted(m.triangles, x), 0);
+}
+
+// Boundary positions, in boundary order, must survive any pass unchanged in every shape.
+void ExpectSameBoundary(const Multimesh& before, const Multimesh& after) {
+  ASSERT_EQ(before.boundary.size(), after.boundary.size());
+  for (int s = 0; s < before.num_shapes(); ++s) {
+    for (size_t b = 0; b < before.boundary.size(); ++b) {
+      EXPECT_EQ(before.shapes[s][before.boundary[b]], after.shapes[s][after.boundary[b]]);
+    }
+  }
+}
+
+Multimesh Sheared(int k, double shear) {
+  Multimesh m = testing::SquareGrid(k);
+  for (Point& p : m.shapes[0]) p.x() += shear * p.y();
+  m.shapes.push_back(testing::Similar(m.shapes[0], 0.3, 1.5, Point(2, 0)));
+  return m;
+}
+
+TEST(ComeshTopologyTest, FlipsLongDiagonalsOfAShearedGridInAllShapes) {
+  const Multimesh m = Sheared(6, 0.8);
+  TopologyOptions options;
+  options.collapses = options.splits = false;
+  TopologyReport report;
+  auto out = ImproveTopology(m, 0.5, options, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_GT(report.flips, 0);
+  EXPECT_EQ(report.collapses, 0);
+  EXPECT_EQ(out->num_vertices(), m.num_vertices());
+  EXPECT_EQ(out->triangles.size(), m.triangles.size());
+  ExpectValidEverywhere(*out);
+  ExpectSameBoundary(m, *out);
+  EXPECT_LT(report.objective_after, report.objective_before);
+  EXPECT_NEAR(Objective(*out), report.objective_after, 1e-9 * report.objective_after);
+  EXPECT_NEAR(Objective(m), report.objective_before, 1e-9 * report.objective_before);
+}
+
+TEST(ComeshTopologyTest, CollapsesANeedlessVertexKeepingBoundaryAndValidity) {
+  Multimesh m = testing::SquareGrid(6);
+  m.shapes.push_back(testing::TutteHexagon(m));
+  // Interior vertex 8 = (1, 1) pushed almost onto its neighbour 15 = (1, 2) in both shapes.
+  for (Points& x : m.shapes) x[8] = x[15] + 0.08 * (x[8] - x[15]);
+  ASSERT_TRUE(ValidateMultimesh(m).ok());
+  m.cohesive_edges.push_back({0, 1, 1, 0});  // must be remapped, never removed
+  TopologyReport report;
+  auto out = ImproveTopology(m, 0.5, TopologyOptions{}, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_GE(report.collapses, 1);
+  EXPECT_EQ(out->num_vertices(), m.num_vertices() - report.collapses + report.splits);
+  EXPECT_EQ(out->triangles.size(), m.triangles.size() - 2 * report.collapses + 2 * report.splits);
+  ExpectValidEverywhere(*out);
+  ExpectSameBoundary(m, *out);
+  ASSERT_EQ(out->cohesive_edges.size(), 1u);
+  for (int s = 0; s < m.num_shapes(); ++s) {
+    EXPECT_EQ(out->shapes[s][out->cohesive_edges[0][0]], m.shapes[s][0]);
+    EXPECT_EQ(out->shapes[s][out->cohesive_edges[0][1]], m.shapes[s][1]);
+  }
+  EXPECT_LE(report.objective_after, report.objective_before);
+  EXPECT_LE(Objective(*out), Objective(m));
+}
+
+TEST(ComeshTopologyTest, NoOperationOnAnOptimalMeshKeepsItIdentical) {
+  // Two triangles, no interior edge to flip or vertex to remove.
+  Multimesh m = testing::SquareGrid(1);
+  m.shapes.push_back(testing::Similar(m.shapes[0], 0.2, 2.0, Point(0, 0)));
+  TopologyReport report;
+  auto out = ImproveTopology(m, 0.5, TopologyOptions{}, &report);
+  ASSERT_TRUE(out.ok());
+  EXPECT_EQ(report.flips + report.collapses + report.splits, 0);
+  EXPECT_EQ(out->triangles, m.triangles);
+  EXPECT_EQ(out->shapes, m.shapes);
+  EXPECT_EQ(out->boundary, m.boundary);
+}
+
+TEST(ComeshTopologyTest, EveryPassOnRandomlyDistortedMeshesStaysValid) {
+  for (int seed = 0; seed < 6; ++seed) {
+    Multimesh m = testing::SquareGrid(8);
+    m.shapes.push_back(testing::TutteHexagon(m));
+    m.shapes.push_back(testing::SmoothlyDistorted(m.shapes[0], 0.03 * (seed - 3)));
+    for (int pass = 0; pass < 3; ++pass) {
+      TopologyReport report;
+      auto out = ImproveTopology(m, 0.1 + 0.15 * seed, TopologyOptions{}, &report);
+      ASSERT_TRUE(out.ok()) << out.status();
+      ExpectValidEverywhere(*out);
+      ExpectSameBoundary(m, *out);
+      EXPECT_LE(report.objective_after, report.objective_before);
+      m = *std::move(out);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace inbetween::solver
