@@ -1,12 +1,14 @@
 // CHOLMOD-backed sparse LDL^T (see sparse_cholesky.h). Simplicial factorization with an AMD
 // ordering: no BLAS and no threads, so results are bit-identical run to run; for the planar
-// meshes we solve (10^2..10^5 vertices) simplicial is as fast as supernodal.
+// meshes we solve (10^2..10^5 vertices) simplicial is as fast as supernodal. Solves are our own
+// substitutions reading CHOLMOD's factor arrays in place (no copy, no allocation per solve).
 #include "solver/core/sparse_cholesky.h"
 
 #include <cholmod.h>
 
 #include <algorithm>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -21,6 +23,19 @@ struct SparseCholesky::Impl {
   // The analyzed pattern, to check that Factorize gets the same structure.
   std::vector<int> outer;
   std::vector<int> inner;
+  // P A P^T = L D L^T read in place from CHOLMOD's simplicial factor (no copy): column j holds
+  // D_jj at x[p[j]], then the rows below the diagonal at i/x[p[j] + 1 .. p[j] + nz[j] - 1];
+  // perm[k] = row of A at position k. Valid while `factor` is not changed.
+  const int* perm = nullptr;
+  const int* l_p = nullptr;
+  const int* l_nz = nullptr;
+  const int* l_i = nullptr;
+  const double* l_x = nullptr;
+  mutable std::vector<double> work;  // interleaved right-hand sides, n x columns
+
+  void Extract();
+  template <int kColumns>
+  void Substitute(double* y, int columns) const;
 
   Impl() {
     cholmod_start(&common);
@@ -38,6 +53,42 @@ struct SparseCholesky::Impl {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 };
+
+void SparseCholesky::Impl::Extract() {
+  perm = static_cast<const int*>(factor->Perm);
+  l_p = static_cast<const int*>(factor->p);
+  l_nz = static_cast<const int*>(factor->nz);
+  l_i = static_cast<const int*>(factor->i);
+  l_x = static_cast<const double*>(factor->x);
+}
+
+// y: n rows of `columns` interleaved values (kColumns == columns, or 0 for any count).
+template <int kColumns>
+void SparseCholesky::Impl::Substitute(double* y, int columns) const {
+  const int c = kColumns > 0 ? kColumns : columns;
+  for (int j = 0; j < n; ++j) {  // L z = y, column oriented
+    const double* yj = y + static_cast<size_t>(j) * c;
+    const int end = l_p[j] + l_nz[j];
+    for (int k = l_p[j] + 1; k < end; ++k) {
+      double* yi = y + static_cast<size_t>(l_i[k]) * c;
+      const double l = l_x[k];
+      for (int q = 0; q < c; ++q) yi[q] -= l * yj[q];
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    const double inv = 1.0 / l_x[l_p[j]];
+    for (int q = 0; q < c; ++q) y[static_cast<size_t>(j) * c + q] *= inv;
+  }
+  for (int j = n - 1; j >= 0; --j) {  // L^T x = z, dot products with L's columns
+    double* yj = y + static_cast<size_t>(j) * c;
+    const int end = l_p[j] + l_nz[j];
+    for (int k = l_p[j] + 1; k < end; ++k) {
+      const double* yi = y + static_cast<size_t>(l_i[k]) * c;
+      const double l = l_x[k];
+      for (int q = 0; q < c; ++q) yj[q] -= l * yi[q];
+    }
+  }
+}
 
 namespace {
 
@@ -135,6 +186,7 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
       }
     }
   }
+  m.Extract();
   m.factorized = true;
   return absl::OkStatus();
 }
@@ -145,34 +197,59 @@ absl::Status SparseCholesky::Compute(const Eigen::SparseMatrix<double>& a) {
 }
 
 absl::StatusOr<Eigen::MatrixXd> SparseCholesky::Solve(const Eigen::MatrixXd& b) const {
-  Impl& m = *impl_;
+  Eigen::MatrixXd x = b;
+  if (absl::Status s = SolveInPlace(&x); !s.ok()) return s;
+  return x;
+}
+
+absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const {
+  const Impl& m = *impl_;
   if (!m.factorized) {
     return absl::FailedPreconditionError("SparseCholesky: Solve before a successful Factorize");
   }
-  if (b.rows() != m.n) {
+  if (b->rows() != m.n) {
     return absl::InvalidArgumentError(
-        absl::StrCat("SparseCholesky: right-hand side has ", b.rows(), " rows, matrix has ", m.n));
+        absl::StrCat("SparseCholesky: right-hand side has ", b->rows(), " rows, matrix has ", m.n));
   }
-  if (b.cols() == 0) return Eigen::MatrixXd(m.n, 0);
-  Eigen::MatrixXd rhs = b;  // CHOLMOD takes a non-const pointer
-  cholmod_dense view{};
-  view.nrow = static_cast<size_t>(rhs.rows());
-  view.ncol = static_cast<size_t>(rhs.cols());
-  view.nzmax = static_cast<size_t>(rhs.size());
-  view.d = static_cast<size_t>(rhs.rows());
-  view.x = rhs.data();
-  view.z = nullptr;
-  view.xtype = CHOLMOD_REAL;
-  view.dtype = CHOLMOD_DOUBLE;
-  cholmod_dense* x = cholmod_solve(CHOLMOD_A, m.factor, &view, &m.common);
-  if (x == nullptr) {
-    return absl::InternalError(
-        absl::StrCat("SparseCholesky: solve failed (CHOLMOD status ", m.common.status, ")"));
+  const int c = static_cast<int>(b->cols());
+  if (c == 0) return absl::OkStatus();
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int workers = std::min(threads, c);
+  m.work.resize(static_cast<size_t>(m.n) * c);
+  double* y = m.work.data();
+  if (workers > 1 && m.n >= kParallelRows) {
+    // Column q in its own contiguous block of `work`, columns dealt round-robin to the workers.
+    auto run = [&](int worker) {
+      for (int q = worker; q < c; q += workers) {
+        double* yq = y + static_cast<size_t>(q) * m.n;
+        for (int k = 0; k < m.n; ++k) yq[k] = (*b)(m.perm[k], q);
+        m.Substitute<1>(yq, 1);
+        for (int k = 0; k < m.n; ++k) (*b)(m.perm[k], q) = yq[k];
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int w = 1; w < workers; ++w) pool.emplace_back(run, w);
+    run(0);
+    for (std::thread& t : pool) t.join();
+    return absl::OkStatus();
   }
-  Eigen::MatrixXd result =
-      Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x->x), m.n, rhs.cols());
-  cholmod_free_dense(&x, &m.common);
-  return result;
+  for (int k = 0; k < m.n; ++k) {
+    for (int q = 0; q < c; ++q) y[static_cast<size_t>(k) * c + q] = (*b)(m.perm[k], q);
+  }
+  switch (c) {
+    case 1:
+      m.Substitute<1>(y, c);
+      break;
+    case 2:
+      m.Substitute<2>(y, c);
+      break;
+    default:
+      m.Substitute<0>(y, c);
+  }
+  for (int k = 0; k < m.n; ++k) {
+    for (int q = 0; q < c; ++q) (*b)(m.perm[k], q) = y[static_cast<size_t>(k) * c + q];
+  }
+  return absl::OkStatus();
 }
 
 int SparseCholesky::rows() const { return impl_->n; }

@@ -2,6 +2,10 @@
 // that nothing else includes cholmod.h. The fill-reducing ordering and symbolic factorization are
 // computed once (Analyze); the numeric factorization can be redone for new values on the same
 // pattern (Factorize), e.g. the per-frame matrix sum_i w_i K_i of the inbetweening global step.
+// Solves with the factor P A P^T = L D L^T are our own forward/backward substitutions over
+// CHOLMOD's factor arrays, all right-hand sides in one sweep over L (interleaved), with no
+// allocation per solve in SolveInPlace: the inbetweener's global step is one such solve with 2
+// columns per iteration.
 #pragma once
 
 #include <Eigen/Core>
@@ -33,6 +37,15 @@ class SparseCholesky {
 
   // Solves A X = B for all columns of B. FailedPrecondition before a successful Factorize.
   absl::StatusOr<Eigen::MatrixXd> Solve(const Eigen::MatrixXd& b) const;
+
+  // Overwrites the columns of *b (rows() rows, any number of columns) with the solution.
+  // Allocation-free after the first call with a given column count. Uses internal scratch, so
+  // one object must not solve on two threads at once. With threads > 1 (<= 0: all cores) and at
+  // least kParallelRows rows, the columns are substituted separately on up to `threads` threads;
+  // each column sees the same operations in the same order either way, so the result is
+  // bit-identical for every thread count.
+  absl::Status SolveInPlace(Eigen::MatrixXd* b, int threads = 1) const;
+  static constexpr int kParallelRows = 8192;
 
   int rows() const;
   bool factorized() const;

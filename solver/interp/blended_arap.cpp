@@ -3,8 +3,10 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "solver/comesh/parallel_chunks.h"  // shared deterministic parallel-for
 #include "solver/interp/example_rotations.h"
 #include "solver/interp/polar.h"
 
@@ -42,6 +44,10 @@ inline Eigen::Matrix2d RotatedExample(const Eigen::Matrix2d& j, const Eigen::Mat
   return ra;
 }
 
+// Triangles per chunk of the parallel loops: fixed, so results do not depend on the thread count;
+// loops below 8192 triangles stay on the caller's thread (ParallelChunks' cut-off).
+constexpr int kChunk = 1024;
+
 }  // namespace
 
 absl::StatusOr<BlendedArap> BlendedArap::Create(const std::vector<Triangle>& triangles,
@@ -58,7 +64,7 @@ absl::StatusOr<BlendedArap> BlendedArap::Create(const std::vector<Triangle>& tri
   const int n = static_cast<int>(shapes[0].size());
   const int num_t = static_cast<int>(triangles.size());
   const int num_shapes = static_cast<int>(shapes.size());
-  const ExampleRotations rotations = ComputeExampleRotations(triangles, shapes);
+  ExampleRotations rotations = ComputeExampleRotations(triangles, shapes);
 
   BlendedArap e;
   e.num_vertices_ = n;
@@ -66,22 +72,22 @@ absl::StatusOr<BlendedArap> BlendedArap::Create(const std::vector<Triangle>& tri
   e.gradients_.resize(num_t);
   e.areas_.resize(num_t);
   e.weights_.resize(num_t);
-  e.mean_stretch_.resize(num_t);
-  e.mean_stretch_inv_.resize(num_t);
+  // Sbar_t first, so that the examples' stretches are freed before the A_it are allocated (peak
+  // memory with many examples).
+  e.mean_stretch_.assign(num_t, Eigen::Matrix2d::Zero());
+  for (int i = 0; i < num_shapes; ++i) {
+    for (int t = 0; t < num_t; ++t) e.mean_stretch_[t] += rotations.stretches[i][t];
+    std::vector<Eigen::Matrix2d>().swap(rotations.stretches[i]);
+  }
+  // A mean of symmetric positive definite matrices is one: the reference triangle is positive.
+  for (Eigen::Matrix2d& mean : e.mean_stretch_) mean /= static_cast<double>(num_shapes);
+  e.angles_ = std::move(rotations.angles);
   e.examples_.assign(num_shapes, std::vector<Eigen::Matrix2d>(num_t));
-  e.stretches_ = rotations.stretches;
-  e.angles_ = rotations.angles;
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(9 * static_cast<size_t>(num_t));
   for (int t = 0; t < num_t; ++t) {
     const Triangle& tri = triangles[t];
-    Eigen::Matrix2d mean = Eigen::Matrix2d::Zero();
-    for (int i = 0; i < num_shapes; ++i) mean += rotations.stretches[i][t];
-    mean /= static_cast<double>(num_shapes);
-    // A mean of symmetric positive definite matrices is one: the reference triangle is positive.
-    e.mean_stretch_[t] = mean;
-    e.mean_stretch_inv_[t] = mean.inverse();
-    const Eigen::Matrix2d d = mean * EdgeMatrix(shapes[0], tri);
+    const Eigen::Matrix2d d = e.mean_stretch_[t] * EdgeMatrix(shapes[0], tri);
     const Eigen::Matrix2d d_inv = d.inverse();
     for (int i = 0; i < num_shapes; ++i) e.examples_[i][t] = EdgeMatrix(shapes[i], tri) * d_inv;
     Eigen::Matrix<double, 2, 3> g;
@@ -99,6 +105,16 @@ absl::StatusOr<BlendedArap> BlendedArap::Create(const std::vector<Triangle>& tri
   e.laplacian_.resize(n, n);
   e.laplacian_.setFromTriplets(triplets.begin(), triplets.end());
   e.laplacian_.makeCompressed();
+  e.incidence_start_.assign(n + 1, 0);
+  for (const Triangle& tri : triangles) {
+    for (int v : tri) ++e.incidence_start_[v + 1];
+  }
+  for (int v = 0; v < n; ++v) e.incidence_start_[v + 1] += e.incidence_start_[v];
+  e.incidence_.resize(3 * static_cast<size_t>(num_t));
+  std::vector<int> fill(e.incidence_start_.begin(), e.incidence_start_.end() - 1);
+  for (int t = 0; t < num_t; ++t) {
+    for (int k = 0; k < 3; ++k) e.incidence_[fill[triangles[t][k]]++] = 3 * t + k;
+  }
   return e;
 }
 
@@ -117,36 +133,33 @@ Eigen::Matrix2d BlendedArap::DeformationGradient(const Coords& x, int t) const {
 }
 
 double BlendedArap::LocalStep(const Coords& x, const std::vector<double>& w,
-                              std::vector<Eigen::Matrix2d>* targets) const {
+                              std::vector<Eigen::Matrix2d>* targets, int threads) const {
   const int num_t = num_triangles();
   targets->resize(num_t);
   // The examples that take part, gathered once.
-  int active[64];
-  int num_active = 0;
-  std::vector<int> overflow;
+  std::vector<int> active;
   for (int i = 0; i < num_examples(); ++i) {
-    if (w[i] == 0.0) continue;
-    if (num_active < 64) {
-      active[num_active++] = i;
-    } else {
-      overflow.push_back(i);
+    if (w[i] != 0.0) active.push_back(i);
+  }
+  std::vector<double> chunk_energy(NumChunks(num_t, kChunk), 0.0);
+  ParallelChunks(num_t, kChunk, ResolveThreads(threads), [&](int chunk, int begin, int end) {
+    double energy = 0.0;
+    for (int t = begin; t < end; ++t) {
+      const Eigen::Matrix2d j = DeformationGradient(x, t);
+      Eigen::Matrix2d target = Eigen::Matrix2d::Zero();
+      double e = 0.0;
+      for (int i : active) {
+        const Eigen::Matrix2d ra = RotatedExample(j, examples_[i][t]);
+        target += w[i] * ra;
+        e += w[i] * (j - ra).squaredNorm();
+      }
+      (*targets)[t] = target;
+      energy += weights_[t] * e;
     }
-  }
+    chunk_energy[chunk] = energy;
+  });
   double energy = 0.0;
-  for (int t = 0; t < num_t; ++t) {
-    const Eigen::Matrix2d j = DeformationGradient(x, t);
-    Eigen::Matrix2d target = Eigen::Matrix2d::Zero();
-    double e = 0.0;
-    auto add = [&](int i) {
-      const Eigen::Matrix2d ra = RotatedExample(j, examples_[i][t]);
-      target += w[i] * ra;
-      e += w[i] * (j - ra).squaredNorm();
-    };
-    for (int k = 0; k < num_active; ++k) add(active[k]);
-    for (int i : overflow) add(i);
-    (*targets)[t] = target;
-    energy += weights_[t] * e;
-  }
+  for (double e : chunk_energy) energy += e;
   return energy;
 }
 
@@ -163,20 +176,28 @@ double BlendedArap::LocalStepToRest(const Coords& x, const std::vector<Eigen::Ma
   return energy;
 }
 
-void BlendedArap::AlexaTargets(const std::vector<double>& w,
-                               std::vector<Eigen::Matrix2d>* targets) const {
+void BlendedArap::AlexaTargets(const std::vector<double>& w, std::vector<Eigen::Matrix2d>* targets,
+                               int threads) const {
+  // R(theta(w)) S(w) Sbar^{-1} = sum_i w_i R(theta(w) - theta_it) A_it, as A_it =
+  // R(theta_it) S_it Sbar^{-1}: the examples' stretches need not be stored (memory with many
+  // examples), at one sin/cos per example with w_i != 0.
   const int num_t = num_triangles();
   targets->resize(num_t);
-  for (int t = 0; t < num_t; ++t) {
-    double angle = 0.0;
-    Eigen::Matrix2d stretch = Eigen::Matrix2d::Zero();
-    for (int i = 0; i < num_examples(); ++i) {
-      if (w[i] == 0.0) continue;
-      angle += w[i] * angles_[i][t];
-      stretch += w[i] * stretches_[i][t];
-    }
-    (*targets)[t] = RotationMatrix(angle) * stretch * mean_stretch_inv_[t];
+  std::vector<int> active;
+  for (int i = 0; i < num_examples(); ++i) {
+    if (w[i] != 0.0) active.push_back(i);
   }
+  ParallelChunks(num_t, kChunk, ResolveThreads(threads), [&](int, int begin, int end) {
+    for (int t = begin; t < end; ++t) {
+      double angle = 0.0;
+      for (int i : active) angle += w[i] * angles_[i][t];
+      Eigen::Matrix2d target = Eigen::Matrix2d::Zero();
+      for (int i : active) {
+        target += w[i] * (RotationMatrix(angle - angles_[i][t]) * examples_[i][t]);
+      }
+      (*targets)[t] = target;
+    }
+  });
 }
 
 double BlendedArap::Value(const Coords& x, const std::vector<double>& w) const {
@@ -199,14 +220,21 @@ Coords BlendedArap::Gradient(const Coords& x, const std::vector<double>& w) cons
   return grad;
 }
 
-void BlendedArap::AddRhs(const std::vector<Eigen::Matrix2d>& targets, Coords* b) const {
-  for (int t = 0; t < num_triangles(); ++t) {
-    const Eigen::Matrix<double, 2, 3> tg = weights_[t] * (targets[t] * gradients_[t]);
-    for (int k = 0; k < 3; ++k) {
-      (*b)(triangles_[t][k], 0) += tg(0, k);
-      (*b)(triangles_[t][k], 1) += tg(1, k);
+void BlendedArap::AddRhs(const std::vector<Eigen::Matrix2d>& targets, Coords* b,
+                         int threads) const {
+  ParallelChunks(num_vertices_, kChunk, ResolveThreads(threads), [&](int, int begin, int end) {
+    for (int v = begin; v < end; ++v) {
+      double bx = (*b)(v, 0), by = (*b)(v, 1);
+      for (int q = incidence_start_[v]; q < incidence_start_[v + 1]; ++q) {
+        const int t = incidence_[q] / 3, k = incidence_[q] % 3;
+        const Eigen::Vector2d tg = targets[t] * gradients_[t].col(k);
+        bx += weights_[t] * tg(0);
+        by += weights_[t] * tg(1);
+      }
+      (*b)(v, 0) = bx;
+      (*b)(v, 1) = by;
     }
-  }
+  });
 }
 
 double BlendedArap::AngleOffset(const Coords& x, const std::vector<double>& w,

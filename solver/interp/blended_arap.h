@@ -53,9 +53,11 @@ class BlendedArap {
   Eigen::Matrix2d DeformationGradient(const Coords& x, int t) const;
 
   // Local step at x: fills `targets` (resized) with T_t = sum_i w_i R_it A_it for the optimal
-  // R_it and returns Wbar(w, x). Examples with w_i == 0 are skipped.
+  // R_it and returns Wbar(w, x). Examples with w_i == 0 are skipped. `threads` (<= 0: all
+  // cores) splits the triangles into fixed-size chunks whose energies are summed in chunk order,
+  // so the result is bit-identical for every thread count.
   double LocalStep(const Coords& x, const std::vector<double>& w,
-                   std::vector<Eigen::Matrix2d>* targets) const;
+                   std::vector<Eigen::Matrix2d>* targets, int threads = 1) const;
 
   // Local step towards one given rest configuration instead of the examples: per triangle
   // R_t = closest rotation to Jbar_t(x) rest_t^T, T_t = R_t rest_t (rest_t = Jbar_t(Phi) for a
@@ -67,7 +69,8 @@ class BlendedArap {
   // Alexa et al. 2000 targets in this reference: T_t = R(theta_t(w)) S_t(w) Sbar_t^{-1},
   // theta_t(w) = sum_i w_i theta_it, S_t(w) = sum_i w_i S_it (= the local step's targets for the
   // rotations R_it = R(theta_t(w) - theta_it)).
-  void AlexaTargets(const std::vector<double>& w, std::vector<Eigen::Matrix2d>* targets) const;
+  void AlexaTargets(const std::vector<double>& w, std::vector<Eigen::Matrix2d>* targets,
+                    int threads = 1) const;
 
   // Wbar(w, x) and its gradient (envelope theorem: rotations frozen at their optimum).
   double Value(const Coords& x, const std::vector<double>& w) const;
@@ -76,8 +79,9 @@ class BlendedArap {
   // Kbar (n x n, symmetric PSD, kernel = constants per edge-connected component).
   const Eigen::SparseMatrix<double>& Laplacian() const { return laplacian_; }
 
-  // *b += B(targets).
-  void AddRhs(const std::vector<Eigen::Matrix2d>& targets, Coords* b) const;
+  // *b += B(targets), gathered per vertex over its triangles in increasing order (the order a
+  // scatter over the triangles would add them), so it is bit-identical for every thread count.
+  void AddRhs(const std::vector<Eigen::Matrix2d>& targets, Coords* b, int threads = 1) const;
 
   // Rotation gauge: area-weighted mean over the triangles of `group` of the angle of x relative to
   // example 0, each unwrapped to the nearest branch of the blended example angle theta_t(w),
@@ -93,15 +97,15 @@ class BlendedArap {
 
   int num_vertices_ = 0;
   std::vector<Triangle> triangles_;
-  std::vector<Eigen::Matrix<double, 2, 3>> gradients_;   // gbar: grad of hat a, b, c
-  std::vector<double> areas_;                            // abar_t
-  std::vector<double> weights_;                          // kappa_t abar_t
-  std::vector<Eigen::Matrix2d> mean_stretch_;            // Sbar_t
-  std::vector<Eigen::Matrix2d> mean_stretch_inv_;        // Sbar_t^{-1}
-  std::vector<std::vector<Eigen::Matrix2d>> examples_;   // A_it [example][triangle]
-  std::vector<std::vector<Eigen::Matrix2d>> stretches_;  // S_it
-  std::vector<std::vector<double>> angles_;              // theta_it
-  std::vector<double> example_norms_;                    // sum_t kappa abar ||A_it||^2, per example
+  std::vector<Eigen::Matrix<double, 2, 3>> gradients_;  // gbar: grad of hat a, b, c
+  std::vector<double> areas_;                           // abar_t
+  std::vector<double> weights_;                         // kappa_t abar_t
+  std::vector<Eigen::Matrix2d> mean_stretch_;           // Sbar_t
+  std::vector<std::vector<Eigen::Matrix2d>> examples_;  // A_it [example][triangle]
+  std::vector<std::vector<double>> angles_;             // theta_it
+  std::vector<double> example_norms_;                   // sum_t kappa abar ||A_it||^2, per example
+  std::vector<int> incidence_start_;                    // per vertex, into incidence_
+  std::vector<int> incidence_;                          // 3 t + corner, by vertex, t increasing
   Eigen::SparseMatrix<double> laplacian_;
 };
 

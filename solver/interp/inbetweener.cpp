@@ -10,9 +10,15 @@
 //    matrix Kbar + Hbar (cohesive) does not depend on w: CHOLMOD factors it ONCE in Create, and
 //    every iteration of every frame is a local step plus one back-substitution with 2 right-hand
 //    sides. W_C's weight-dependent, capped and anisotropic parts enter only the right-hand side
-//    (majorize-minimize, cohesive_energy.h). Each iteration lowers E (Anderson steps that would
-//    not are replaced by the plain step). The start is the lower-energy of (a) the Alexa targets
-//    solved with the same matrix and (b) the previous frame moved into this frame's gauge.
+//    (majorize-minimize, cohesive_energy.h). No iteration raises E: Anderson steps that would are
+//    replaced by the plain step, and a plain step that would (W_C's lagged direction for
+//    alpha != 1/2) ends the frame. The start is the lower-energy of (a) the Alexa targets solved
+//    with the same matrix and (b) the previous frame translated into this frame's gauge (the
+//    rotation gauge is applied once, after the iterations); (a) is skipped in sequential playback
+//    when warm_start_trust_radius > 0. The back-substitutions are our own over CHOLMOD's factor
+//    (sparse_cholesky.h), the overlap hierarchies are refit, not rebuilt, per frame, and with
+//    options.threads > 1 the local step, right-hand side and x/y solves run in fixed chunks
+//    (bit-identical frames for every thread count).
 //    Non-overlap W_O (S-eq.8/9) is checked on every frame (overlap.h) and, when violated, enforced
 //    by pushing the offending boundary vertices out to the boundary with a stiff spring term
 //    (a second matrix with the spring on every boundary vertex, factored on first use).
@@ -35,6 +41,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <numeric>
 #include <optional>
 #include <utility>
@@ -166,8 +173,14 @@ struct Inbetweener::Impl {
   double contact_stiffness = 0.0;
   Eigen::SparseMatrix<double> zhu_matrix;  // Kbar + Hbar, full
 
-  // The two frames Solve returned last (dynamics through the two-argument Solve).
+  // The two frames Solve returned last (dynamics through the two-argument Solve), and the
+  // weights of the last one (warm start without the cold-start check).
   Points last_frame, frame_before_last;
+  ExampleWeights last_weights;
+  // Set by Zhu17 when the frame it returns is known to have no boundary vertex inside the shape
+  // (the overlap pass then only counts crossings).
+  bool known_inside_free = false;
+  mutable Eigen::MatrixXd solve_scratch;  // right-hand sides of GlobalSolve
 
   // What one frame's objective is made of (see the header comment).
   struct Problem {
@@ -200,8 +213,9 @@ struct Inbetweener::Impl {
   absl::StatusOr<Coords> Zhu17(const ExampleWeights& w, const Frame& previous,
                                const Frame& before_previous, const CancelToken* cancel,
                                FrameReport* report);
-  absl::Status EnforceNonOverlap(Problem* p, Coords* x, const CancelToken* cancel,
-                                 FrameReport* report);
+  // Returns whether the final x was checked and has no boundary vertex inside the shape.
+  absl::StatusOr<bool> EnforceNonOverlap(Problem* p, Coords* x, const CancelToken* cancel,
+                                         FrameReport* report);
   absl::StatusOr<Frame> Solve(const ExampleWeights& weights, const Frame& previous,
                               const Frame& before_previous, const CancelToken* cancel,
                               FrameReport* report);
@@ -385,21 +399,26 @@ void Inbetweener::Impl::Rotate(const ExampleWeights& w, Coords* x) const {
 absl::StatusOr<Coords> Inbetweener::Impl::GlobalSolve(
     const SparseCholesky& s, bool pinned, const Coords& b,
     const std::vector<Eigen::Vector2d>& centroid_target) const {
-  Coords x = Coords::Zero(num_vertices(), 2);  // pinned vertices at 0, moved by the gauge
+  Coords x(num_vertices(), 2);
+  Eigen::MatrixXd& rhs = solve_scratch;
   if (pinned) {
-    Eigen::MatrixXd rhs(num_free, 2);
+    rhs.resize(num_free, 2);
     for (int v = 0; v < num_vertices(); ++v) {
       if (free_index[v] >= 0) rhs.row(free_index[v]) = b.row(v);
     }
-    absl::StatusOr<Eigen::MatrixXd> sol = s.Solve(rhs);
-    if (!sol.ok()) return sol.status();
+    if (absl::Status st = s.SolveInPlace(&rhs, options.threads); !st.ok()) return st;
     for (int v = 0; v < num_vertices(); ++v) {
-      if (free_index[v] >= 0) x.row(v) = sol->row(free_index[v]);
+      // Pinned vertices at 0, moved by the gauge.
+      if (free_index[v] >= 0) {
+        x.row(v) = rhs.row(free_index[v]);
+      } else {
+        x.row(v).setZero();
+      }
     }
   } else {
-    absl::StatusOr<Eigen::MatrixXd> sol = s.Solve(b);
-    if (!sol.ok()) return sol.status();
-    x = *sol;
+    rhs = b;
+    if (absl::Status st = s.SolveInPlace(&rhs, options.threads); !st.ok()) return st;
+    x = rhs;
   }
   Translate(centroid_target, &x);
   return x;
@@ -409,9 +428,9 @@ double Inbetweener::Impl::Evaluate(const Coords& x, const Problem& p, Coords* rh
                                    int* separated) const {
   static thread_local std::vector<Eigen::Matrix2d> targets;
   rhs->setZero(num_vertices(), 2);
-  double energy =
-      p.dynamic ? arap->LocalStepToRest(x, p.rest, &targets) : arap->LocalStep(x, *p.w, &targets);
-  arap->AddRhs(targets, rhs);
+  double energy = p.dynamic ? arap->LocalStepToRest(x, p.rest, &targets)
+                            : arap->LocalStep(x, *p.w, &targets, options.threads);
+  arap->AddRhs(targets, rhs, options.threads);
   if (cohesive->num_edges() > 0) {
     std::vector<char> open;
     energy += cohesive->LocalStep(x, *p.w, p.thresholds, rhs, &open);
@@ -476,8 +495,17 @@ absl::StatusOr<Coords> Inbetweener::Impl::Iterate(const Problem& p, Coords x, do
       }
     }
     if (!accepted) {
+      // Safeguard: the plain step minimizes a majorizer of E, so it cannot raise E except where
+      // the majorizer is inexact: W_C's direction xhat (S-eq.14) lagged at x_k for alpha != 1/2,
+      // and rounding near convergence. A step that would raise E is refused and the frame ends,
+      // so E never increases over the iterations (tested for alpha != 1/2).
+      int plain_separated = 0;
+      const double plain_energy = Evaluate(*g, p, &next_rhs, &plain_separated);
+      if (plain_energy > energy) break;
       x = *std::move(g);
-      energy = Evaluate(x, p, &rhs, &separated);
+      energy = plain_energy;
+      std::swap(rhs, next_rhs);
+      separated = plain_separated;
     }
     if (step <= displacement_limit ||
         previous_energy - energy <= options.convergence_tolerance * previous_energy) {
@@ -509,10 +537,11 @@ absl::StatusOr<Coords> Inbetweener::Impl::Alexa(const ExampleWeights& w) const {
   return GlobalSolve(solver, true, b, BlendedCentroids(w));
 }
 
-absl::Status Inbetweener::Impl::EnforceNonOverlap(Problem* p, Coords* x, const CancelToken* cancel,
-                                                  FrameReport* report) {
+absl::StatusOr<bool> Inbetweener::Impl::EnforceNonOverlap(Problem* p, Coords* x,
+                                                          const CancelToken* cancel,
+                                                          FrameReport* report) {
   std::vector<OverlapContact> contacts = overlap->Contacts(*x);
-  if (contacts.empty()) return absl::OkStatus();
+  if (contacts.empty()) return true;
   if (!contact_factored) {
     // Springs an order of magnitude stiffer than the material around a boundary vertex.
     double max_diagonal = 0.0;
@@ -539,8 +568,9 @@ absl::Status Inbetweener::Impl::EnforceNonOverlap(Problem* p, Coords* x, const C
     contacts = overlap->Contacts(*x);
   }
   p->contact = false;
+  const bool inside_free = contacts.empty();
   p->contacts.clear();
-  return absl::OkStatus();
+  return inside_free;
 }
 
 absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const Frame& previous,
@@ -553,20 +583,36 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
   if (!previous.vertices.empty()) prev = ToCoords(previous.vertices);
   p.thresholds = cohesive->Thresholds(prev ? &*prev : nullptr);
 
+  // Sequential playback: `previous` is the frame returned last and the weights moved little, so
+  // the warm start is the continuation of the last solve and the cold-start check is skipped.
+  bool trusted = false;
+  if (options.warm_start && options.warm_start_trust_radius > 0.0 && prev &&
+      last_weights.size() == w.size() && previous.vertices == last_frame) {
+    double moved = 0.0;
+    for (size_t i = 0; i < w.size(); ++i) moved += std::abs(w[i] - last_weights[i]);
+    trusted = 0.5 * moved <= options.warm_start_trust_radius;
+  }
+  Coords x, rhs;
+  double energy = std::numeric_limits<double>::infinity();
   // Start (a): the Alexa targets solved with the kZhu17 matrix (cohesive jumps pulled to 0).
-  std::vector<Eigen::Matrix2d> targets;
-  arap->AlexaTargets(w, &targets);
-  Coords b = Coords::Zero(num_vertices(), 2);
-  arap->AddRhs(targets, &b);
-  absl::StatusOr<Coords> cold = GlobalSolve(solver, true, b, p.group_centroids);
-  if (!cold.ok()) return cold.status();
-  Coords x = *std::move(cold);
-  Coords rhs;
-  double energy = Evaluate(x, p, &rhs, nullptr);
-  // Start (b): the previous frame in this frame's gauge.
+  auto cold_start = [&]() -> absl::Status {
+    std::vector<Eigen::Matrix2d> targets;
+    arap->AlexaTargets(w, &targets, options.threads);
+    Coords b = Coords::Zero(num_vertices(), 2);
+    arap->AddRhs(targets, &b, options.threads);
+    absl::StatusOr<Coords> cold = GlobalSolve(solver, true, b, p.group_centroids);
+    if (!cold.ok()) return cold.status();
+    x = *std::move(cold);
+    energy = Evaluate(x, p, &rhs, nullptr);
+    return absl::OkStatus();
+  };
+  if (!trusted) {
+    if (absl::Status s = cold_start(); !s.ok()) return s;
+  }
+  // Start (b): the previous frame, translated into this frame's gauge (the energy and the
+  // iteration are rotation-equivariant, so the rotation gauge is applied once, at the end).
   if (options.warm_start && prev) {
     Coords warm = *prev;
-    Rotate(w, &warm);
     Translate(p.group_centroids, &warm);
     Coords warm_rhs;
     const double warm_energy = Evaluate(warm, p, &warm_rhs, nullptr);
@@ -577,15 +623,21 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
       report->warm_started = true;
     }
   }
+  if (x.rows() == 0) {  // a trusted warm start that is not finite
+    if (absl::Status s = cold_start(); !s.ok()) return s;
+  }
   absl::StatusOr<Coords> solved = Iterate(p, std::move(x), energy, std::move(rhs), cancel, report);
   if (!solved.ok()) return solved.status();
   x = *std::move(solved);
   Rotate(w, &x);
   Translate(p.group_centroids, &x);
   if (options.prevent_overlap) {
-    if (absl::Status s = EnforceNonOverlap(&p, &x, cancel, report); !s.ok()) return s;
+    absl::StatusOr<bool> inside_free = EnforceNonOverlap(&p, &x, cancel, report);
+    if (!inside_free.ok()) return inside_free.status();
+    known_inside_free = *inside_free;
   }
   if (options.epsilon <= 0.0 || !prev) return x;
+  known_inside_free = false;
 
   // Dynamics (S-eq.28/29): x is Phi.
   const Coords& x1 = *prev;
@@ -656,6 +708,7 @@ absl::StatusOr<Frame> Inbetweener::Impl::Solve(const ExampleWeights& weights, co
 
   FrameReport local;
   Coords x;
+  known_inside_free = false;
   if (unit >= 0 && options.exact_keys) {
     x = shapes[unit];
   } else if (options.method == InterpMethod::kLinear) {
@@ -674,12 +727,13 @@ absl::StatusOr<Frame> Inbetweener::Impl::Solve(const ExampleWeights& weights, co
     local.energy = arap->Value(x, weights);
   }
   local.inverted = CountInverted(triangles, x);
-  local.overlaps = overlap->Count(x);
+  local.overlaps = known_inside_free ? overlap->Crossings(x) : overlap->Count(x);
   local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (report != nullptr) *report = local;
   Frame frame{ToPoints(x)};
   frame_before_last = std::move(last_frame);
   last_frame = frame.vertices;
+  last_weights = weights;
   return frame;
 }
 

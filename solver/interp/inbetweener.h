@@ -52,6 +52,17 @@ struct InbetweenOptions {
   double hysteresis = 0.1;
   // Non-overlap W_O (S-eq.8/9) enforced as a constraint in kZhu17 (overlap.h).
   bool prevent_overlap = true;
+  // Warm start without the cold-start check: when `previous` is the frame this object returned
+  // last and the weights moved by at most this much since (half their L1 distance, 0..1), the
+  // solve continues from `previous` alone; the Alexa start is computed only otherwise (first
+  // frame, scrubbing, a caller-made `previous`). 0 = always compare both starts: the default,
+  // because on smooth bends the Alexa start is within the tolerance after one iteration while the
+  // previous frame needs ~10 (bench_inbetween --trust 0.5: 2.7x slower frames on the bar).
+  double warm_start_trust_radius = 0.0;
+  // Threads for the local step, the right-hand side and the x/y back-substitutions (<= 0: all
+  // cores). Work is cut into fixed chunks reduced in a fixed order, so frames are bit-identical
+  // for every thread count; small meshes (< 8192 triangles / rows) stay on the caller's thread.
+  int threads = 1;
 };
 
 // Blend weights of the examples at one frame; they sum to 1.

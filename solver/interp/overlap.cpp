@@ -3,17 +3,18 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <utility>
 
 namespace inbetween::solver {
-namespace {
 
-using Box = Eigen::AlignedBox2d;
-
-// Median-split AABB tree over boxes; rebuilt per query set (positions change every frame).
-class Bvh {
+// Median-split AABB tree. The topology is built once (from the first positions seen: a continuous
+// deformation keeps neighbouring primitives near each other) and only the boxes are refit for
+// new positions, O(n) instead of the O(n log n) rebuild; a query's answer does not depend on the
+// topology, only its cost does.
+class OverlapChecker::Bvh {
  public:
   explicit Bvh(std::vector<Box> boxes) : boxes_(std::move(boxes)) {
     order_.resize(boxes_.size());
@@ -21,6 +22,24 @@ class Bvh {
     nodes_.reserve(2 * boxes_.size() / kLeaf + 2);
     if (!boxes_.empty()) Build(0, static_cast<int>(boxes_.size()));
   }
+
+  // New boxes for the same primitives: children follow their parent in nodes_, so one backward
+  // sweep refits every node.
+  void Refit(std::vector<Box> boxes) {
+    boxes_ = std::move(boxes);
+    for (int id = static_cast<int>(nodes_.size()) - 1; id >= 0; --id) {
+      Node& node = nodes_[id];
+      Box box;
+      if (node.left < 0) {
+        for (int k = node.begin; k < node.end; ++k) box.extend(boxes_[order_[k]]);
+      } else {
+        box = nodes_[node.left].box.merged(nodes_[node.right].box);
+      }
+      node.box = box;
+    }
+  }
+
+  const Box& box(int k) const { return boxes_[k]; }
 
   template <class F>
   void Query(const Box& q, F&& f) const {
@@ -77,6 +96,8 @@ class Bvh {
   std::vector<int> order_;
   std::vector<Node> nodes_;
 };
+
+namespace {
 
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
@@ -143,6 +164,20 @@ OverlapChecker::OverlapChecker(const std::vector<Triangle>& triangles,
   }
 }
 
+OverlapChecker::~OverlapChecker() = default;
+OverlapChecker::OverlapChecker(OverlapChecker&&) noexcept = default;
+OverlapChecker& OverlapChecker::operator=(OverlapChecker&&) noexcept = default;
+
+const OverlapChecker::Bvh& OverlapChecker::Tree(std::vector<Box> boxes,
+                                                std::unique_ptr<Bvh>* tree) const {
+  if (*tree == nullptr) {
+    *tree = std::make_unique<Bvh>(std::move(boxes));
+  } else {
+    (*tree)->Refit(std::move(boxes));
+  }
+  return **tree;
+}
+
 bool OverlapChecker::Exempt(int v, const Triangle& t) const {
   for (int u : t) {
     if (u == v) return true;
@@ -170,7 +205,7 @@ std::vector<std::pair<int, int>> OverlapChecker::Inside(const Coords& x) const {
   for (size_t t = 0; t < triangles_.size(); ++t) {
     for (int v : triangles_[t]) boxes[t].extend(P(x, v));
   }
-  const Bvh bvh(std::move(boxes));
+  const Bvh& bvh = Tree(std::move(boxes), &triangle_tree_);
   std::vector<std::pair<int, int>> inside;
   for (int v : boundary_vertices_) {
     const Eigen::Vector2d p = P(x, v);
@@ -191,11 +226,11 @@ int OverlapChecker::Crossings(const Coords& x) const {
     boxes[s].extend(P(x, segments_[s][0]));
     boxes[s].extend(P(x, segments_[s][1]));
   }
-  const Bvh bvh(boxes);
+  const Bvh& bvh = Tree(std::move(boxes), &segment_tree_);
   int crossings = 0;
   for (int s = 0; s < static_cast<int>(segments_.size()); ++s) {
     const auto [a, b] = segments_[s];
-    bvh.Query(boxes[s], [&](int r) {
+    bvh.Query(bvh.box(s), [&](int r) {
       if (r <= s) return;
       const auto [c, d] = segments_[r];
       if (Exempt(a, b, c, d)) return;

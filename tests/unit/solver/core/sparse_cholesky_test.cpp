@@ -48,6 +48,35 @@ TEST(SparseCholeskyTest, SolvesSpdSystemWithSeveralColumns) {
   EXPECT_LT((a * *x - b).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+TEST(SparseCholeskyTest, SolveInPlaceMatchesForAnyColumnCountAndReusesItsScratch) {
+  const Eigen::SparseMatrix<double> a = GridMatrix(15, 0.05);
+  SparseCholesky chol;
+  ASSERT_TRUE(chol.Compute(a).ok());
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int columns : {1, 2, 3, 5, 2, 1}) {  // scratch grows and shrinks
+    Eigen::MatrixXd x_true(a.rows(), columns);
+    for (Eigen::Index k = 0; k < x_true.size(); ++k) x_true.data()[k] = u(rng);
+    Eigen::MatrixXd b = a * x_true;
+    const Eigen::MatrixXd b0 = b;
+    ASSERT_TRUE(chol.SolveInPlace(&b).ok());
+    EXPECT_LT((b - x_true).cwiseAbs().maxCoeff(), 1e-11) << columns;
+    // Each column is solved exactly as on its own (columns do not mix).
+    for (int q = 0; q < columns; ++q) {
+      Eigen::MatrixXd single = b0.col(q);
+      ASSERT_TRUE(chol.SolveInPlace(&single).ok());
+      EXPECT_EQ(single.col(0), b.col(q));
+    }
+  }
+  Eigen::MatrixXd wrong(a.rows() + 1, 2);
+  EXPECT_EQ(chol.SolveInPlace(&wrong).code(), absl::StatusCode::kInvalidArgument);
+  Eigen::MatrixXd empty(a.rows(), 0);
+  EXPECT_TRUE(chol.SolveInPlace(&empty).ok());
+  SparseCholesky unfactored;
+  Eigen::MatrixXd b(4, 1);
+  EXPECT_EQ(unfactored.SolveInPlace(&b).code(), absl::StatusCode::kFailedPrecondition);
+}
+
 TEST(SparseCholeskyTest, RefactorsNewValuesOnTheAnalyzedPattern) {
   const Eigen::SparseMatrix<double> a = GridMatrix(8, 1.0);
   const Eigen::SparseMatrix<double> a2 = GridMatrix(8, 3.0, 2.0);  // same pattern
