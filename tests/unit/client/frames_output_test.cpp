@@ -5,8 +5,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
-#include "client/animate_command.h"
+#include "client/commands.h"
+#include "client/render/export.h"
 
 namespace inbetween::client {
 namespace {
@@ -50,7 +52,11 @@ TEST(FramesOutputTest, JsonHasTheDocumentedShape) {
 TEST(FramesOutputTest, WritesOneSvgPerFrameAndTheJson) {
   const auto dir = std::filesystem::temp_directory_path() / "inbetween_frames_output_test";
   std::filesystem::remove_all(dir);
-  ASSERT_TRUE(WriteFrames(dir, TwoFrames(), {.mesh_overlay = true}).ok());
+  render::ExportOptions options;
+  options.dir = dir;
+  options.formats = {"svg", "json"};
+  options.mesh_overlay = true;
+  ASSERT_TRUE(render::ExportFrames(ToFrameSet(TwoFrames()), options).ok());
   EXPECT_TRUE(std::filesystem::exists(dir / "frame_0000.svg"));
   EXPECT_TRUE(std::filesystem::exists(dir / "frame_0001.svg"));
   std::ifstream in(dir / "frames.json");
@@ -58,12 +64,14 @@ TEST(FramesOutputTest, WritesOneSvgPerFrameAndTheJson) {
   std::ifstream svg(dir / "frame_0001.svg");
   std::string text((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("viewBox"), std::string::npos);
-  EXPECT_NE(text.find("M0 0L2 0L0 1Z"), std::string::npos);
+  EXPECT_NE(text.find("M0 0L2 0L0 1Z"), std::string::npos) << text;
   std::filesystem::remove_all(dir);
 }
 
 TEST(FramesOutputTest, ReportsAnUnwritableDirectory) {
-  EXPECT_FALSE(WriteFrames("/proc/definitely/not/here", TwoFrames()).ok());
+  render::ExportOptions options;
+  options.dir = "/proc/definitely/not/here";
+  EXPECT_FALSE(render::ExportFrames(ToFrameSet(TwoFrames()), options).ok());
 }
 
 TEST(AnimateCommandTest, ExitCodesAreDocumentedOnes) {
@@ -71,6 +79,7 @@ TEST(AnimateCommandTest, ExitCodesAreDocumentedOnes) {
   EXPECT_EQ(ExitCodeFor(absl::InvalidArgumentError("x")), 3);
   EXPECT_EQ(ExitCodeFor(absl::UnavailableError("x")), 4);
   EXPECT_EQ(ExitCodeFor(absl::InternalError("x")), 5);
+  EXPECT_EQ(ExitCodeFor(absl::UnimplementedError("x")), 5);
   EXPECT_EQ(ExitCodeFor(absl::CancelledError("x")), 130);
 }
 
