@@ -20,6 +20,13 @@ struct Outline {
   Points points;
 };
 
+// A correspondence mark (S-Sec.1 "Boundary Tool"): marks with the same id in several drawings
+// pin corresponding boundary points (the boundary point nearest to `point` in each drawing).
+struct CorrespondenceMark {
+  int id = 0;
+  Point point = Point::Zero();
+};
+
 // One key drawing: its outlines in the drawing's user units (SVG y-down coordinates as given).
 struct Drawing {
   std::vector<Outline> outlines;
@@ -28,6 +35,9 @@ struct Drawing {
   // open a hole or a slit; both become cohesive edge pairs (solver/geometry/graph_flow.h).
   std::vector<Points> cuts;
   std::vector<Points> openings;
+  // Correspondence marks drawn with the drawing (e.g. SVG data-corr="N" elements), in document
+  // order. Used by BuildMultimesh when MultimeshOptions::marks is empty.
+  std::vector<CorrespondenceMark> marks;
 };
 
 }  // namespace inbetween::solver

@@ -13,7 +13,10 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <limits>
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,6 +30,7 @@
 #include <svgpp/svgpp.hpp>
 
 #include "absl/status/status.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "solver/geometry/polygon.h"
 
@@ -38,6 +42,8 @@ using Affine = Eigen::Matrix<double, 2, 3>;  // [A | t]
 
 constexpr char kSvgNamespace[] = "http://www.w3.org/2000/svg";
 constexpr int kMaxSubdivisionDepth = 18;
+constexpr int kMaxUseDepth = 8;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Our own error raised from inside SVG++ callbacks; SVG++ attaches the element to it.
 struct ImportError : virtual boost::exception, virtual std::exception {
@@ -88,8 +94,18 @@ void FlattenCubic(const Point& p0, const Point& p1, const Point& p2, const Point
 struct Collector {
   double tolerance = 0.05;
   std::vector<Outline> outlines;
-  std::vector<Points> cuts, openings;  // from class="cut" / class="opening" elements
+  std::vector<Points> cuts, openings;     // from class="cut" / class="opening" elements
+  std::vector<CorrespondenceMark> marks;  // from data-corr="N" elements
 };
+
+// The value of attribute `name`, or nullopt.
+std::optional<std::string> Attribute(xmlNode* node, const char* name) {
+  xmlChar* value = xmlGetProp(node, reinterpret_cast<const xmlChar*>(name));
+  if (value == nullptr) return std::nullopt;
+  std::string out = reinterpret_cast<const char*>(value);
+  xmlFree(value);
+  return out;
+}
 
 // Whether the element's class attribute lists `token` (whitespace-separated).
 bool HasClass(xmlNode* node, const std::string& token) {
@@ -127,7 +143,11 @@ class Context {
     ctm_(0, 0) = ctm_(1, 1) = 1.0;
   }
   Context(const Context& parent, xmlNode* node)
-      : collector_(parent.collector_), node_(node), ctm_(parent.ctm_), filled_(parent.filled_) {}
+      : collector_(parent.collector_),
+        node_(node),
+        ctm_(parent.ctm_),
+        filled_(parent.filled_),
+        evenodd_(parent.evenodd_) {}
 
   // Transform (SVG++ composes the attribute's list into one matrix [a b c d e f]).
   void transform_matrix(const boost::array<double, 6>& m) {
@@ -146,6 +166,10 @@ class Context {
   void set(sv::tag::attribute::fill, Args&&...) {
     filled_ = true;
   }
+  // fill-rule (inherited; SVG's initial value is nonzero).
+  void set(sv::tag::attribute::fill_rule, sv::tag::value::nonzero) { evenodd_ = false; }
+  void set(sv::tag::attribute::fill_rule, sv::tag::value::evenodd) { evenodd_ = true; }
+  void set(sv::tag::attribute::fill_rule, sv::tag::value::inherit) {}
 
   // Path events, absolute coordinates only (policy::path::minimal).
   void path_move_to(double x, double y, sv::tag::coordinate::absolute) {
@@ -178,6 +202,25 @@ class Context {
   void path_exit() {}
 
   void on_exit_element() {
+    // Correspondence marks (docs/svg-convention.md): the centre of the element's bounding box.
+    if (node_ != nullptr) {
+      if (std::optional<std::string> corr = Attribute(node_, "data-corr")) {
+        int id = 0;
+        if (!absl::SimpleAtoi(*corr, &id) || id < 0) {
+          throw ImportError(absl::StrCat("data-corr=\"", *corr, "\" is not a mark number"))
+              << ElementInfo(node_);
+        }
+        Point lo(kInf, kInf), hi(-kInf, -kInf);
+        for (const Subpath& subpath : subpaths_) {
+          for (const Point& p : Flatten(subpath)) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+        }
+        if (!(lo.x() <= hi.x())) {
+          throw ImportError("a data-corr mark needs some geometry") << ElementInfo(node_);
+        }
+        collector_->marks.push_back({id, 0.5 * (lo + hi)});
+        return;
+      }
+    }
     // Topology edits (docs/svg-convention.md): class="cut" / class="opening" elements are open
     // polylines whatever their paint; they never become outlines.
     const bool cut = node_ != nullptr && HasClass(node_, "cut");
@@ -193,7 +236,10 @@ class Context {
       return;
     }
     if (!filled_) return;
-    for (const Subpath& subpath : subpaths_) Emit(subpath);
+    std::vector<Outline> outlines;
+    for (const Subpath& subpath : subpaths_) Emit(subpath, &outlines);
+    if (!evenodd_) DropNonzeroInnerBoundaries(&outlines);
+    for (Outline& o : outlines) collector_->outlines.push_back(std::move(o));
   }
 
  private:
@@ -238,8 +284,33 @@ class Context {
     return out;
   }
 
+  // fill-rule nonzero: a subpath nested in this element's others is a boundary only if the
+  // winding number changes between zero and non-zero across it (a same-direction subpath inside
+  // a filled one is filled on both sides and dropped). Subpaths that cross are left as they
+  // are (the boundary builder reports crossing outlines).
+  static void DropNonzeroInnerBoundaries(std::vector<Outline>* outlines) {
+    const size_t n = outlines->size();
+    if (n < 2) return;
+    std::vector<int> sign(n);
+    for (size_t i = 0; i < n; ++i) sign[i] = PolygonSignedArea((*outlines)[i].points) > 0 ? 1 : -1;
+    std::vector<bool> boundary(n);
+    for (size_t i = 0; i < n; ++i) {
+      int winding = sign[i];  // just inside outline i
+      const Point probe = (*outlines)[i].points[0];
+      for (size_t j = 0; j < n; ++j) {
+        if (j != i && PolygonContains((*outlines)[j].points, probe)) winding += sign[j];
+      }
+      boundary[i] = (winding != 0) != (winding - sign[i] != 0);
+    }
+    std::vector<Outline> kept;
+    for (size_t i = 0; i < n; ++i) {
+      if (boundary[i]) kept.push_back(std::move((*outlines)[i]));
+    }
+    *outlines = std::move(kept);
+  }
+
   // Flattens and closes one subpath; keeps it when it encloses some area.
-  void Emit(const Subpath& subpath) const {
+  void Emit(const Subpath& subpath, std::vector<Outline>* outlines) const {
     // A fill closes every subpath implicitly; drop the repeated closing point.
     Outline outline;
     outline.points = Flatten(subpath);
@@ -247,14 +318,15 @@ class Context {
       outline.points.pop_back();
     }
     if (outline.points.size() >= 3 && PolygonSignedArea(outline.points) != 0.0) {
-      collector_->outlines.push_back(std::move(outline));
+      outlines->push_back(std::move(outline));
     }
   }
 
   Collector* collector_;
   xmlNode* node_;
   Affine ctm_;
-  bool filled_ = true;  // SVG's initial fill is black
+  bool filled_ = true;    // SVG's initial fill is black
+  bool evenodd_ = false;  // SVG's initial fill-rule is nonzero
   std::vector<Subpath> subpaths_;
   Point pen_ = Point::Zero();
   bool open_ = false;
@@ -296,9 +368,12 @@ using ProcessedAttributes =
     boost::mpl::insert<boost::mpl::insert<sv::traits::shapes_attributes_by_element,
                                           sv::tag::attribute::transform>::type,
                        sv::tag::attribute::fill>::type;
+using ProcessedAttributesWithFillRule =
+    boost::mpl::insert<ProcessedAttributes, sv::tag::attribute::fill_rule>::type;
 
 using Traversal = sv::document_traversal<
-    sv::processed_elements<ProcessedElements>, sv::processed_attributes<ProcessedAttributes>,
+    sv::processed_elements<ProcessedElements>,
+    sv::processed_attributes<ProcessedAttributesWithFillRule>,
     sv::context_factories<ContextFactories>, sv::path_policy<sv::policy::path::minimal>,
     sv::basic_shapes_policy<sv::policy::basic_shapes::all_to_path>, sv::error_policy<ErrorPolicy>>;
 
@@ -340,6 +415,71 @@ void AdoptSvgNamespace(xmlNode* root) {
   }
 }
 
+// Replaces every <use href="#id" x y transform> by a <g transform="... translate(x y)"> holding
+// a deep copy of the referenced element (ids dropped from the copy), repeatedly so that copies
+// holding <use> expand too. Returns the <use> that cannot be expanded, with the reason.
+std::optional<std::pair<xmlNode*, std::string>> ExpandUses(xmlDoc* doc, xmlNode* root) {
+  for (int depth = 0;; ++depth) {
+    std::map<std::string, xmlNode*> by_id;
+    std::vector<xmlNode*> uses, stack = {root};
+    while (!stack.empty()) {
+      xmlNode* node = stack.back();
+      stack.pop_back();
+      if (node->type != XML_ELEMENT_NODE) continue;
+      if (std::optional<std::string> id = Attribute(node, "id")) by_id.emplace(*id, node);
+      if (xmlStrcmp(node->name, reinterpret_cast<const xmlChar*>("use")) == 0) {
+        uses.push_back(node);
+        continue;
+      }
+      for (xmlNode* child = node->children; child; child = child->next) stack.push_back(child);
+    }
+    if (uses.empty()) return std::nullopt;
+    if (depth >= kMaxUseDepth) {
+      return std::make_pair(uses[0], "<use> nested too deeply (or referencing itself)");
+    }
+    for (xmlNode* use : uses) {
+      std::optional<std::string> href = Attribute(use, "href");
+      if (!href) {
+        xmlChar* x = xmlGetNsProp(use, reinterpret_cast<const xmlChar*>("href"),
+                                  reinterpret_cast<const xmlChar*>("http://www.w3.org/1999/xlink"));
+        if (x != nullptr) href = reinterpret_cast<const char*>(x), xmlFree(x);
+      }
+      if (!href || href->size() < 2 || (*href)[0] != '#') {
+        return std::make_pair(use, "<use> needs href=\"#id\" of an element in the document");
+      }
+      auto it = by_id.find(href->substr(1));
+      if (it == by_id.end()) {
+        return std::make_pair(use, absl::StrCat("<use> references unknown id \"", *href, "\""));
+      }
+      std::string transform = Attribute(use, "transform").value_or("");
+      const std::string x = Attribute(use, "x").value_or("0"),
+                        y = Attribute(use, "y").value_or("0");
+      absl::StrAppend(&transform, " translate(", x, " ", y, ")");
+      xmlNode* group = xmlNewDocNode(doc, use->ns, reinterpret_cast<const xmlChar*>("g"), nullptr);
+      xmlSetProp(group, reinterpret_cast<const xmlChar*>("transform"),
+                 reinterpret_cast<const xmlChar*>(transform.c_str()));
+      for (const char* inherited : {"fill", "fill-rule", "class", "style"}) {
+        if (std::optional<std::string> v = Attribute(use, inherited)) {
+          xmlSetProp(group, reinterpret_cast<const xmlChar*>(inherited),
+                     reinterpret_cast<const xmlChar*>(v->c_str()));
+        }
+      }
+      xmlNode* copy = xmlDocCopyNode(it->second, doc, 1);
+      std::vector<xmlNode*> strip = {copy};
+      while (!strip.empty()) {
+        xmlNode* node = strip.back();
+        strip.pop_back();
+        if (node->type != XML_ELEMENT_NODE) continue;
+        xmlUnsetProp(node, reinterpret_cast<const xmlChar*>("id"));
+        for (xmlNode* child = node->children; child; child = child->next) strip.push_back(child);
+      }
+      xmlAddChild(group, copy);
+      xmlReplaceNode(use, group);
+      xmlFreeNode(use);
+    }
+  }
+}
+
 }  // namespace
 
 absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOptions& options) {
@@ -372,6 +512,10 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
                      ": entity references are not supported (never expanded)"));
   }
   AdoptSvgNamespace(root);
+  if (auto bad = ExpandUses(doc.get(), root)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("SVG element ", Describe(bad->first), ": ", bad->second));
+  }
 
   Collector collector;
   collector.tolerance = options.tolerance;
@@ -396,6 +540,7 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   drawing.outlines = std::move(collector.outlines);
   drawing.cuts = std::move(collector.cuts);
   drawing.openings = std::move(collector.openings);
+  drawing.marks = std::move(collector.marks);
   return drawing;
 }
 

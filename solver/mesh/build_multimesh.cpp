@@ -9,6 +9,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -16,6 +17,7 @@
 #include "solver/geometry/graph_flow.h"
 #include "solver/mesh/cgal_triangulate.h"
 #include "solver/mesh/map_to_boundary.h"
+#include "solver/mesh/refine_boundary_fans.h"
 #include "solver/mesh/split_boundary_chords.h"
 #include "solver/mesh/validate.h"
 
@@ -134,6 +136,41 @@ void SplitBoundaryEdge(CutMesh* mesh, const std::vector<int>& next_edge_start, i
   }
 }
 
+// Drawing::marks -> MultimeshOptions::marks layout (marks[m][d]), ordered by mark id. A mark id
+// must appear once in every drawing or in none.
+absl::StatusOr<std::vector<std::vector<Point>>> MarksFromDrawings(
+    const std::vector<Drawing>& drawings) {
+  std::map<int, std::vector<std::optional<Point>>> by_id;
+  const int n = static_cast<int>(drawings.size());
+  for (int d = 0; d < n; ++d) {
+    for (const CorrespondenceMark& mark : drawings[d].marks) {
+      auto& points = by_id[mark.id];
+      points.resize(n);
+      if (points[d]) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("drawing ", d + 1, ": correspondence mark ", mark.id, " appears twice"));
+      }
+      points[d] = mark.point;
+    }
+  }
+  std::vector<std::vector<Point>> marks;
+  for (const auto& [id, points] : by_id) {
+    std::vector<Point> mark;
+    for (int d = 0; d < n; ++d) {
+      if (!points[d]) {
+        const int has = static_cast<int>(std::find_if(points.begin(), points.end(),
+                                                      [](const auto& p) { return p.has_value(); }) -
+                                         points.begin());
+        return absl::InvalidArgumentError(absl::StrCat(
+            "correspondence mark ", id, " is in drawing ", has + 1, " but not in drawing ", d + 1));
+      }
+      mark.push_back(*points[d]);
+    }
+    marks.push_back(std::move(mark));
+  }
+  return marks;
+}
+
 }  // namespace
 
 absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
@@ -176,6 +213,11 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   correspondence_options.vertices = options.boundary_vertices;
   correspondence_options.corner_angle_degrees = options.corner_angle_degrees;
   correspondence_options.marks = options.marks;
+  if (options.marks.empty()) {
+    absl::StatusOr<std::vector<std::vector<Point>>> drawn = MarksFromDrawings(drawings);
+    if (!drawn.ok()) return drawn.status();
+    correspondence_options.marks = *std::move(drawn);
+  }
   absl::StatusOr<BoundaryCorrespondence> bc =
       ComputeBoundaryCorrespondence(graphs, correspondence_options);
   if (!bc.ok()) return bc.status();
@@ -206,14 +248,28 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     return bc->shapes[d][g][e - bc->loop_start[g]];
   };
 
+  // The drawing meshed first: the one with the most closed cut/opening sides. Opening a slit
+  // (mapping out of the closed drawing) only widens angles, while closing a hole onto a slit
+  // asks the mesh for 2*pi at the slit tips; RefineBoundaryFans covers what remains.
+  int ref = 0;
+  {
+    int best = -1;
+    for (int d = 0; d < num_shapes; ++d) {
+      const int closed = static_cast<int>(std::count_if(
+          bc->edge_twin[d].begin(), bc->edge_twin[d].end(), [](int f) { return f >= 0; }));
+      if (closed > best) best = closed, ref = d;
+    }
+  }
+
   if (cancelled()) return absl::CancelledError("BuildMultimesh cancelled");
-  notify("triangulate", 0.1, absl::StrCat("drawing 1, ", num_edges, " boundary vertices"));
+  notify("triangulate", 0.1,
+         absl::StrCat("drawing ", ref + 1, ", ", num_edges, " boundary vertices"));
   TriangulateOptions triangulate_options;
   triangulate_options.shape_bound = options.shape_bound;
   {
-    Point lo = bc->shapes[0][0][0], hi = lo;
+    Point lo = bc->shapes[ref][0][0], hi = lo;
     double perimeter = 0.0;
-    for (const Points& loop : bc->shapes[0]) {
+    for (const Points& loop : bc->shapes[ref]) {
       for (size_t i = 0; i < loop.size(); ++i) {
         lo = lo.cwiseMin(loop[i]), hi = hi.cwiseMax(loop[i]);
         perimeter += (loop[(i + 1) % loop.size()] - loop[i]).norm();
@@ -224,10 +280,10 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
                                        : 1.5 * perimeter / num_edges;  // about the spacing
   }
   absl::StatusOr<DomainTriangulation> triangulation =
-      CgalTriangulateDomain(bc->shapes[0], triangulate_options);
+      CgalTriangulateDomain(bc->shapes[ref], triangulate_options);
   if (!triangulation.ok()) {
     return absl::Status(triangulation.status().code(),
-                        absl::StrCat("drawing 1: ", triangulation.status().message()));
+                        absl::StrCat("drawing ", ref + 1, ": ", triangulation.status().message()));
   }
   CutMesh cut = CutAlongSeams(*triangulation, *bc);
 
@@ -263,8 +319,6 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     mesh.boundary_loops.push_back(std::move(loop));
   }
   SplitBoundaryChords(&cut.vertices, &cut.triangles, &is_boundary);
-  mesh.triangles = cut.triangles;
-  const int num_vertices = static_cast<int>(cut.vertices.size());
 
   // Targets per drawing: boundary vertices at their edge parameter, twins made exactly equal.
   auto targets_of = [&](int d) {
@@ -288,6 +342,26 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     return target;
   };
 
+  // Widest interior angle each boundary vertex must take in any drawing; fans too small for it
+  // get more triangles.
+  {
+    std::vector<double> demand(cut.vertices.size(), 0.0);
+    for (int d = 0; d < num_shapes; ++d) {
+      const Points target = targets_of(d);
+      for (const std::vector<int>& loop : mesh.boundary_loops) {
+        for (size_t k = 0; k < loop.size(); ++k) {
+          const int prev = loop[(k + loop.size() - 1) % loop.size()];
+          const int next = loop[(k + 1) % loop.size()];
+          demand[loop[k]] = std::max(
+              demand[loop[k]], BoundaryInteriorAngle(target[prev], target[loop[k]], target[next]));
+        }
+      }
+    }
+    RefineBoundaryFans(demand, &cut.vertices, &cut.triangles, &is_boundary);
+  }
+  mesh.triangles = cut.triangles;
+  const int num_vertices = static_cast<int>(cut.vertices.size());
+
   // Connected components, each mapped on its own.
   UnionFind components(num_vertices);
   for (const Triangle& t : mesh.triangles)
@@ -296,10 +370,12 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   for (int g = 0; g < bc->num_loops(); ++g) {
     loops_of_component[components.Find(mesh.boundary_loops[g][0])].push_back(g);
   }
-  mesh.shapes.push_back(targets_of(0));
-  for (int d = 1; d < num_shapes; ++d) {
+  mesh.shapes.assign(num_shapes, {});
+  mesh.shapes[ref] = targets_of(ref);
+  for (int d = 0, done = 0; d < num_shapes; ++d) {
+    if (d == ref) continue;
     if (cancelled()) return absl::CancelledError("BuildMultimesh cancelled");
-    notify("map", 0.2 + 0.75 * (d - 1) / (num_shapes - 1), absl::StrCat("drawing ", d + 1));
+    notify("map", 0.2 + 0.75 * done++ / (num_shapes - 1), absl::StrCat("drawing ", d + 1));
     Points shape = targets_of(d);
     const Points target = shape;
     for (const auto& [root, loops] : loops_of_component) {
@@ -316,7 +392,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
         triangles.push_back(lt);
       }
       Points source;
-      for (int v : global) source.push_back(mesh.shapes[0][v]);
+      for (int v : global) source.push_back(mesh.shapes[ref][v]);
       std::vector<int> boundary;
       Points target_boundary;
       for (int g : loops) {
@@ -331,12 +407,13 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
           MapToBoundary(source, triangles, boundary, target_boundary, map_options, cancel);
       if (!mapped.ok()) {
         if (absl::IsCancelled(mapped.status())) return mapped.status();
-        return absl::FailedPreconditionError(absl::StrCat(
-            "cannot map drawing 1's mesh into drawing ", d + 1, ": ", mapped.status().message()));
+        return absl::FailedPreconditionError(absl::StrCat("cannot map drawing ", ref + 1,
+                                                          "'s mesh into drawing ", d + 1, ": ",
+                                                          mapped.status().message()));
       }
       for (size_t i = 0; i < global.size(); ++i) shape[global[i]] = (*mapped)[i];
     }
-    mesh.shapes.push_back(std::move(shape));
+    mesh.shapes[d] = std::move(shape);
   }
 
   // Cohesive edges: sub-edges of twin edges, closed in the drawings where they are collocated.

@@ -14,13 +14,15 @@ namespace inbetween::solver {
 struct MultimeshOptions {
   // Target number of boundary vertices per shape; 0 = choose from the shapes' size (about 64).
   int boundary_vertices = 0;
-  // Max triangle edge length relative to the bounding-box diagonal of shape 1 (0 = automatic).
+  // Max triangle edge length relative to the bounding-box diagonal of the meshed drawing
+  // (0 = automatic: about the boundary spacing).
   double max_edge_relative = 0.0;
   // CGAL Delaunay_mesh_size_criteria_2 shape bound B (0.125 is a minimum angle of ~20.7 deg).
   double shape_bound = 0.125;
   // Correspondence marks: marks[m][d] is mark m's point in drawing d (one point per drawing).
   // Each pins a boundary point across drawings; between marks, boundaries are reparameterized
-  // with equal vertex counts (solver/geometry/boundary_correspondence.h). Empty = automatic.
+  // with equal vertex counts (solver/geometry/boundary_correspondence.h). Empty = the drawings'
+  // own marks (Drawing::marks, matched by id), and automatic when they have none.
   std::vector<std::vector<Point>> marks;
   // Boundary vertices turning by more than this many degrees are kept as mesh vertices.
   double corner_angle_degrees = 30.0;
@@ -37,12 +39,14 @@ struct MultimeshReport {
 };
 
 // Builds one compatible mesh across all drawings (>= 2): S-Alg.1 boundaries of each drawing
-// (outlines, cuts, openings), loop matching and compatible reparameterization, CGAL mesh of
-// drawing 1 (holes, several components, cut sides duplicated into cohesive edge pairs), boundary
-// Steiner points mirrored across every cohesive zone, then an injective map of each component
-// into every other drawing. Drawings are named 1-based in messages ("drawing 2"). Errors:
-// INVALID_ARGUMENT naming the drawing and what is wrong (including drawings of different
-// equivalence class), FAILED_PRECONDITION when a shape cannot be reached, CANCELLED.
+// (outlines, cuts, openings), loop matching and compatible reparameterization, CGAL mesh of one
+// drawing (the one with the most closed cut/opening sides, else drawing 1; holes, several
+// components, cut sides duplicated into cohesive edge pairs), boundary Steiner points mirrored
+// across every cohesive zone, fans widened where a boundary angle must open up to 2*pi
+// (refine_boundary_fans.h), then an injective map of each component into every other drawing.
+// Drawings are named 1-based in messages ("drawing 2"). Errors: INVALID_ARGUMENT naming the drawing
+// and what is wrong (including drawings of different equivalence class), FAILED_PRECONDITION when a
+// shape cannot be reached, CANCELLED.
 absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
                                          const MultimeshOptions& options,
                                          const CancelToken* cancel = nullptr,

@@ -18,6 +18,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <memory>
 
 #include "absl/strings/str_cat.h"
 #include "solver/geometry/polygon.h"
@@ -99,7 +101,7 @@ class Mapper {
   bool ProxySolve(const Points& x, const Constraints& c, Points* out) const {
     const int nf = c.free_count;
     std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(triangles_.size() * 4 * 36 + 2 * boundary_.size());
+    entries.reserve(triangles_.size() * 36 + 2 * boundary_.size());
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * nf);
     for (size_t t = 0; t < triangles_.size(); ++t) {
       const Eigen::Matrix2d j = Jacobian(t, x);
@@ -117,31 +119,37 @@ class Mapper {
       }
       const Eigen::Matrix2d weight = u * w.asDiagonal() * u.transpose();
       const Eigen::Matrix2d target = weight * (u * v.transpose());
+      // Local 6 x 6 system over (dimension, corner), then one triplet per free pair.
       const double a = frames_[t].area;
+      Eigen::Matrix<double, 6, 6> local = Eigen::Matrix<double, 6, 6>::Zero();
+      Eigen::Matrix<double, 6, 1> local_rhs = Eigen::Matrix<double, 6, 1>::Zero();
       for (int r = 0; r < 2; ++r) {
         for (int col = 0; col < 2; ++col) {
-          int index[6];
-          double coef[6];
-          double constant = target(r, col);
-          int m = 0;
+          Eigen::Matrix<double, 6, 1> coef;
           for (int sdim = 0; sdim < 2; ++sdim) {
-            for (int k = 0; k < 3; ++k) {
-              const int vtx = triangles_[t][k];
-              const double cf = weight(r, sdim) * frames_[t].grad(k, col);
-              if (c.free_index[vtx] < 0) {
-                constant -= cf * c.fixed_at[vtx](sdim);
-              } else {
-                index[m] = sdim * nf + c.free_index[vtx];
-                coef[m++] = cf;
-              }
-            }
+            for (int k = 0; k < 3; ++k)
+              coef(3 * sdim + k) = weight(r, sdim) * frames_[t].grad(k, col);
           }
-          for (int p = 0; p < m; ++p) {
-            rhs(index[p]) += a * coef[p] * constant;
-            for (int q = 0; q < m; ++q)
-              entries.emplace_back(index[p], index[q], a * coef[p] * coef[q]);
+          local.noalias() += a * coef * coef.transpose();
+          local_rhs += a * target(r, col) * coef;
+        }
+      }
+      int index[6];
+      for (int q = 0; q < 6; ++q) {
+        const int vtx = triangles_[t][q % 3];
+        index[q] = c.free_index[vtx] < 0 ? -1 : (q / 3) * nf + c.free_index[vtx];
+      }
+      for (int p = 0; p < 6; ++p) {
+        if (index[p] < 0) continue;
+        double value = local_rhs(p);
+        for (int q = 0; q < 6; ++q) {
+          if (index[q] >= 0) {
+            entries.emplace_back(index[p], index[q], local(p, q));
+          } else {
+            value -= local(p, q) * c.fixed_at[triangles_[t][q % 3]](q / 3);
           }
         }
+        rhs(index[p]) += value;
       }
     }
     if (c.penalty > 0) {
@@ -156,7 +164,18 @@ class Mapper {
     }
     Eigen::SparseMatrix<double> h(2 * nf, 2 * nf);
     h.setFromTriplets(entries.begin(), entries.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(h);
+    // The sparsity pattern depends only on which vertices are free: analyse it once per
+    // constraint set (the ordering is most of a small factorization's cost) and refactor the
+    // numbers each iteration.
+    Cached& cached = cache_[&c];
+    if (cached.size != 2 * nf || cached.nonzeros != h.nonZeros()) {
+      cached.solver = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>();
+      cached.solver->analyzePattern(h);
+      cached.size = 2 * nf;
+      cached.nonzeros = h.nonZeros();
+    }
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& solver = *cached.solver;
+    solver.factorize(h);
     if (solver.info() != Eigen::Success) return false;
     const Eigen::VectorXd sol = solver.solve(rhs);
     if (solver.info() != Eigen::Success || !sol.allFinite()) return false;
@@ -222,6 +241,12 @@ class Mapper {
   }
 
  private:
+  struct Cached {
+    std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> solver;
+    int size = -1;
+    Eigen::Index nonzeros = -1;
+  };
+  mutable std::map<const Constraints*, Cached> cache_;
   const std::vector<Triangle>& triangles_;
   const std::vector<int>& boundary_;
   const Points& target_;
@@ -316,10 +341,16 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
 
   Points x;
   bool placed = false;
-  if (options.tutte_when_convex && IsConvexPositive(target_boundary) &&
-      TutteEmbedding(source, triangles, boundary, target_boundary, &x) &&
-      CountInverted(triangles, x) == 0) {
-    rep.tutte = placed = true;
+  const bool convex = IsConvexPositive(target_boundary);
+  if (((options.tutte_when_convex && convex) || options.tutte_first_always) &&
+      TutteEmbedding(source, triangles, boundary, target_boundary, &x)) {
+    // Non-convex targets: keep it only if no triangle is folded or nearly flat (relative to
+    // its source area), so the polish's barrier starts from a sound map.
+    bool sound = CountInverted(triangles, x) == 0;
+    for (size_t t = 0; sound && !convex && t < triangles.size(); ++t) {
+      sound = SignedArea2(triangles[t], x) > 1e-6 * SignedArea2(triangles[t], source);
+    }
+    rep.tutte = placed = sound;
   }
 
   if (!placed) {

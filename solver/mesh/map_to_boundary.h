@@ -1,5 +1,6 @@
-// Injective map of a triangle mesh into a new boundary: Tutte embedding for convex targets,
-// otherwise a LIM-style progressive boundary pull under a symmetric Dirichlet barrier.
+// Injective map of a triangle mesh into a new boundary: Tutte embedding for convex targets (and
+// tried for any target), otherwise a LIM-style progressive boundary pull under a symmetric
+// Dirichlet barrier.
 #pragma once
 
 #include <vector>
@@ -22,6 +23,10 @@ struct MapToBoundaryOptions {
   double boundary_tolerance = 1e-6;
   // Try the mean-value Tutte embedding first when the target boundary is convex.
   bool tutte_when_convex = true;
+  // Also try it when the target is not convex (or has several loops), and keep it when no
+  // triangle folds (then only the polish runs): much cheaper than the progressive pull, which
+  // remains the fallback.
+  bool tutte_first_always = true;
 };
 
 struct MapToBoundaryReport {

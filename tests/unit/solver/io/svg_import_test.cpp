@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "solver/geometry/polygon.h"
@@ -128,9 +129,9 @@ TEST(SvgImportTest, BasicShapes) {
 }
 
 TEST(SvgImportTest, HolesAreNegativeByNestingDepth) {
-  // Outer square, a hole (drawn in the same direction), and an island inside the hole.
+  // Outer square, a hole (drawn in the same direction, so evenodd), an island inside the hole.
   Drawing d =
-      ImportOk(Svg("<path d=\"M0 0 H100 V100 H0 Z M20 20 H80 V80 H20 Z\"/>"
+      ImportOk(Svg("<path fill-rule=\"evenodd\" d=\"M0 0 H100 V100 H0 Z M20 20 H80 V80 H20 Z\"/>"
                    "<circle cx=\"50\" cy=\"50\" r=\"10\"/>"
                    "<rect x=\"150\" y=\"0\" width=\"10\" height=\"10\"/>"));
   ASSERT_EQ(d.outlines.size(), 4u);
@@ -244,6 +245,89 @@ TEST(SvgImportTest, CutAndOpeningClassesBecomePolylines) {
   EXPECT_EQ(d->cuts[0], (Points{{5, -1}, {5, 11}}));
   ASSERT_EQ(d->openings.size(), 1u);
   EXPECT_EQ(d->openings[0].size(), 3u);
+}
+
+TEST(SvgImportTest, FillRuleNonzeroKeepsOnlyWindingChanges) {
+  // nonzero (SVG's default): an inner subpath drawn the same way is filled on both sides.
+  EXPECT_EQ(ImportOk(Svg("<path d=\"M0 0 H100 V100 H0 Z M20 20 H80 V80 H20 Z\"/>")).outlines.size(),
+            1u);
+  // Drawn the other way it is a hole under both rules.
+  for (const char* rule : {"nonzero", "evenodd"}) {
+    Drawing d = ImportOk(Svg(std::string("<path fill-rule=\"") + rule +
+                             "\" d=\"M0 0 H100 V100 H0 Z M20 20 V80 H80 V20 Z\"/>"));
+    ASSERT_EQ(d.outlines.size(), 2u) << rule;
+    EXPECT_LT(PolygonSignedArea(d.outlines[1].points), 0) << rule;
+  }
+  // Inherited from a group; an island inside a same-direction ring stays under evenodd.
+  Drawing d =
+      ImportOk(Svg("<g fill-rule=\"evenodd\"><path d=\"M0 0 H100 V100 H0 Z M20 20 H80 V80 H20 Z "
+                   "M40 40 H60 V60 H40 Z\"/></g>"));
+  EXPECT_EQ(d.outlines.size(), 3u);
+  Drawing nonzero =
+      ImportOk(Svg("<path d=\"M0 0 H100 V100 H0 Z M20 20 V80 H80 V20 Z M40 40 H60 V60 H40 Z\"/>"));
+  EXPECT_EQ(nonzero.outlines.size(), 3u);  // windings 1 | 0 | 1
+}
+
+TEST(SvgImportTest, UseElementsAreExpanded) {
+  Drawing d = ImportOk(R"svg(<svg xmlns="http://www.w3.org/2000/svg"
+      xmlns:xlink="http://www.w3.org/1999/xlink">
+    <defs><g id="tile"><rect width="10" height="10"/></g></defs>
+    <use href="#tile" x="100" y="0"/>
+    <use xlink:href="#tile" transform="translate(0 50) scale(2)" y="5"/>
+    <rect id="base" x="0" y="0" width="4" height="4"/>
+    <use href="#base" x="20"/>
+  </svg>)svg");
+  ASSERT_EQ(d.outlines.size(), 4u);
+  ExpectBox(d.outlines[0].points, 100, 0, 110, 10);
+  ExpectBox(d.outlines[1].points, 0, 60, 20, 80);
+  ExpectBox(d.outlines[2].points, 0, 0, 4, 4);
+  ExpectBox(d.outlines[3].points, 20, 0, 24, 4);
+  absl::StatusOr<Drawing> unknown =
+      ImportSvg(Svg("<rect width=\"5\" height=\"5\"/>"
+                    "<use id=\"u\" href=\"#nothing\"/>"));
+  EXPECT_EQ(unknown.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(unknown.status().message(), HasSubstr("<use id=\"u\">"));
+  EXPECT_THAT(unknown.status().message(), HasSubstr("unknown id"));
+  absl::StatusOr<Drawing> loop =
+      ImportSvg(Svg("<rect width=\"5\" height=\"5\"/>"
+                    "<g id=\"a\"><use href=\"#a\"/></g>"));
+  EXPECT_EQ(loop.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(loop.status().message(), HasSubstr("nested too deeply"));
+}
+
+TEST(SvgImportTest, DataCorrElementsBecomeMarks) {
+  Drawing d =
+      ImportOk(Svg("<rect width=\"50\" height=\"50\"/>"
+                   "<g transform=\"translate(10 20)\">"
+                   "<circle data-corr=\"3\" cx=\"40\" cy=\"0\" r=\"2\" fill=\"red\"/></g>"
+                   "<rect class=\"mark\" data-corr=\"1\" x=\"-1\" y=\"9\" width=\"2\" "
+                   "height=\"2\"/>"));
+  ASSERT_EQ(d.outlines.size(), 1u);  // marks are never outlines
+  ASSERT_EQ(d.marks.size(), 2u);
+  EXPECT_EQ(d.marks[0].id, 3);
+  EXPECT_NEAR((d.marks[0].point - Point(50, 20)).norm(), 0, 1e-9);
+  EXPECT_EQ(d.marks[1].id, 1);
+  EXPECT_NEAR((d.marks[1].point - Point(0, 10)).norm(), 0, 1e-9);
+  absl::StatusOr<Drawing> bad =
+      ImportSvg(Svg("<rect width=\"5\" height=\"5\"/><circle id=\"m\" data-corr=\"x\" r=\"1\"/>"));
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(bad.status().message(), HasSubstr("<circle id=\"m\">"));
+  EXPECT_THAT(bad.status().message(), HasSubstr("not a mark number"));
+}
+
+TEST(SvgImportTest, AllExampleDrawingsImport) {
+  namespace fs = std::filesystem;
+  int files = 0;
+  for (const auto& entry :
+       fs::recursive_directory_iterator(fs::path(INBETWEEN_SOURCE_DIR) / "examples")) {
+    if (entry.path().extension() != ".svg") continue;
+    const std::string relative =
+        fs::relative(entry.path(), fs::path(INBETWEEN_SOURCE_DIR) / "examples").string();
+    Drawing d = ImportOk(ReadExample(relative));
+    EXPECT_FALSE(d.outlines.empty()) << relative;
+    ++files;
+  }
+  EXPECT_GT(files, 20);
 }
 
 }  // namespace

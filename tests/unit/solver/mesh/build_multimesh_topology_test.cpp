@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <utility>
 
 #include "solver/geometry/polygon.h"
 #include "solver/mesh/build_multimesh.h"
@@ -79,9 +81,9 @@ TEST(BuildMultimeshTopologyTest, ClosedMouthOpensThroughAnOpening) {
   closed.openings = {{{-5, 2}, {0, 2.5}, {5, 2}}};
   open.outlines = {{Circle({0, 0}, 10, 64)}};
   open.outlines.push_back({{{-5, 2}, {0, 0}, {5, 2}, {0, 5}}});  // the open mouth
-  // Known limitation: meshing the open mouth first and collapsing its hole onto the slit fails
-  // in the exact boundary placement of MapToBoundary (issue 4 follow-up), so only this order.
-  for (const auto& drawings : {std::vector<Drawing>{closed, open}}) {
+  // Both orders: meshing the open mouth first means collapsing its hole onto the slit.
+  for (const auto& drawings :
+       {std::vector<Drawing>{closed, open}, std::vector<Drawing>{open, closed}}) {
     absl::StatusOr<Multimesh> m = BuildMultimesh(drawings, {});
     ASSERT_TRUE(m.ok()) << m.status();
     ExpectValid(*m);
@@ -91,6 +93,28 @@ TEST(BuildMultimeshTopologyTest, ClosedMouthOpensThroughAnOpening) {
     EXPECT_EQ(m->cohesive_closed[closed_shape].size(), m->cohesive_edges.size());
     EXPECT_TRUE(m->cohesive_closed[1 - closed_shape].empty());
     EXPECT_NEAR(Area(*m, 1 - closed_shape), M_PI * 100 - 25, 1.5);
+  }
+}
+
+// Each drawing closes a different mouth, so whichever is meshed first, one hole must collapse
+// onto a slit (2*pi at its tips): the boundary fans there get enough triangles.
+TEST(BuildMultimeshTopologyTest, TwoMouthsClosedInDifferentDrawings) {
+  Drawing a, b;
+  a.outlines = {{Rect(0, 0, 40, 20)}};
+  b.outlines = {{Rect(0, 0, 40, 20)}};
+  a.openings = {{{5, 10}, {10, 11}, {15, 10}}};
+  b.outlines.push_back({{{5, 10}, {10, 7}, {15, 10}, {10, 13}}});
+  a.outlines.push_back({{{25, 10}, {30, 7}, {35, 10}, {30, 13}}});
+  b.openings = {{{25, 10}, {30, 11}, {35, 10}}};
+  for (const auto& drawings : {std::vector<Drawing>{a, b}, std::vector<Drawing>{b, a}}) {
+    absl::StatusOr<Multimesh> m = BuildMultimesh(drawings, {});
+    ASSERT_TRUE(m.ok()) << m.status();
+    ExpectValid(*m);
+    EXPECT_EQ(m->boundary_loops.size(), 3u);
+    EXPECT_FALSE(m->cohesive_closed[0].empty());
+    EXPECT_FALSE(m->cohesive_closed[1].empty());
+    EXPECT_NEAR(Area(*m, 0), 800 - 30, 1e-6);
+    EXPECT_NEAR(Area(*m, 1), 800 - 30, 1e-6);
   }
 }
 
@@ -112,6 +136,37 @@ TEST(BuildMultimeshTopologyTest, CutSplitsOneShapeIntoTwo) {
   }
 }
 
+// A fine size bound makes CGAL put Steiner points on the cut sides of the meshed drawing; each
+// is mirrored onto the twin side, so the cut's two sides carry the same points where it is
+// closed, whichever drawing is meshed.
+TEST(BuildMultimeshTopologyTest, BoundarySteinerPointsMirroredAcrossCuts) {
+  Drawing whole, parts;
+  whole.outlines = {{Rect(0, 0, 20, 10)}};
+  whole.cuts = {{{10, -1}, {10.5, 5}, {10, 11}}};
+  parts.outlines = {{Rect(-5, 0, 8, 10)}, {Rect(12, 2, 25, 12)}};
+  MultimeshOptions options;
+  options.boundary_vertices = 16;
+  options.max_edge_relative = 0.03;
+  for (const auto& drawings :
+       {std::vector<Drawing>{whole, parts}, std::vector<Drawing>{parts, whole}}) {
+    absl::StatusOr<Multimesh> m = BuildMultimesh(drawings, options);
+    ASSERT_TRUE(m.ok()) << m.status();
+    ExpectValid(*m);
+    const int w = drawings[0].cuts.empty() ? 1 : 0;
+    // Boundary vertices on the cut (away from the outline) come in collocated pairs.
+    std::map<std::pair<double, double>, int> on_cut;
+    for (int v : m->boundary) {
+      const Point p = m->shapes[w][v];
+      if (p.y() > 1e-9 && p.y() < 10 - 1e-9 && p.x() > 1 && p.x() < 19) ++on_cut[{p.x(), p.y()}];
+    }
+    EXPECT_GT(on_cut.size(), 8u);  // more than the 16-vertex boundary alone would give
+    for (const auto& [p, count] : on_cut) {
+      EXPECT_EQ(count, 2) << "(" << p.first << ", " << p.second << ")";
+    }
+    EXPECT_EQ(m->cohesive_edges.size(), on_cut.size() + 1);
+  }
+}
+
 TEST(BuildMultimeshTopologyTest, DifferentClassesNameEachDrawing) {
   Drawing disk, ring;
   disk.outlines = {{Circle({0, 0}, 10, 32)}};
@@ -121,6 +176,29 @@ TEST(BuildMultimeshTopologyTest, DifferentClassesNameEachDrawing) {
   EXPECT_THAT(s.message(),
               HasSubstr("drawing 1: 1 component, 0 holes; drawing 2: 1 component, 1 hole"));
   EXPECT_THAT(s.message(), HasSubstr("add an opening"));
+}
+
+TEST(BuildMultimeshTopologyTest, DrawingMarksUsedWhenOptionsHaveNone) {
+  Drawing a, b;
+  a.outlines = {{Circle({0, 0}, 10, 64)}};
+  b.outlines = {{Circle({0, 0}, 10, 64)}};
+  a.marks = {{7, {10, 0}}, {2, {-10, 0}}};
+  b.marks = {{2, {0, -10}}, {7, {0, 10}}};
+  absl::StatusOr<Multimesh> m = BuildMultimesh({a, b}, {});
+  ASSERT_TRUE(m.ok()) << m.status();
+  ExpectValid(*m);
+  int pinned = 0;
+  for (int v : m->boundary) {
+    if ((m->shapes[0][v] - Point(10, 0)).norm() < 1e-6) {
+      EXPECT_NEAR((m->shapes[1][v] - Point(0, 10)).norm(), 0, 1e-6);
+      ++pinned;
+    }
+  }
+  EXPECT_EQ(pinned, 1);
+  b.marks.pop_back();
+  absl::Status missing = BuildMultimesh({a, b}, {}).status();
+  EXPECT_EQ(missing.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(missing.message(), HasSubstr("mark 7 is in drawing 1 but not in drawing 2"));
 }
 
 TEST(BuildMultimeshTopologyTest, MarksPinCorrespondingPoints) {

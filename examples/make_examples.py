@@ -1,0 +1,218 @@
+# Writes the example drawings (SVG) and project files under examples/ (python3 make_examples.py).
+# The SVGs are the source of truth for the lead and the tests; this only records how they were drawn.
+import json, math, os
+ROOT = os.path.dirname(os.path.abspath(__file__))
+
+def f(v):
+    s = ('%.1f' % v).rstrip('0').rstrip('.')
+    return '0' if s in ('-0', '') else s
+
+def pts(ps):
+    return ' '.join('%s,%s' % (f(x), f(y)) for x, y in ps)
+
+def svg(w, h, title, body):
+    return ('<?xml version="1.0" encoding="UTF-8"?>\n'
+            '<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" viewBox="0 0 %d %d">\n'
+            '  <title>%s</title>\n%s</svg>\n') % (w, h, w, h, title, body)
+
+def write(name, files, project_extra=None, drawings=None):
+    d = os.path.join(ROOT, name)
+    os.makedirs(d, exist_ok=True)
+    for fname, text in files:
+        assert len(text) < 5000, (name, fname, len(text))
+        open(os.path.join(d, fname), 'w').write(text)
+    proj = {'version': 1, 'drawings': drawings or [fn for fn, _ in files],
+            'inbetween': {'frames': 24}}
+    if project_extra:
+        for k, v in project_extra.items():
+            proj.setdefault(k, {}).update(v) if isinstance(v, dict) else proj.__setitem__(k, v)
+    open(os.path.join(d, 'project.json'), 'w').write(json.dumps(proj, indent=2) + '\n')
+
+# --- existing examples get project files
+write('square_hexagon', [], drawings=['square.svg', 'hexagon.svg'])
+write('bar_arch', [], drawings=['bar.svg', 'arch.svg'])
+
+# --- pentagon -> star, six difficulty levels (S-Table 4): inner radius 0.7 .. 0.2 of the outer
+for level in range(1, 7):
+    ratio = 0.8 - 0.1 * level
+    c, R = 60, 50
+    pent = [(c + R * math.cos(math.radians(-90 + 72 * k)), c + R * math.sin(math.radians(-90 + 72 * k))) for k in range(5)]
+    star = []
+    for k in range(10):
+        r = R if k % 2 == 0 else R * ratio
+        a = math.radians(-90 + 36 * k)
+        star.append((c + r * math.cos(a), c + r * math.sin(a)))
+    write('pentagon_star/hard%d' % level, [
+        ('pentagon.svg', svg(120, 120, 'Key drawing 1: regular pentagon, circumradius 50',
+                             '  <polygon id="pentagon" fill="#5a8fd0" points="%s"/>\n' % pts(pent))),
+        ('star.svg', svg(120, 120, 'Key drawing 2: five-pointed star, inner radius %.1f x outer' % ratio,
+                         '  <polygon id="star" fill="#e0a030" points="%s"/>\n' % pts(star))),
+    ])
+
+# --- limbs: a limb leaves a body edge at `top` in direction angle a (degrees from +y, towards +x),
+def unit(a):
+    return (math.sin(math.radians(a)), math.cos(math.radians(a)))
+
+def add(p, q, s=1.0):
+    return (p[0] + s * q[0], p[1] + s * q[1])
+
+def intersect(p, d, q, e):
+    # p + s d = q + t e
+    den = d[0] * e[1] - d[1] * e[0]
+    s = ((q[0] - p[0]) * e[1] - (q[1] - p[1]) * e[0]) / den
+    return add(p, d, s)
+
+# --- walking character, half a walk cycle (contact, passing, up, contact); a "down" pose
+#     (20, -24) did not build with the others (see the closing note)
+def walker(front, back, arm, passing=False):
+    P = (0, -6); w = 9; L = 54
+    out = []
+    # head (arc) and neck, walked clockwise on screen from the back of the neck
+    head = 'M -3 -66 A 11 11 0 1 1 5 -66'
+    out_pts = [(5, -62), (9, -60)]
+    # arm on the torso front (x = 9) from the shoulder
+    T = (9, -60); d = unit(arm); n = (-math.cos(math.radians(arm)), math.sin(math.radians(arm)))
+    wa, La = 7, 34
+    hand = add(T, d, La)
+    out_pts += [hand, add(add(hand, n, wa), d, 2), intersect(add(T, n, wa), d, T, (0, 1))]
+    out_pts += [(9, -10)]
+    def leg_edges(a):
+        d = unit(a); n = (math.cos(math.radians(a)), -math.sin(math.radians(a)))
+        fr = add(P, n, w / 2); bk = add(P, n, -w / 2)
+        return d, n, fr, bk
+    df, nf, ff, fb = leg_edges(front)
+    db, nb, bf, bb = leg_edges(back)
+    toe = lambda e, d, n: add(add(e, n, 8), d, 2)
+    if passing:
+        ef, eb = add(ff, df, L), add(fb, df, L)
+        out_pts += [ff, ef, toe(ef, df, nf), add(eb, df, 2), eb, bb]
+    else:
+        crotch = intersect(fb, df, bf, db)
+        ef, eb = add(ff, df, L), add(fb, df, L)
+        out_pts += [ff, ef, toe(ef, df, nf), add(eb, df, 2), eb, crotch]
+        ef, eb = add(bf, db, L), add(bb, db, L)
+        out_pts += [ef, toe(ef, db, nb), add(eb, db, 2), eb, bb]
+    out_pts += [(-9, -10), (-10, -56), (-3, -62)]
+    dpath = head + ' L ' + ' L '.join('%s %s' % (f(x), f(y)) for x, y in out_pts) + ' Z'
+    return dpath
+
+poses = [('contact', 28, -28, 48, 0), ('passing', 0, 0, 32, -1),
+         ('up', 20, -18, 40, -4), ('contact2', 28, -28, 48, 0)]
+files = []
+for i, (name, fr, bk, arm, bob) in enumerate(poses):
+    body = '  <g transform="translate(40 %s)">\n' % f(96 + bob)
+    body += '    <path id="walker" fill="#3a3a48" d="%s"/>\n' % walker(fr, bk, arm, name == 'passing')
+    if name == 'passing':
+        body += '    <path class="cut" d="M 0 56 L 0 4" stroke="red" fill="none"/>\n'
+        body += '    <circle data-corr="1" cx="0" cy="4" r="1" fill="red"/>\n'
+    else:
+        P = (0, -6); w = 9
+        fb = add(P, (math.cos(math.radians(fr)), -math.sin(math.radians(fr))), -w / 2)
+        bf = add(P, (math.cos(math.radians(bk)), -math.sin(math.radians(bk))), w / 2)
+        c = intersect(fb, unit(fr), bf, unit(bk))
+        body += '    <circle data-corr="1" cx="%s" cy="%s" r="1" fill="red"/>\n' % (f(c[0]), f(c[1]))
+    body += '  </g>\n'
+    files.append(('%d_%s.svg' % (i + 1, name),
+                  svg(100, 160, 'Walk cycle key %d: %s (side view silhouette)' % (i + 1, name), body)))
+write('walk', files, {'inbetween': {'timing': 'catmull_rom'}})
+
+# --- flying bird: the wing folded onto the body (a cut) opens up and away
+def bird(wing_tip1, wing_tip2, folded):
+    body = 'M 100 52 Q 96 42 86 42 L 76 44'
+    if folded:
+        body += ' L 12 44'
+    else:
+        body += ' L %s %s L %s %s L 62 44 L 12 44' % (f(wing_tip1[0]), f(wing_tip1[1]), f(wing_tip2[0]), f(wing_tip2[1]))
+    body += ' L 2 36 L 6 50 Q 30 70 70 64 Q 90 60 100 52 Z'
+    return body
+bird_files = []
+for i, (name, t1, t2) in enumerate([('folded', None, None), ('raised', (30, 20), (24, 26)), ('up', (44, 2), (38, 6))]):
+    b = '  <path id="bird" fill="#2f6f8f" d="%s"/>\n' % bird(t1, t2, name == 'folded')
+    if name == 'folded':
+        b += '  <path class="cut" d="M 36 38 L 62 50" stroke="red" fill="none"/>\n'
+        b += '  <circle data-corr="1" cx="62" cy="50" r="1" fill="red"/>\n'
+    else:
+        b += '  <circle data-corr="1" cx="62" cy="44" r="1" fill="red"/>\n'
+    bird_files.append(('%d_%s.svg' % (i + 1, name), svg(110, 80, 'Flying bird key %d: wing %s' % (i + 1, name), b)))
+write('bird', bird_files)
+
+# --- closed mouth that opens: disk -> annulus through an opening
+face = 'M 10 50 A 40 40 0 1 1 90 50 A 40 40 0 1 1 10 50 Z'
+write('mouth', [
+    ('1_closed.svg', svg(100, 100, 'Mouth key 1: closed (an opening marks the lips)',
+                         '  <path id="face" fill="#e8b040" d="%s"/>\n'
+                         '  <path class="opening" d="M 30 58 Q 50 68 70 58" stroke="red" fill="none"/>\n' % face)),
+    ('2_ajar.svg', svg(100, 100, 'Mouth key 2: ajar',
+                       '  <path id="face" fill="#e8b040" fill-rule="evenodd"\n        d="%s M 30 58 Q 50 62 70 58 Q 50 76 30 58 Z"/>\n' % face)),
+    ('3_open.svg', svg(100, 100, 'Mouth key 3: wide open',
+                       '  <path id="face" fill="#e8b040" fill-rule="evenodd"\n        d="%s M 30 54 Q 50 56 70 54 Q 50 92 30 54 Z"/>\n' % face)),
+])
+
+# --- one shape that splits into two (a cut)
+write('split', [
+    ('1_whole.svg', svg(120, 100, 'Split key 1: one cell, the cut marks where it divides',
+                        '  <path id="cell" fill="#6aa84f" d="M 30 30 H 90 A 20 20 0 0 1 90 70 H 30 A 20 20 0 0 1 30 30 Z"/>\n'
+                        '  <path class="cut" d="M 60 20 L 60 80" stroke="red" fill="none"/>\n')),
+    ('2_two.svg', svg(120, 100, 'Split key 2: two cells',
+                      '  <path id="cells" fill="#6aa84f" d="M 4 50 A 22 22 0 1 1 48 50 A 22 22 0 1 1 4 50 Z M 72 50 A 22 22 0 1 1 116 50 A 22 22 0 1 1 72 50 Z"/>\n')),
+])
+
+# --- 12 principles
+def ellipse(cx, cy, rx, ry, color='#d04a4a', id='ball'):
+    return '  <ellipse id="%s" fill="%s" cx="%s" cy="%s" rx="%s" ry="%s"/>\n' % (id, color, f(cx), f(cy), f(rx), f(ry))
+write('principles_squash_stretch', [
+    ('1_round.svg', svg(100, 120, 'Squash and stretch key 1: ball at the top', ellipse(50, 24, 20, 20))),
+    ('2_stretch.svg', svg(100, 120, 'Squash and stretch key 2: stretched as it falls', ellipse(50, 66, 14, 29))),
+    ('3_squash.svg', svg(100, 120, 'Squash and stretch key 3: squashed on the ground', ellipse(50, 106, 30, 12))),
+])
+bean = 'M 0 0 C -22 0 -24 -30 -16 -52 C -10 -70 10 -70 16 -52 C 24 -30 22 0 0 0 Z'
+def bean_svg(title, tf):
+    return svg(120, 110, title, '  <path id="bean" fill="#8e5ac8" transform="%s"\n        d="%s"/>\n' % (tf, bean))
+write('principles_anticipation', [
+    ('1_stand.svg', bean_svg('Anticipation key 1: standing', 'translate(50 100)')),
+    ('2_windup.svg', bean_svg('Anticipation key 2: crouched and leaning back', 'translate(46 100) skewX(14) scale(1.15 0.75)')),
+    ('3_action.svg', bean_svg('Anticipation key 3: leaping forward', 'translate(74 96) skewX(-24) scale(0.85 1.25)')),
+])
+write('principles_slow_in_out', [
+    ('1_start.svg', svg(200, 80, 'Slow in and slow out key 1: at rest on the left',
+                        '  <rect id="box" fill="#4a90a0" x="10" y="20" width="40" height="40" rx="6"/>\n')),
+    ('2_end.svg', svg(200, 80, 'Slow in and slow out key 2: at rest on the right, a quarter turn later',
+                      '  <rect id="box" fill="#4a90a0" x="-20" y="-20" width="40" height="40" rx="6" transform="translate(170 40) rotate(90)"/>\n')),
+], {'inbetween': {'timing': 'ease_in_out', 'ease': [0.8]}})
+arc_files = []
+for i, a in enumerate([180, 120, 60, 0]):
+    cx, cy = 100 + 80 * math.cos(math.radians(a)), 100 - 80 * math.sin(math.radians(a))
+    arc_files.append(('%d_ball.svg' % (i + 1), svg(200, 120, 'Arcs key %d: the ball on its arc (%d degrees)' % (i + 1, a),
+                      '  <circle id="ball" fill="#d07030" cx="%s" cy="%s" r="12"/>\n' % (f(cx), f(cy)))))
+write('principles_arcs', arc_files, {'inbetween': {'timing': 'catmull_rom'}})
+
+# Follow-through and overlapping action: a block with tails (limbs) on its back edge.
+def tail_pts(x0, ty, phi, length, w):
+    d = (-math.cos(math.radians(phi)), -math.sin(math.radians(phi)))
+    n = (-math.sin(math.radians(phi)), math.cos(math.radians(phi)))
+    T = (x0, ty)
+    root2 = (x0, ty + w / math.cos(math.radians(phi)))
+    return [root2, add(add(T, n, w), d, length), add(T, d, length), T]
+
+def block(x, tails):
+    x0 = x - 16
+    p = [(x0, 0)]
+    for ty, phi, length, w in sorted(tails, reverse=True):
+        p += tail_pts(x0, ty, phi, length, w)
+    return ('M ' + ' L '.join('%s %s' % (f(a), f(b)) for a, b in p) +
+            ' L %s -46 Q %s -58 %s -46 L %s 0 Z' % (f(x0), f(x), f(x + 16), f(x + 16)))
+
+def block_svg(title, x, tails, color):
+    return svg(170, 100, title, '  <path id="body" fill="%s" transform="translate(0 90)"\n        d="%s"/>\n' % (color, block(x, tails)))
+
+write('principles_follow_through', [
+    ('1_moving.svg', block_svg('Follow-through key 1: moving right, the tail trails', 60, [(-38, 12, 40, 7)], '#c05050')),
+    ('2_stop.svg', block_svg('Follow-through key 2: stopped, the tail swings on and up', 130, [(-38, 70, 40, 7)], '#c05050')),
+    ('3_settle.svg', block_svg('Follow-through key 3: the tail settles down', 130, [(-38, -40, 40, 7)], '#c05050')),
+])
+write('principles_overlapping_action', [
+    ('1_moving.svg', block_svg('Overlapping action key 1: both strands trail', 60, [(-42, 22, 26, 6), (-20, -4, 38, 6)], '#508050')),
+    ('2_stop.svg', block_svg('Overlapping action key 2: the short strand leads, the long one lags', 130, [(-42, 62, 26, 6), (-20, 12, 38, 6)], '#508050')),
+    ('3_settle.svg', block_svg('Overlapping action key 3: the short strand settles first', 130, [(-42, -12, 26, 6), (-20, -32, 38, 6)], '#508050')),
+    ('4_rest.svg', block_svg('Overlapping action key 4: both at rest', 130, [(-42, -20, 26, 6), (-20, -46, 38, 6)], '#508050')),
+])
