@@ -1,25 +1,26 @@
-// Drawing validation and import; the SVG parsing itself is solver::ImportSvg.
+// Drawing validation and import; the SVG parsing is solver::ImportSvg and the boundaries are
+// solver::BuildBoundaries (S-Alg.1), whose messages name the drawing and the location.
 #include "server/drawing_import.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
+#include <set>
 #include <string>
+#include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "server/proto_convert.h"
 #include "solver/geometry/polygon.h"
 #include "solver/io/svg_import.h"
 
 namespace inbetween::server {
 namespace {
 
-using inbetween::v1::ElementKind;
-using inbetween::v1::TopologyElement;
+namespace v1 = ::inbetween::v1;
 
-absl::Status CheckOutline(const solver::Points& points, const std::string& where) {
-  if (points.size() < 3) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(where, " has ", points.size(), " points, an outline needs at least 3"));
-  }
+absl::Status CheckPoints(const solver::Points& points, const std::string& where) {
   for (size_t i = 0; i < points.size(); ++i) {
     const solver::Point& p = points[i];
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || std::abs(p.x()) > kMaxCoordinate ||
@@ -29,6 +30,15 @@ absl::Status CheckOutline(const solver::Points& points, const std::string& where
                        ") is not finite or exceeds |coordinate| <= 1e9"));
     }
   }
+  return absl::OkStatus();
+}
+
+absl::Status CheckOutline(const solver::Points& points, const std::string& where) {
+  if (points.size() < 3) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(where, " has ", points.size(), " points, an outline needs at least 3"));
+  }
+  if (absl::Status s = CheckPoints(points, where); !s.ok()) return s;
   const double area = solver::PolygonSignedArea(points);
   if (!(std::abs(area) > 0.0) || !std::isfinite(area)) {
     return absl::InvalidArgumentError(absl::StrCat(where, " has zero area"));
@@ -41,47 +51,80 @@ absl::Status CheckOutline(const solver::Points& points, const std::string& where
   return absl::OkStatus();
 }
 
-// Shared tail of both entry points: checks the outlines, numbers them and classifies them.
-absl::StatusOr<ImportedDrawing> FromOutlines(solver::Drawing parsed, absl::string_view field,
-                                             absl::string_view element_field) {
+absl::Status CheckOpenPolyline(const solver::Points& points, const std::string& where) {
+  if (points.size() < 2) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(where, " has ", points.size(), " points, a cut or opening needs at least 2"));
+  }
+  return CheckPoints(points, where);
+}
+
+// `field`[i], plus the element id for stored elements, e.g. "drawing 2.elements[2] (element 5)".
+std::string ElementName(absl::string_view field, int i, const v1::TopologyElement& element,
+                        bool with_id) {
+  std::string name = absl::StrCat(field, "[", i, "]");
+  if (with_id) absl::StrAppend(&name, " (element ", element.id(), ")");
+  return name;
+}
+
+// Shared tail of every entry point: checks each element by kind, builds the solver drawing and
+// runs the graph flow. `elements` have their final ids.
+absl::StatusOr<ImportedDrawing> Analyze(TopologyElements elements, absl::string_view field,
+                                        absl::string_view element_field, bool with_ids,
+                                        int drawing_number, int max_points) {
   ImportedDrawing out;
   size_t total_points = 0;
-  for (size_t i = 0; i < parsed.outlines.size(); ++i) {
-    const solver::Points& points = parsed.outlines[i].points;
-    total_points += points.size();
-    if (total_points > static_cast<size_t>(kMaxPointsPerDrawing)) {
-      return absl::ResourceExhaustedError(absl::StrCat(
-          field, " has more than ", kMaxPointsPerDrawing, " points (limit per drawing)"));
+  bool has_positive_outline = false;
+  for (int i = 0; i < elements.size(); ++i) {
+    const v1::TopologyElement& element = elements[i];
+    const std::string where = ElementName(element_field, i, element, with_ids);
+    total_points += element.polyline().points_size();
+    if (total_points > static_cast<size_t>(max_points)) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat(field, " has more than ", max_points,
+                       " points (limit per drawing, --max-drawing-points)"));
     }
-    if (absl::Status s = CheckOutline(points, absl::StrCat(field, ".", element_field, "[", i, "]"));
-        !s.ok()) {
-      return s;
-    }
-    TopologyElement* element = out.elements.Add();
-    element->set_id(static_cast<uint32_t>(i + 1));
-    element->set_kind(inbetween::v1::ELEMENT_KIND_OUTLINE);
-    for (const solver::Point& p : points) {
-      inbetween::v1::Point* q = element->mutable_polyline()->add_points();
-      q->set_x(p.x());
-      q->set_y(p.y());
-    }
-    if (solver::PolygonSignedArea(points) > 0) {
-      out.equivalence_class.set_components(out.equivalence_class.components() + 1);
-    } else {
-      out.equivalence_class.set_holes(out.equivalence_class.holes() + 1);
+    solver::Points points = FromProto(element.polyline().points());
+    switch (element.kind()) {
+      case v1::ELEMENT_KIND_OUTLINE:
+        if (absl::Status s = CheckOutline(points, where); !s.ok()) return s;
+        has_positive_outline |= solver::PolygonSignedArea(points) > 0;
+        out.parsed.outlines.push_back({std::move(points)});
+        break;
+      case v1::ELEMENT_KIND_CUT:
+        if (absl::Status s = CheckOpenPolyline(points, where); !s.ok()) return s;
+        out.parsed.cuts.push_back(std::move(points));
+        break;
+      case v1::ELEMENT_KIND_OPENING:
+        if (absl::Status s = CheckOpenPolyline(points, where); !s.ok()) return s;
+        out.parsed.openings.push_back(std::move(points));
+        break;
+      default:
+        return absl::InvalidArgumentError(absl::StrCat(
+            where, ".kind must be ELEMENT_KIND_OUTLINE, ELEMENT_KIND_CUT or ELEMENT_KIND_OPENING"));
     }
   }
-  if (out.equivalence_class.components() == 0) {
+  if (!has_positive_outline) {
     return absl::InvalidArgumentError(absl::StrCat(
         field,
         " has no outer outline (an outline with positive signed area, i.e. clockwise on "
         "screen with y down)"));
   }
-  out.parsed = std::move(parsed);
+  absl::StatusOr<solver::BoundaryGraph> boundaries =
+      solver::BuildBoundaries(out.parsed, drawing_number);
+  if (!boundaries.ok()) {
+    // The solver names the drawing ("drawing 2, cut 1 ..."); add the field unless it says the same.
+    const absl::string_view message = boundaries.status().message();
+    if (absl::StartsWith(message, field)) return boundaries.status();
+    return absl::Status(boundaries.status().code(), absl::StrCat(field, ": ", message));
+  }
+  out.boundaries = *std::move(boundaries);
+  out.equivalence_class = ToProto(out.boundaries.equivalence);
+  out.elements = std::move(elements);
   return out;
 }
 
-absl::Status CheckDrawingFields(const inbetween::v1::Drawing& drawing, absl::string_view field) {
+absl::Status CheckDrawingFields(const v1::Drawing& drawing, absl::string_view field) {
   if (drawing.name().size() > kMaxNameBytes) {
     return absl::InvalidArgumentError(absl::StrCat(field, ".name is ", drawing.name().size(),
                                                    " bytes, the limit is ", kMaxNameBytes));
@@ -94,46 +137,47 @@ absl::Status CheckDrawingFields(const inbetween::v1::Drawing& drawing, absl::str
   return absl::OkStatus();
 }
 
-// Converts explicit elements (request polylines or stored elements) to outlines.
-absl::StatusOr<solver::Drawing> OutlinesFromElements(
-    const google::protobuf::RepeatedPtrField<TopologyElement>& elements, absl::string_view field) {
-  solver::Drawing parsed;
-  for (int i = 0; i < elements.size(); ++i) {
-    const TopologyElement& element = elements[i];
-    const std::string where = absl::StrCat(field, "[", i, "]");
-    switch (element.kind()) {
-      case inbetween::v1::ELEMENT_KIND_OUTLINE:
-        break;
-      case inbetween::v1::ELEMENT_KIND_CUT:
-      case inbetween::v1::ELEMENT_KIND_OPENING:
-        return absl::UnimplementedError(
-            absl::StrCat(where, ".kind = ", inbetween::v1::ElementKind_Name(element.kind()),
-                         ": cuts and openings are not supported yet in this server version"));
-      default:
-        return absl::InvalidArgumentError(
-            absl::StrCat(where, ".kind must be ELEMENT_KIND_OUTLINE"));
-    }
-    solver::Outline& outline = parsed.outlines.emplace_back();
-    outline.points.reserve(element.polyline().points_size());
-    for (const inbetween::v1::Point& p : element.polyline().points()) {
-      outline.points.emplace_back(p.x(), p.y());
-    }
-  }
-  return parsed;
+void AddElement(v1::ElementKind kind, const solver::Points& points, TopologyElements* out) {
+  v1::TopologyElement* element = out->Add();
+  element->set_id(static_cast<uint32_t>(out->size()));
+  element->set_kind(kind);
+  ToProto(points, element->mutable_polyline()->mutable_points());
 }
 
 }  // namespace
 
-absl::StatusOr<ImportedDrawing> ImportDrawing(const inbetween::v1::Drawing& drawing,
-                                              double flatten_tolerance, absl::string_view field) {
+v1::EquivalenceClass ToProto(const solver::EquivalenceClass& equivalence) {
+  v1::EquivalenceClass out;
+  out.set_components(static_cast<uint32_t>(equivalence.components));
+  out.set_holes(static_cast<uint32_t>(equivalence.holes));
+  return out;
+}
+
+absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing, double flatten_tolerance,
+                                              absl::string_view field, int drawing_number,
+                                              const TopologyElements& topology,
+                                              absl::string_view topology_field, int max_points) {
   if (absl::Status s = CheckDrawingFields(drawing, field); !s.ok()) return s;
   if (flatten_tolerance == 0) flatten_tolerance = kDefaultFlattenTolerance;
   if (!(std::isfinite(flatten_tolerance) && flatten_tolerance > 0 && flatten_tolerance <= 1e6)) {
     return absl::InvalidArgumentError(
         absl::StrCat("flatten_tolerance = ", flatten_tolerance, " is not in (0, 1e6]"));
   }
+  for (int i = 0; i < topology.size(); ++i) {
+    const v1::TopologyElement& element = topology[i];
+    if (element.kind() != v1::ELEMENT_KIND_CUT && element.kind() != v1::ELEMENT_KIND_OPENING) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          topology_field, "[", i, "].kind must be ELEMENT_KIND_CUT or ELEMENT_KIND_OPENING"));
+    }
+    if (element.id() != 0) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          topology_field, "[", i, "].id = ", element.id(), ": new elements have id 0"));
+    }
+  }
+  TopologyElements elements;
+  std::string element_field;
   switch (drawing.source_case()) {
-    case inbetween::v1::Drawing::kSvg: {
+    case v1::Drawing::kSvg: {
       if (drawing.svg().empty()) {
         return absl::InvalidArgumentError(absl::StrCat(field, ".svg is empty"));
       }
@@ -147,28 +191,62 @@ absl::StatusOr<ImportedDrawing> ImportDrawing(const inbetween::v1::Drawing& draw
       if (parsed->outlines.empty()) {
         return absl::InvalidArgumentError(absl::StrCat(field, ".svg has no filled shapes"));
       }
-      return FromOutlines(*std::move(parsed), field, "svg outline");
+      for (const solver::Outline& o : parsed->outlines) {
+        AddElement(v1::ELEMENT_KIND_OUTLINE, o.points, &elements);
+      }
+      for (const solver::Points& c : parsed->cuts) AddElement(v1::ELEMENT_KIND_CUT, c, &elements);
+      for (const solver::Points& o : parsed->openings) {
+        AddElement(v1::ELEMENT_KIND_OPENING, o, &elements);
+      }
+      element_field = absl::StrCat(field, ".svg element");
+      break;
     }
-    case inbetween::v1::Drawing::kPolylines: {
-      const std::string elements_field = absl::StrCat(field, ".polylines.elements");
-      absl::StatusOr<solver::Drawing> parsed =
-          OutlinesFromElements(drawing.polylines().elements(), elements_field);
-      if (!parsed.ok()) return parsed.status();
-      return FromOutlines(*std::move(parsed), field, "polylines.elements");
-    }
+    case v1::Drawing::kPolylines:
+      elements = drawing.polylines().elements();
+      for (int i = 0; i < elements.size(); ++i) elements[i].set_id(static_cast<uint32_t>(i + 1));
+      element_field = absl::StrCat(field, ".polylines.elements");
+      break;
     default:
       return absl::InvalidArgumentError(
           absl::StrCat(field, " has no source: set ", field, ".svg or ", field, ".polylines"));
   }
+  // The added elements are checked under `topology_field` first, so that Analyze's per-element
+  // messages can only be about the source's elements. Graph-flow messages count cuts and
+  // openings 1-based in element order ("drawing 2, cut 1").
+  for (int i = 0; i < topology.size(); ++i) {
+    const std::string where = absl::StrCat(topology_field, "[", i, "]");
+    if (absl::Status s = CheckOpenPolyline(FromProto(topology[i].polyline().points()), where);
+        !s.ok()) {
+      return s;
+    }
+    v1::TopologyElement* element = elements.Add();
+    *element = topology[i];
+    element->set_id(static_cast<uint32_t>(elements.size()));
+  }
+  return Analyze(std::move(elements), field, element_field, false, drawing_number, max_points);
 }
 
-absl::StatusOr<ImportedDrawing> ImportDrawingElements(const inbetween::v1::Drawing& drawing,
-                                                      absl::string_view field) {
+absl::StatusOr<ImportedDrawing> ImportDrawingElements(const v1::Drawing& drawing,
+                                                      absl::string_view field, int drawing_number,
+                                                      int max_points) {
   if (absl::Status s = CheckDrawingFields(drawing, field); !s.ok()) return s;
-  absl::StatusOr<solver::Drawing> parsed =
-      OutlinesFromElements(drawing.elements(), absl::StrCat(field, ".elements"));
-  if (!parsed.ok()) return parsed.status();
-  return FromOutlines(*std::move(parsed), field, "elements");
+  TopologyElements elements = drawing.elements();
+  std::set<uint32_t> ids;
+  uint32_t max_id = 0;
+  for (int i = 0; i < elements.size(); ++i) {
+    const uint32_t id = elements[i].id();
+    if (id == 0) continue;
+    if (!ids.insert(id).second) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".elements[", i, "].id = ", id, " is repeated"));
+    }
+    max_id = std::max(max_id, id);
+  }
+  for (v1::TopologyElement& element : elements) {
+    if (element.id() == 0) element.set_id(++max_id);
+  }
+  return Analyze(std::move(elements), field, absl::StrCat(field, ".elements"), true, drawing_number,
+                 max_points);
 }
 
 }  // namespace inbetween::server

@@ -1,11 +1,12 @@
-// A request's drawing (SVG text or explicit polylines) -> validated outline elements and the
-// solver drawing made of them.
+// A request's drawing (SVG text or explicit polylines) plus its cuts and openings -> validated
+// topology elements, the solver drawing made of them and its boundaries (S-Alg.1 graph flow).
 #pragma once
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "inbetween/v1/inbetween.pb.h"
 #include "solver/core/types.h"
+#include "solver/geometry/graph_flow.h"
 
 namespace inbetween::server {
 
@@ -14,25 +15,40 @@ inline constexpr double kMaxCoordinate = 1e9;
 inline constexpr int kMaxPointsPerDrawing = 1'000'000;
 inline constexpr size_t kMaxNameBytes = 256;
 
+using TopologyElements = google::protobuf::RepeatedPtrField<inbetween::v1::TopologyElement>;
+
 struct ImportedDrawing {
+  // The solver drawing: OUTLINE elements as outlines, CUT as cuts, OPENING as openings, each in
+  // element order (SolverDrawing() of the elements).
   solver::Drawing parsed;
-  // OUTLINE elements with ids 1..n, in the order of parsed.outlines.
-  google::protobuf::RepeatedPtrField<inbetween::v1::TopologyElement> elements;
-  // Read from the outlines' orientation: components = outer (positive) outlines, holes =
-  // negative ones. Graph flow (S-Alg.1) will replace this once cuts and openings exist.
+  // Every element with its id (>= 1, unique within the drawing).
+  TopologyElements elements;
+  // Closed boundaries, cohesive twins and the equivalence class from BuildBoundaries.
+  solver::BoundaryGraph boundaries;
   inbetween::v1::EquivalenceClass equivalence_class;
 };
 
-// Imports drawing.svg (with `flatten_tolerance`, 0 = default) or drawing.polylines and checks
-// the name, key_time and every outline (>= 3 finite points, |coordinate| <= 1e9, non-zero area,
-// not self-intersecting, at least one positive outline). Errors name `field` (e.g. "drawing") and
-// the element index: INVALID_ARGUMENT for bad input, UNIMPLEMENTED for cuts and openings (not
-// supported yet), RESOURCE_EXHAUSTED above kMaxPointsPerDrawing.
+// Imports drawing.svg (with `flatten_tolerance`, 0 = default) or drawing.polylines, appends the
+// `topology` elements (CUT or OPENING, id 0; named `topology_field`), numbers new elements and
+// checks everything: name, key_time, outlines (>= 3 finite points, |coordinate| <= 1e9, non-zero
+// area, not self-intersecting, at least one positive outline), cuts and openings (>= 2 finite
+// points) and the graph flow of the whole drawing. `drawing_number` (1-based) names the drawing
+// in the solver's messages. Errors name `field` and the element: INVALID_ARGUMENT for bad
+// input, RESOURCE_EXHAUSTED above max_points.
 absl::StatusOr<ImportedDrawing> ImportDrawing(const inbetween::v1::Drawing& drawing,
-                                              double flatten_tolerance, absl::string_view field);
+                                              double flatten_tolerance, absl::string_view field,
+                                              int drawing_number,
+                                              const TopologyElements& topology = {},
+                                              absl::string_view topology_field = "topology",
+                                              int max_points = kMaxPointsPerDrawing);
 
-// Same checks for a drawing whose elements are already filled in (a stored or archived drawing).
+// Same checks for a drawing whose elements are already filled in (a stored, archived or edited
+// drawing). Ids are kept; elements with id 0 get fresh ones; repeated ids are INVALID_ARGUMENT.
 absl::StatusOr<ImportedDrawing> ImportDrawingElements(const inbetween::v1::Drawing& drawing,
-                                                      absl::string_view field);
+                                                      absl::string_view field, int drawing_number,
+                                                      int max_points = kMaxPointsPerDrawing);
+
+// The equivalence class as the API reports it.
+inbetween::v1::EquivalenceClass ToProto(const solver::EquivalenceClass& equivalence);
 
 }  // namespace inbetween::server

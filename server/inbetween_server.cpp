@@ -8,28 +8,100 @@
 #include <grpcpp/support/channel_arguments.h>
 #include <spdlog/spdlog.h>
 
+#include <fstream>
+#include <sstream>
 #include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "server/dir_session_store.h"
 #include "server/inbetween_service.h"
+#include "server/metrics.h"
 #include "server/session_store.h"
 
 namespace inbetween::server {
 
+namespace {
+
+absl::StatusOr<std::string> ReadPem(const std::string& path, absl::string_view flag) {
+  std::ifstream in(path);
+  if (!in) return absl::InvalidArgumentError(absl::StrCat(flag, ": cannot read '", path, "'"));
+  std::stringstream text;
+  text << in.rdbuf();
+  if (text.str().find("-----BEGIN") == std::string::npos) {
+    return absl::InvalidArgumentError(absl::StrCat(flag, ": '", path, "' is not a PEM file"));
+  }
+  return text.str();
+}
+
+absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const ServerOptions& options) {
+  if (options.tls_cert.empty() && options.tls_key.empty()) {
+    if (!options.tls_client_ca.empty()) {
+      return absl::InvalidArgumentError("--tls-client-ca needs --tls-cert and --tls-key");
+    }
+    return grpc::InsecureServerCredentials();
+  }
+  if (options.tls_cert.empty() || options.tls_key.empty()) {
+    return absl::InvalidArgumentError("--tls-cert and --tls-key go together");
+  }
+  absl::StatusOr<std::string> cert = ReadPem(options.tls_cert, "--tls-cert");
+  if (!cert.ok()) return cert.status();
+  absl::StatusOr<std::string> key = ReadPem(options.tls_key, "--tls-key");
+  if (!key.ok()) return key.status();
+  grpc::SslServerCredentialsOptions ssl;
+  ssl.pem_key_cert_pairs.push_back({*key, *cert});
+  if (!options.tls_client_ca.empty()) {
+    absl::StatusOr<std::string> ca = ReadPem(options.tls_client_ca, "--tls-client-ca");
+    if (!ca.ok()) return ca.status();
+    ssl.pem_root_certs = *ca;
+    ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+  }
+  return grpc::SslServerCredentials(ssl);
+}
+
+absl::StatusOr<std::shared_ptr<SessionStore>> OpenStore(const ServerOptions& options) {
+  if (options.store == "memory") {
+    return std::make_shared<MemorySessionStore>(options.max_sessions);
+  }
+  if (absl::StartsWith(options.store, "dir:")) {
+    DirStoreOptions dir;
+    dir.max_sessions = options.max_sessions;
+    absl::StatusOr<std::unique_ptr<DirSessionStore>> store =
+        DirSessionStore::Open(options.store.substr(4), dir);
+    if (!store.ok()) return store.status();
+    return std::shared_ptr<SessionStore>(*std::move(store));
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("--store: '", options.store, "' is not supported (use 'memory' or 'dir:PATH')"));
+}
+
+}  // namespace
+
 absl::StatusOr<std::unique_ptr<InbetweenServer>> InbetweenServer::Start(
     const ServerOptions& options) {
-  if (options.store != "memory") {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "--store: '", options.store, "' is not supported (this version has only 'memory')"));
-  }
   if (!options.listen.empty() && options.listen.find(':') == std::string::npos) {
     return absl::InvalidArgumentError(
         absl::StrCat("--listen: '", options.listen, "' is not HOST:PORT"));
   }
+  if (options.max_message_bytes < 1024) {
+    return absl::InvalidArgumentError("--max-message-bytes must be at least 1024");
+  }
+  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials = Credentials(options);
+  if (!credentials.ok()) return credentials.status();
   std::unique_ptr<InbetweenServer> server(new InbetweenServer());
   server->options_ = options;
-  server->store_ = std::make_shared<MemorySessionStore>();
-  server->service_ = std::make_unique<InbetweenService>(server->store_);
+  absl::StatusOr<std::shared_ptr<SessionStore>> store = OpenStore(options);
+  if (!store.ok()) return store.status();
+  server->store_ = *std::move(store);
+  ServiceOptions service = options.service;
+  if (!options.tokens_file.empty()) {
+    absl::StatusOr<TokenTable> tokens = TokenTable::Load(options.tokens_file);
+    if (!tokens.ok()) return tokens.status();
+    service.tokens = std::make_shared<const TokenTable>(*std::move(tokens));
+  }
+  server->metrics_ = service.metrics ? service.metrics : std::make_shared<Metrics>();
+  service.metrics = server->metrics_;
+  server->service_ = std::make_unique<InbetweenService>(server->store_, service);
 
   // Both switches are process-wide in gRPC and must be set before the builder is created.
   grpc::EnableDefaultHealthCheckService(true);
@@ -37,13 +109,13 @@ absl::StatusOr<std::unique_ptr<InbetweenServer>> InbetweenServer::Start(
 
   grpc::ServerBuilder builder;
   if (!options.listen.empty()) {
-    builder.AddListeningPort(options.listen, grpc::InsecureServerCredentials(), &server->port_);
+    builder.AddListeningPort(options.listen, *credentials, &server->port_);
   }
   // gRPC sets SO_REUSEPORT by default: a second server on a taken port would start and silently
   // share the traffic. Fail instead.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
-  builder.SetMaxReceiveMessageSize(kMaxMessageBytes);
-  builder.SetMaxSendMessageSize(kMaxMessageBytes);
+  builder.SetMaxReceiveMessageSize(options.max_message_bytes);
+  builder.SetMaxSendMessageSize(options.max_message_bytes);
   builder.RegisterService(server->service_.get());
   server->server_ = builder.BuildAndStart();
   if (!server->server_) {
@@ -60,6 +132,13 @@ absl::StatusOr<std::unique_ptr<InbetweenServer>> InbetweenServer::Start(
     health->SetServingStatus("", true);
     health->SetServingStatus("inbetween.v1.Inbetween", true);
   }
+  if (!options.metrics_listen.empty()) {
+    InbetweenServer* self = server.get();
+    absl::StatusOr<std::unique_ptr<MetricsHttpServer>> http =
+        MetricsHttpServer::Start(options.metrics_listen, [self] { return self->RenderMetrics(); });
+    if (!http.ok()) return http.status();
+    server->metrics_server_ = *std::move(http);
+  }
   return server;
 }
 
@@ -68,6 +147,7 @@ InbetweenServer::~InbetweenServer() {
     Shutdown();
     Wait();
   }
+  metrics_server_.reset();  // its callback reads the service and the store
 }
 
 std::shared_ptr<grpc::Channel> InbetweenServer::InProcessChannel() {
@@ -79,8 +159,25 @@ std::shared_ptr<grpc::Channel> InbetweenServer::InProcessChannel() {
 
 int InbetweenServer::port() const { return port_; }
 
+int InbetweenServer::metrics_port() const { return metrics_server_ ? metrics_server_->port() : 0; }
+
+std::string InbetweenServer::RenderMetrics() const {
+  const HeavyJobs& heavy = service_->heavy_jobs();
+  return metrics_->Render({
+      {"inbetween_active_sessions", "Sessions in the store.", static_cast<double>(store_->Count())},
+      {"inbetween_heavy_jobs_running", "Heavy jobs (build, optimize, inbetween) running.",
+       static_cast<double>(heavy.running())},
+      {"inbetween_heavy_queue_depth", "Heavy jobs waiting for a slot.",
+       static_cast<double>(heavy.queued())},
+      {"inbetween_heavy_jobs_max", "Heavy-job slots (--max-heavy-jobs).",
+       static_cast<double>(heavy.max_running())},
+      {"inbetween_serving", "1 while serving, 0 while draining.", draining_ ? 0.0 : 1.0},
+  });
+}
+
 void InbetweenServer::Shutdown() {
   std::call_once(shutdown_once_, [this] {
+    draining_ = true;
     spdlog::info("shutting down (grace {} ms)", options_.shutdown_grace.count());
     if (grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService()) {
       health->Shutdown();  // every service reports NOT_SERVING from now on

@@ -5,27 +5,38 @@
 #include <grpcpp/channel.h>
 #include <grpcpp/server.h>
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <mutex>
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "server/inbetween_service.h"
 
 namespace inbetween::server {
 
-class InbetweenService;
-class SessionStore;
+class MetricsHttpServer;
 
 inline constexpr int kMaxMessageBytes = 64 * 1024 * 1024;
 
 struct ServerOptions {
   // "host:port"; empty = no listening port (in-process only); port 0 = pick a free port.
   std::string listen;
-  // Only "memory" for now; anything else -> InvalidArgument naming the flag (--store).
+  // "memory" (default; the embedded CLI) or "dir:PATH" (snapshots, dir_session_store.h);
+  // anything else -> InvalidArgument naming the flag (--store).
   std::string store = "memory";
   bool reflection = true;
   std::chrono::milliseconds shutdown_grace{5000};
+  int max_message_bytes = kMaxMessageBytes;  // --max-message-bytes, both directions
+  size_t max_sessions = 10000;               // --max-sessions (whole server)
+  // Limits, heavy-job pool; tokens and metrics are filled from the fields below.
+  ServiceOptions service;
+  std::string tokens_file;  // --tokens: bearer tokens required when set
+  std::string tls_cert;     // --tls-cert / --tls-key: PEM files; TLS when both are set
+  std::string tls_key;
+  std::string tls_client_ca;   // --tls-client-ca: require client certificates signed by it
+  std::string metrics_listen;  // --metrics-listen HOST:PORT: Prometheus /metrics; empty = off
 };
 
 class InbetweenServer {
@@ -38,10 +49,13 @@ class InbetweenServer {
 
   std::shared_ptr<grpc::Channel> InProcessChannel();  // same service, no network
   int port() const;                                   // the bound port (0 if not listening)
+  int metrics_port() const;                           // 0 without --metrics-listen
   // Stop accepting, let running streams finish up to shutdown_grace, then cancel them (the
   // handlers see the cancellation and stop their solver work). Idempotent, thread-safe.
   void Shutdown();
   void Wait();  // blocks until the server has shut down
+  // The Prometheus exposition text served on --metrics-listen.
+  std::string RenderMetrics() const;
 
  private:
   InbetweenServer() = default;
@@ -49,9 +63,12 @@ class InbetweenServer {
   ServerOptions options_;
   int port_ = 0;
   std::shared_ptr<SessionStore> store_;
+  std::shared_ptr<Metrics> metrics_;
   std::unique_ptr<InbetweenService> service_;  // must outlive server_
   std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<MetricsHttpServer> metrics_server_;
   std::once_flag shutdown_once_;
+  std::atomic<bool> draining_{false};
 };
 
 }  // namespace inbetween::server

@@ -4,22 +4,30 @@
 #include "server/inbetween_service.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <mutex>
+#include <optional>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "server/cancel_watcher.h"
+#include "server/comesh_progress.h"
 #include "server/drawing_import.h"
 #include "server/logging.h"
 #include "server/parameters.h"
 #include "server/proto_convert.h"
+#include "server/session_snapshot.h"
 #include "server/status_mapping.h"
 #include "server/stiffness_field.h"
+#include "solver/comesh/comesh_objective.h"
+#include "solver/comesh/comesh_optimizer.h"
+#include "solver/geometry/graph_flow.h"
 #include "solver/interp/inbetweener.h"
 #include "solver/interp/timing.h"
 #include "solver/mesh/build_multimesh.h"
@@ -31,29 +39,64 @@ namespace {
 namespace v1 = ::inbetween::v1;
 using Clock = std::chrono::steady_clock;
 
-// Runs a handler body: catches anything thrown (a bug must not take the server down), maps the
-// status once and logs one line. `session_id` is read after `body` ran (CreateSession sets it).
-template <typename Body>
-grpc::Status RunRpc(absl::string_view rpc, const std::string& session_id, Body&& body) {
-  const Clock::time_point start = Clock::now();
-  absl::Status status;
-  try {
-    status = body();
-  } catch (const std::exception& e) {
-    status = absl::InternalError(absl::StrCat(rpc, " failed: ", e.what()));
-  } catch (...) {
-    status = absl::InternalError(absl::StrCat(rpc, " failed with an unknown exception"));
+// Who is calling: the request id of this call and the owner its token maps to ("" without
+// --tokens).
+struct Caller {
+  std::string request_id;
+  std::string owner;
+};
+
+// The client's x-request-id (if short and printable) or a new one: process prefix + counter.
+std::string RequestId(const grpc::ServerContext& context) {
+  auto it = context.client_metadata().find("x-request-id");
+  if (it != context.client_metadata().end() && !it->second.empty() && it->second.size() <= 64 &&
+      std::all_of(it->second.begin(), it->second.end(),
+                  [](char c) { return c > ' ' && c < 127 && c != '"' && c != '\\'; })) {
+    return std::string(it->second.data(), it->second.size());
   }
-  grpc::Status out = ToGrpcStatus(status);
-  LogRpc(rpc, session_id, out, std::chrono::duration<double>(Clock::now() - start).count());
-  return out;
+  static const std::string prefix = [] {
+    std::mt19937_64 rng(std::random_device{}());
+    return RandomSessionId(rng).substr(0, 8);
+  }();
+  static std::atomic<uint64_t> counter{0};
+  return absl::StrCat(prefix, "-", ++counter);
 }
 
-grpc::Status NotImplemented(absl::string_view rpc, const std::string& session_id) {
-  grpc::Status status(grpc::StatusCode::UNIMPLEMENTED,
-                      absl::StrCat(rpc, " is not implemented yet in this server version"));
-  LogRpc(rpc, session_id, status, 0.0);
-  return status;
+// Runs a handler body: names the request, authenticates the caller (with --tokens), catches
+// anything thrown (a bug must not take the server down), maps the status once, logs one line and
+// counts it. `session_id` is read after `body` ran (CreateSession sets it).
+template <typename Body>
+grpc::Status RunRpc(const ServiceOptions& options, grpc::ServerContext* context,
+                    absl::string_view rpc, const std::string& session_id, Caller* caller,
+                    Body&& body) {
+  const Clock::time_point start = Clock::now();
+  caller->request_id = RequestId(*context);
+  context->AddInitialMetadata("x-request-id", caller->request_id);
+  absl::Status status;
+  if (options.tokens) {
+    absl::StatusOr<std::string> owner = options.tokens->Authenticate(*context);
+    if (owner.ok()) {
+      caller->owner = *std::move(owner);
+    } else {
+      status = owner.status();
+    }
+  }
+  if (status.ok()) {
+    try {
+      status = body();
+    } catch (const std::exception& e) {
+      status = absl::InternalError(absl::StrCat(rpc, " failed: ", e.what()));
+    } catch (...) {
+      status = absl::InternalError(absl::StrCat(rpc, " failed with an unknown exception"));
+    }
+  }
+  grpc::Status out = ToGrpcStatus(status);
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  LogRpc(caller->request_id, rpc, session_id, out, seconds, options.log_ok_rpcs_at_info);
+  if (options.metrics) {
+    options.metrics->ObserveRpc(rpc, absl::StatusCodeToString(status.code()), seconds);
+  }
+  return out;
 }
 
 absl::Status RequireSessionId(const std::string& id) {
@@ -61,15 +104,19 @@ absl::Status RequireSessionId(const std::string& id) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<SessionState> Load(const SessionStore& store, const std::string& id) {
+// Another owner's session is NOT_FOUND, worded exactly like a missing one (no existence leak).
+absl::StatusOr<SessionState> Load(const SessionStore& store, const std::string& id,
+                                  const Caller& caller) {
   if (absl::Status s = RequireSessionId(id); !s.ok()) return s;
-  return store.Get(id);
+  absl::StatusOr<SessionState> state = store.Get(id);
+  if (state.ok() && state->owner != caller.owner) return SessionNotFoundError(id);
+  return state;
 }
 
 // Load for a mutation: also checks expected_version against the current version.
 absl::StatusOr<SessionState> LoadForUpdate(const SessionStore& store, const std::string& id,
-                                           uint64_t expected_version) {
-  absl::StatusOr<SessionState> state = Load(store, id);
+                                           uint64_t expected_version, const Caller& caller) {
+  absl::StatusOr<SessionState> state = Load(store, id, caller);
   if (!state.ok()) return state.status();
   if (state->session.version() != expected_version) {
     return StaleVersionError(id, state->session.version(), expected_version);
@@ -81,18 +128,6 @@ absl::StatusOr<SessionState> LoadForUpdate(const SessionStore& store, const std:
 v1::Session Compact(const v1::Session& session) {
   v1::Session out = session;
   for (v1::Drawing& drawing : *out.mutable_drawings()) drawing.clear_source();
-  return out;
-}
-
-// The ListSessions summary: id, version, display_name, stage, timestamps.
-v1::Session Summary(const v1::Session& session) {
-  v1::Session out;
-  out.set_id(session.id());
-  out.set_version(session.version());
-  out.set_display_name(session.display_name());
-  out.set_stage(session.stage());
-  out.set_created_unix_ms(session.created_unix_ms());
-  out.set_updated_unix_ms(session.updated_unix_ms());
   return out;
 }
 
@@ -165,7 +200,20 @@ v1::MultimeshStats StatsOf(const solver::Multimesh& mesh) {
     inverted += solver::CountInverted(mesh.triangles, shape);
   }
   stats.set_inverted_triangles(inverted);
-  // map_energy and mesh_energy are filled in by the comesh stage (not in this version).
+  // The comesh objective's reported energies (2 = conformal maps, 1 = equilateral tiling), with
+  // the mesh itself as the rest state; left 0 for a mesh it cannot evaluate (one shape).
+  if (mesh.num_shapes() >= 2 && inverted == 0) {
+    absl::StatusOr<solver::ComeshObjective> objective =
+        solver::ComeshObjective::Create(mesh.triangles, mesh.shapes);
+    if (objective.ok()) {
+      solver::ComeshEnergies energies;
+      objective->Evaluate(mesh.shapes, nullptr, &energies);
+      if (std::isfinite(energies.map) && std::isfinite(energies.mesh)) {
+        stats.set_map_energy(energies.map);
+        stats.set_mesh_energy(energies.mesh);
+      }
+    }
+  }
   return stats;
 }
 
@@ -177,25 +225,211 @@ absl::Status StoppedStatus(const grpc::ServerContext& context, absl::string_view
   return absl::CancelledError(absl::StrCat(rpc, " stopped: the client cancelled or went away"));
 }
 
+int FindElement(const v1::Drawing& drawing, uint32_t element_id) {
+  for (int i = 0; i < drawing.elements_size(); ++i) {
+    if (drawing.elements(i).id() == element_id) return i;
+  }
+  return -1;
+}
+
+absl::string_view KindName(v1::ElementKind kind) {
+  switch (kind) {
+    case v1::ELEMENT_KIND_OUTLINE:
+      return "outline";
+    case v1::ELEMENT_KIND_CUT:
+      return "cut";
+    case v1::ELEMENT_KIND_OPENING:
+      return "opening";
+    default:
+      return "element";
+  }
+}
+
+// Applies one TopologyEdit to `state` (elements, solver drawing, multimesh dropped) and returns
+// the reply without its version. A bad edit is INVALID_ARGUMENT naming the edit, the drawing and
+// the element.
+absl::StatusOr<v1::TopologyState> ApplyTopologyEdit(const v1::TopologyEdit& edit, int n,
+                                                    int max_points, SessionState& state) {
+  v1::Session& session = state.session;
+  const int index = edit.drawing_id() == 0 ? -1 : FindDrawing(session, edit.drawing_id());
+  if (index < 0) {
+    return absl::NotFoundError(absl::StrCat("edit ", n, ": drawing ", edit.drawing_id(),
+                                            " not found in session ", session.id()));
+  }
+  v1::Drawing& drawing = *session.mutable_drawings(index);
+  std::string what;  // "edit 0 (move cut 3) in drawing 2 'mouth.svg'"
+  auto named = [&](absl::string_view verb, v1::ElementKind kind, uint32_t id) {
+    return absl::StrCat("edit ", n, " (", verb, " ", KindName(kind), " ", id, ") in drawing ",
+                        index + 1, drawing.name().empty() ? "" : " '", drawing.name(),
+                        drawing.name().empty() ? "" : "'");
+  };
+  switch (edit.edit_case()) {
+    case v1::TopologyEdit::kAdd: {
+      const v1::TopologyElement& element = edit.add();
+      if (element.id() != 0) {
+        return absl::InvalidArgumentError(absl::StrCat("edit ", n, ": add.id = ", element.id(),
+                                                       " must be 0 (the server assigns ids)"));
+      }
+      uint32_t id = 0;
+      for (const v1::TopologyElement& e : drawing.elements()) id = std::max(id, e.id());
+      ++id;
+      what = named("add", element.kind(), id);
+      v1::TopologyElement* added = drawing.add_elements();
+      *added = element;
+      added->set_id(id);
+      break;
+    }
+    case v1::TopologyEdit::kMove: {
+      const v1::TopologyElement& element = edit.move();
+      const int i = FindElement(drawing, element.id());
+      if (element.id() == 0 || i < 0) {
+        return absl::InvalidArgumentError(absl::StrCat("edit ", n, ": move.id = ", element.id(),
+                                                       " is not an element of drawing ",
+                                                       edit.drawing_id()));
+      }
+      v1::TopologyElement& target = *drawing.mutable_elements(i);
+      if (element.kind() != v1::ELEMENT_KIND_UNSPECIFIED && element.kind() != target.kind()) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "edit ", n, ": move.kind = ", v1::ElementKind_Name(element.kind()), " but element ",
+            element.id(), " is a ", KindName(target.kind()), " (delete and add to change it)"));
+      }
+      what = named("move", target.kind(), element.id());
+      *target.mutable_polyline() = element.polyline();
+      break;
+    }
+    case v1::TopologyEdit::kDeleteElement: {
+      const int i = FindElement(drawing, edit.delete_element());
+      if (edit.delete_element() == 0 || i < 0) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("edit ", n, ": delete_element = ", edit.delete_element(),
+                         " is not an element of drawing ", edit.drawing_id()));
+      }
+      what = named("delete", drawing.elements(i).kind(), edit.delete_element());
+      drawing.mutable_elements()->DeleteSubrange(i, 1);
+      break;
+    }
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("edit ", n, ": set one of add, move or delete_element"));
+  }
+  absl::StatusOr<ImportedDrawing> imported =
+      ImportDrawingElements(drawing, absl::StrCat("drawing ", index + 1), index + 1, max_points);
+  if (!imported.ok()) {
+    return absl::Status(imported.status().code(),
+                        absl::StrCat(what, ": ", imported.status().message()));
+  }
+  state.parsed[index] = std::move(imported->parsed);
+  InvalidateMultimesh(state);
+
+  v1::TopologyState reply;
+  reply.set_drawing_id(drawing.id());
+  *reply.mutable_elements() = drawing.elements();
+  const solver::BoundaryGraph& graph = imported->boundaries;
+  for (size_t l = 0; l < graph.loops.size(); ++l) {
+    const solver::BoundaryLoop& loop = graph.loops[l];
+    ToProto(loop.points, reply.add_boundaries()->mutable_points());
+    for (size_t k = 0; k < loop.twin.size(); ++k) {
+      // One CohesiveEdge per pair: emitted from the side that comes first.
+      const auto [twin_loop, twin_edge] = loop.twin[k];
+      if (twin_loop < 0 || std::pair<int, int>(twin_loop, twin_edge) <
+                               std::pair<int, int>(static_cast<int>(l), static_cast<int>(k))) {
+        continue;
+      }
+      v1::CohesiveEdge* edge = reply.add_cohesive_edges();
+      ToProto(loop.points[k], edge->mutable_a());
+      ToProto(loop.points[(k + 1) % loop.points.size()], edge->mutable_b());
+    }
+  }
+  for (int j = 0; j < session.drawings_size(); ++j) {
+    if (j == index) {
+      *reply.add_classes() = imported->equivalence_class;
+      continue;
+    }
+    absl::StatusOr<solver::BoundaryGraph> other = solver::BuildBoundaries(state.parsed[j], j + 1);
+    if (other.ok()) {
+      *reply.add_classes() = ToProto(other->equivalence);
+    } else {
+      reply.add_classes();
+      reply.add_warnings(std::string(other.status().message()));
+    }
+  }
+  for (int j = 0; j < reply.classes_size(); ++j) {
+    const v1::EquivalenceClass& a = reply.classes(j);
+    const v1::EquivalenceClass& b = reply.classes(index);
+    if (j != index && (a.components() != b.components() || a.holes() != b.holes())) {
+      reply.add_warnings(absl::StrCat("drawing ", j + 1, " has ", a.components(),
+                                      " component(s) and ", a.holes(), " hole(s), drawing ",
+                                      index + 1, " has ", b.components(), " and ", b.holes(),
+                                      ": the multimesh needs every drawing in the same class"));
+    }
+  }
+  return reply;
+}
+
+int MaxDrawings(const ServiceOptions& options) {
+  return std::clamp(options.limits.max_drawings, 2, kMaxDrawingsPerSession);
+}
+
+// --max-sessions-per-token (only with --tokens: without them every caller is the same owner).
+absl::Status CheckSessionQuota(const SessionStore& store, const ServiceOptions& options,
+                               const Caller& caller) {
+  if (!options.tokens) return absl::OkStatus();
+  const size_t owned = store.CountOwned(caller.owner);
+  if (owned >= options.limits.max_sessions_per_token) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "this token already has ", owned, " sessions, the limit is ",
+        options.limits.max_sessions_per_token, " (--max-sessions-per-token); delete some first"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckMeshVertices(const solver::Multimesh& mesh, const ServiceOptions& options,
+                               absl::string_view what) {
+  if (mesh.num_vertices() > options.limits.max_mesh_vertices) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        what, " has ", mesh.num_vertices(), " vertices, the limit is ",
+        options.limits.max_mesh_vertices,
+        " (--max-mesh-vertices); use fewer boundary_vertices or a larger max_edge_relative"));
+  }
+  return absl::OkStatus();
+}
+
+// A heavy-job slot for this call; a busy answer carries trailing metadata retry-after-ms.
+absl::StatusOr<HeavyJobs::Slot> AcquireHeavy(HeavyJobs& heavy, grpc::ServerContext* context,
+                                             const Caller& caller) {
+  absl::StatusOr<HeavyJobs::Slot> slot =
+      heavy.Acquire(caller.owner, [context] { return context->IsCancelled(); });
+  if (slot.status().code() == absl::StatusCode::kResourceExhausted) {
+    context->AddTrailingMetadata("retry-after-ms", absl::StrCat(kBusyRetryAfterSeconds * 1000));
+  }
+  if (slot.status().code() == absl::StatusCode::kCancelled) {
+    return StoppedStatus(*context, "the call");
+  }
+  return slot;
+}
+
 }  // namespace
 
-InbetweenService::InbetweenService(std::shared_ptr<SessionStore> store)
-    : store_(std::move(store)) {}
+InbetweenService::InbetweenService(std::shared_ptr<SessionStore> store, ServiceOptions options)
+    : store_(std::move(store)), options_(std::move(options)), heavy_(options_.heavy) {}
 
 // ---------------------------------------------------------------------------------------------
 // Sessions
 
-grpc::Status InbetweenService::CreateSession(grpc::ServerContext*,
+grpc::Status InbetweenService::CreateSession(grpc::ServerContext* context,
                                              const v1::CreateSessionRequest* request,
                                              v1::CreateSessionResponse* response) {
   std::string session_id;
-  return RunRpc("CreateSession", session_id, [&]() -> absl::Status {
+  Caller caller;
+  return RunRpc(options_, context, "CreateSession", session_id, &caller, [&]() -> absl::Status {
     if (auto s = CheckName(request->display_name(), "display_name"); !s.ok()) return s;
     if (auto s = ValidateParameters(request->parameters(), "parameters"); !s.ok()) return s;
     SessionState state;
     state.session.set_display_name(request->display_name());
     *state.session.mutable_parameters() = request->parameters();
     state.session.set_stage(v1::STAGE_UNSPECIFIED);
+    state.owner = caller.owner;
+    if (auto s = CheckSessionQuota(*store_, options_, caller); !s.ok()) return s;
     absl::StatusOr<SessionState> stored = store_->Create(std::move(state));
     if (!stored.ok()) return stored.status();
     session_id = stored->session.id();
@@ -204,70 +438,82 @@ grpc::Status InbetweenService::CreateSession(grpc::ServerContext*,
   });
 }
 
-grpc::Status InbetweenService::GetSession(grpc::ServerContext*,
+grpc::Status InbetweenService::GetSession(grpc::ServerContext* context,
                                           const v1::GetSessionRequest* request,
                                           v1::GetSessionResponse* response) {
-  return RunRpc("GetSession", request->session_id(), [&]() -> absl::Status {
-    absl::StatusOr<SessionState> state = Load(*store_, request->session_id());
-    if (!state.ok()) return state.status();
-    if (request->full()) {
-      *response->mutable_session() = state->session;
-      if (state->multimesh) *response->mutable_multimesh() = ToProto(*state->multimesh);
-    } else {
-      *response->mutable_session() = Compact(state->session);
-    }
-    return absl::OkStatus();
-  });
+  Caller caller;
+  return RunRpc(options_, context, "GetSession", request->session_id(), &caller,
+                [&]() -> absl::Status {
+                  absl::StatusOr<SessionState> state = Load(*store_, request->session_id(), caller);
+                  if (!state.ok()) return state.status();
+                  if (request->full()) {
+                    *response->mutable_session() = state->session;
+                    if (state->multimesh)
+                      *response->mutable_multimesh() = ToProto(*state->multimesh);
+                  } else {
+                    *response->mutable_session() = Compact(state->session);
+                  }
+                  return absl::OkStatus();
+                });
 }
 
-grpc::Status InbetweenService::ListSessions(grpc::ServerContext*,
+grpc::Status InbetweenService::ListSessions(grpc::ServerContext* context,
                                             const v1::ListSessionsRequest* request,
                                             v1::ListSessionsResponse* response) {
-  return RunRpc("ListSessions", "", [&]() -> absl::Status {
+  Caller caller;
+  return RunRpc(options_, context, "ListSessions", "", &caller, [&]() -> absl::Status {
     // Page sizes above the maximum are clamped (AIP-158), not rejected.
     const uint32_t page_size =
         request->page_size() == 0 ? kDefaultPageSize : std::min(request->page_size(), kMaxPageSize);
-    absl::StatusOr<SessionPage> page = store_->List(page_size, request->page_token());
+    absl::StatusOr<SessionPage> page = store_->List(page_size, request->page_token(), caller.owner);
     if (!page.ok()) return page.status();
     for (const SessionState& state : page->sessions) {
-      *response->add_sessions() = Summary(state.session);
+      *response->add_sessions() = SessionSummary(state.session);
     }
     response->set_next_page_token(page->next_page_token);
     return absl::OkStatus();
   });
 }
 
-grpc::Status InbetweenService::DeleteSession(grpc::ServerContext*,
+grpc::Status InbetweenService::DeleteSession(grpc::ServerContext* context,
                                              const v1::DeleteSessionRequest* request,
                                              v1::DeleteSessionResponse*) {
-  return RunRpc("DeleteSession", request->session_id(), [&]() -> absl::Status {
-    if (auto s = RequireSessionId(request->session_id()); !s.ok()) return s;
-    return store_->Delete(request->session_id(), request->expected_version());
-  });
+  Caller caller;
+  return RunRpc(options_, context, "DeleteSession", request->session_id(), &caller,
+                [&]() -> absl::Status {
+                  // Load first: another owner's session is NOT_FOUND.
+                  if (auto state = Load(*store_, request->session_id(), caller); !state.ok()) {
+                    return state.status();
+                  }
+                  return store_->Delete(request->session_id(), request->expected_version());
+                });
 }
 
-grpc::Status InbetweenService::ExportSession(grpc::ServerContext*,
+grpc::Status InbetweenService::ExportSession(grpc::ServerContext* context,
                                              const v1::ExportSessionRequest* request,
                                              v1::ExportSessionResponse* response) {
-  return RunRpc("ExportSession", request->session_id(), [&]() -> absl::Status {
-    absl::StatusOr<SessionState> state = Load(*store_, request->session_id());
-    if (!state.ok()) return state.status();
-    v1::SessionArchive archive;
-    archive.set_format_version(1);
-    *archive.mutable_session() = state->session;
-    if (state->multimesh) *archive.mutable_multimesh() = ToProto(*state->multimesh);
-    if (!archive.SerializeToString(response->mutable_data())) {
-      return absl::InternalError("could not serialize the session archive");
-    }
-    return absl::OkStatus();
-  });
+  Caller caller;
+  return RunRpc(options_, context, "ExportSession", request->session_id(), &caller,
+                [&]() -> absl::Status {
+                  absl::StatusOr<SessionState> state = Load(*store_, request->session_id(), caller);
+                  if (!state.ok()) return state.status();
+                  v1::SessionArchive archive;
+                  archive.set_format_version(1);
+                  *archive.mutable_session() = state->session;
+                  if (state->multimesh) *archive.mutable_multimesh() = ToProto(*state->multimesh);
+                  if (!archive.SerializeToString(response->mutable_data())) {
+                    return absl::InternalError("could not serialize the session archive");
+                  }
+                  return absl::OkStatus();
+                });
 }
 
-grpc::Status InbetweenService::ImportSession(grpc::ServerContext*,
+grpc::Status InbetweenService::ImportSession(grpc::ServerContext* context,
                                              const v1::ImportSessionRequest* request,
                                              v1::ImportSessionResponse* response) {
   std::string session_id = request->session_id();
-  return RunRpc("ImportSession", session_id, [&]() -> absl::Status {
+  Caller caller;
+  return RunRpc(options_, context, "ImportSession", session_id, &caller, [&]() -> absl::Status {
     if (auto s = CheckSessionIdSyntax(request->session_id()); !s.ok()) return s;
     v1::SessionArchive archive;
     if (request->data().empty() || !archive.ParseFromString(request->data())) {
@@ -283,6 +529,8 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext*,
     SessionState state;
     state.session = std::move(*archive.mutable_session());
     state.session.set_id(request->session_id());
+    state.owner = caller.owner;
+    if (auto s = CheckSessionQuota(*store_, options_, caller); !s.ok()) return s;
     v1::Session& session = state.session;
     if (auto s = CheckName(session.display_name(), "data: session.display_name"); !s.ok()) {
       return s;
@@ -290,10 +538,10 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext*,
     if (auto s = ValidateParameters(session.parameters(), "data: session.parameters"); !s.ok()) {
       return s;
     }
-    if (session.drawings_size() > kMaxDrawingsPerSession) {
+    if (session.drawings_size() > MaxDrawings(options_)) {
       return absl::ResourceExhaustedError(
           absl::StrCat("data: the session has ", session.drawings_size(),
-                       " drawings, the limit is ", kMaxDrawingsPerSession));
+                       " drawings, the limit is ", MaxDrawings(options_), " (--max-drawings)"));
     }
     uint32_t max_id = 0;
     for (int i = 0; i < session.drawings_size(); ++i) {
@@ -305,10 +553,12 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext*,
       }
       max_id = std::max(max_id, drawing.id());
       absl::StatusOr<ImportedDrawing> imported =
-          drawing.elements().empty() ? ImportDrawing(drawing, kDefaultFlattenTolerance, field)
-                                     : ImportDrawingElements(drawing, field);
+          drawing.elements().empty()
+              ? ImportDrawing(drawing, kDefaultFlattenTolerance, field, i + 1, {}, "topology",
+                              options_.limits.max_drawing_points)
+              : ImportDrawingElements(drawing, field, i + 1, options_.limits.max_drawing_points);
       if (!imported.ok()) return imported.status();
-      if (drawing.elements().empty()) *drawing.mutable_elements() = imported->elements;
+      *drawing.mutable_elements() = imported->elements;
       state.parsed.push_back(std::move(imported->parsed));
     }
     state.next_drawing_id = max_id + 1;
@@ -321,6 +571,9 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext*,
       absl::StatusOr<solver::Multimesh> mesh =
           MultimeshFromProto(archive.multimesh(), "data: multimesh");
       if (!mesh.ok()) return mesh.status();
+      if (absl::Status s = CheckMeshVertices(*mesh, options_, "data: multimesh"); !s.ok()) {
+        return s;
+      }
       if (mesh->num_shapes() != session.drawings_size()) {
         return absl::InvalidArgumentError(absl::StrCat("data: multimesh has ", mesh->num_shapes(),
                                                        " shapes for ", session.drawings_size(),
@@ -350,112 +603,140 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext*,
 // ---------------------------------------------------------------------------------------------
 // Drawings and topology
 
-grpc::Status InbetweenService::PutDrawing(grpc::ServerContext*,
+grpc::Status InbetweenService::PutDrawing(grpc::ServerContext* context,
                                           const v1::PutDrawingRequest* request,
                                           v1::PutDrawingResponse* response) {
-  return RunRpc("PutDrawing", request->session_id(), [&]() -> absl::Status {
-    absl::StatusOr<SessionState> state =
-        LoadForUpdate(*store_, request->session_id(), request->expected_version());
-    if (!state.ok()) return state.status();
-    if (request->topology_size() > 0) {
-      // The contract says: refuse rather than silently drop the cuts/openings.
-      return absl::UnimplementedError(
-          "PutDrawing.topology (cuts and openings) is not implemented yet in this server version");
-    }
-    // SVG parsing runs here, outside the store's lock.
-    absl::StatusOr<ImportedDrawing> imported =
-        ImportDrawing(request->drawing(), request->flatten_tolerance(), "drawing");
-    if (!imported.ok()) return imported.status();
+  Caller caller;
+  return RunRpc(
+      options_, context, "PutDrawing", request->session_id(), &caller, [&]() -> absl::Status {
+        absl::StatusOr<SessionState> state =
+            LoadForUpdate(*store_, request->session_id(), request->expected_version(), caller);
+        if (!state.ok()) return state.status();
+        v1::Session& session = state->session;
+        const uint32_t drawing_id = request->drawing().id();
+        const bool add = drawing_id == 0;
+        const int index = add ? session.drawings_size() : FindDrawing(session, drawing_id);
+        if (add && session.drawings_size() >= MaxDrawings(options_)) {
+          return absl::ResourceExhaustedError(
+              absl::StrCat("session ", session.id(), " already has the maximum of ",
+                           MaxDrawings(options_), " drawings (--max-drawings)"));
+        }
+        if (index < 0) {
+          return absl::NotFoundError(
+              absl::StrCat("drawing ", drawing_id, " not found in session ", session.id()));
+        }
+        // SVG parsing and graph flow run here, outside the store's lock.
+        absl::StatusOr<ImportedDrawing> imported =
+            ImportDrawing(request->drawing(), request->flatten_tolerance(), "drawing", index + 1,
+                          request->topology(), "topology", options_.limits.max_drawing_points);
+        if (!imported.ok()) return imported.status();
 
-    v1::Session& session = state->session;
-    v1::Drawing drawing = request->drawing();
-    *drawing.mutable_elements() = imported->elements;
-    int index = -1;
-    if (drawing.id() == 0) {
-      if (session.drawings_size() >= kMaxDrawingsPerSession) {
-        return absl::ResourceExhaustedError(absl::StrCat("session ", session.id(),
-                                                         " already has the maximum of ",
-                                                         kMaxDrawingsPerSession, " drawings"));
-      }
-      drawing.set_id(state->next_drawing_id++);
-      *session.add_drawings() = drawing;
-      state->parsed.push_back(std::move(imported->parsed));
-      index = session.drawings_size() - 1;
-      // Each mark has one point per drawing; with a new drawing the old marks no longer fit.
-      session.clear_correspondences();
-    } else {
-      index = FindDrawing(session, drawing.id());
-      if (index < 0) {
-        return absl::NotFoundError(
-            absl::StrCat("drawing ", drawing.id(), " not found in session ", session.id()));
-      }
-      *session.mutable_drawings(index) = drawing;
-      state->parsed[index] = std::move(imported->parsed);
-    }
-    InvalidateMultimesh(*state);
-    absl::StatusOr<SessionState> stored =
-        store_->Put(*std::move(state), request->expected_version());
-    if (!stored.ok()) return stored.status();
-    *response->mutable_session() = Compact(stored->session);
-    *response->mutable_drawing() = stored->session.drawings(index);
-    response->mutable_drawing()->clear_source();
-    *response->mutable_equivalence_class() = imported->equivalence_class;
-    return absl::OkStatus();
-  });
+        v1::Drawing drawing = request->drawing();
+        *drawing.mutable_elements() = imported->elements;
+        if (add) {
+          drawing.set_id(state->next_drawing_id++);
+          *session.add_drawings() = drawing;
+          state->parsed.push_back(std::move(imported->parsed));
+          // Each mark has one point per drawing; with a new drawing the old marks no longer fit.
+          session.clear_correspondences();
+        } else {
+          *session.mutable_drawings(index) = drawing;
+          state->parsed[index] = std::move(imported->parsed);
+        }
+        InvalidateMultimesh(*state);
+        absl::StatusOr<SessionState> stored =
+            store_->Put(*std::move(state), request->expected_version());
+        if (!stored.ok()) return stored.status();
+        *response->mutable_session() = Compact(stored->session);
+        *response->mutable_drawing() = stored->session.drawings(index);
+        response->mutable_drawing()->clear_source();
+        *response->mutable_equivalence_class() = imported->equivalence_class;
+        return absl::OkStatus();
+      });
 }
 
-grpc::Status InbetweenService::RemoveDrawing(grpc::ServerContext*,
+grpc::Status InbetweenService::RemoveDrawing(grpc::ServerContext* context,
                                              const v1::RemoveDrawingRequest* request,
                                              v1::RemoveDrawingResponse* response) {
-  return RunRpc("RemoveDrawing", request->session_id(), [&]() -> absl::Status {
-    absl::StatusOr<SessionState> state =
-        LoadForUpdate(*store_, request->session_id(), request->expected_version());
-    if (!state.ok()) return state.status();
-    const int index = FindDrawing(state->session, request->drawing_id());
-    if (request->drawing_id() == 0 || index < 0) {
-      return absl::NotFoundError(absl::StrCat("drawing ", request->drawing_id(),
-                                              " not found in session ", request->session_id()));
-    }
-    state->session.mutable_drawings()->DeleteSubrange(index, 1);
-    state->parsed.erase(state->parsed.begin() + index);
-    state->session.clear_correspondences();  // one point per drawing; they no longer fit
-    InvalidateMultimesh(*state);
-    absl::StatusOr<SessionState> stored =
-        store_->Put(*std::move(state), request->expected_version());
-    if (!stored.ok()) return stored.status();
-    *response->mutable_session() = Compact(stored->session);
-    return absl::OkStatus();
-  });
+  Caller caller;
+  return RunRpc(
+      options_, context, "RemoveDrawing", request->session_id(), &caller, [&]() -> absl::Status {
+        absl::StatusOr<SessionState> state =
+            LoadForUpdate(*store_, request->session_id(), request->expected_version(), caller);
+        if (!state.ok()) return state.status();
+        const int index = FindDrawing(state->session, request->drawing_id());
+        if (request->drawing_id() == 0 || index < 0) {
+          return absl::NotFoundError(absl::StrCat("drawing ", request->drawing_id(),
+                                                  " not found in session ", request->session_id()));
+        }
+        state->session.mutable_drawings()->DeleteSubrange(index, 1);
+        state->parsed.erase(state->parsed.begin() + index);
+        state->session.clear_correspondences();  // one point per drawing; they no longer fit
+        InvalidateMultimesh(*state);
+        absl::StatusOr<SessionState> stored =
+            store_->Put(*std::move(state), request->expected_version());
+        if (!stored.ok()) return stored.status();
+        *response->mutable_session() = Compact(stored->session);
+        return absl::OkStatus();
+      });
 }
 
 grpc::Status InbetweenService::EditTopology(
-    grpc::ServerContext*, grpc::ServerReaderWriter<v1::TopologyState, v1::TopologyEdit>*) {
-  return NotImplemented("EditTopology", "");
-}
-
-grpc::Status InbetweenService::SetCorrespondences(grpc::ServerContext*,
-                                                  const v1::SetCorrespondencesRequest* request,
-                                                  v1::SetCorrespondencesResponse* response) {
-  return RunRpc("SetCorrespondences", request->session_id(), [&]() -> absl::Status {
-    absl::StatusOr<SessionState> state =
-        LoadForUpdate(*store_, request->session_id(), request->expected_version());
-    if (!state.ok()) return state.status();
-    if (auto s = CheckCorrespondences(request->correspondences(), state->session.drawings_size(),
-                                      "correspondences");
-        !s.ok()) {
-      return s;
+    grpc::ServerContext* context,
+    grpc::ServerReaderWriter<v1::TopologyState, v1::TopologyEdit>* stream) {
+  std::string session_id;
+  Caller caller;
+  return RunRpc(options_, context, "EditTopology", session_id, &caller, [&]() -> absl::Status {
+    v1::TopologyEdit edit;
+    for (int n = 0; stream->Read(&edit); ++n) {
+      if (n == 0) {
+        session_id = edit.session_id();
+      } else if (edit.session_id() != session_id) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("edit ", n, ": session_id '", edit.session_id(),
+                         "' differs from the stream's session '", session_id, "'"));
+      }
+      absl::StatusOr<SessionState> state =
+          LoadForUpdate(*store_, edit.session_id(), edit.expected_version(), caller);
+      if (!state.ok()) return state.status();
+      absl::StatusOr<v1::TopologyState> reply =
+          ApplyTopologyEdit(edit, n, options_.limits.max_drawing_points, *state);
+      if (!reply.ok()) return reply.status();
+      absl::StatusOr<SessionState> stored = store_->Put(*std::move(state), edit.expected_version());
+      if (!stored.ok()) return stored.status();
+      reply->set_version(stored->session.version());
+      if (!stream->Write(*reply)) return StoppedStatus(*context, "EditTopology");
     }
-    // Stored only: the slice's BuildMultimesh matches boundaries automatically and does not read
-    // the marks yet. They still invalidate the multimesh, because once the solver uses them a
-    // mesh built without them would be stale.
-    *state->session.mutable_correspondences() = request->correspondences();
-    InvalidateMultimesh(*state);
-    absl::StatusOr<SessionState> stored =
-        store_->Put(*std::move(state), request->expected_version());
-    if (!stored.ok()) return stored.status();
-    *response->mutable_session() = Compact(stored->session);
+    if (context->IsCancelled()) return StoppedStatus(*context, "EditTopology");
     return absl::OkStatus();
   });
+}
+
+grpc::Status InbetweenService::SetCorrespondences(grpc::ServerContext* context,
+                                                  const v1::SetCorrespondencesRequest* request,
+                                                  v1::SetCorrespondencesResponse* response) {
+  Caller caller;
+  return RunRpc(
+      options_, context, "SetCorrespondences", request->session_id(), &caller,
+      [&]() -> absl::Status {
+        absl::StatusOr<SessionState> state =
+            LoadForUpdate(*store_, request->session_id(), request->expected_version(), caller);
+        if (!state.ok()) return state.status();
+        if (auto s = CheckCorrespondences(request->correspondences(),
+                                          state->session.drawings_size(), "correspondences");
+            !s.ok()) {
+          return s;
+        }
+        // BuildMultimesh pins the marks (MultimeshOptions::marks): a mesh built without them is
+        // stale.
+        *state->session.mutable_correspondences() = request->correspondences();
+        InvalidateMultimesh(*state);
+        absl::StatusOr<SessionState> stored =
+            store_->Put(*std::move(state), request->expected_version());
+        if (!stored.ok()) return stored.status();
+        *response->mutable_session() = Compact(stored->session);
+        return absl::OkStatus();
+      });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -464,189 +745,311 @@ grpc::Status InbetweenService::SetCorrespondences(grpc::ServerContext*,
 grpc::Status InbetweenService::BuildMultimesh(
     grpc::ServerContext* context, const v1::BuildMultimeshRequest* request,
     grpc::ServerWriter<v1::BuildMultimeshResponse>* writer) {
-  return RunRpc("BuildMultimesh", request->session_id(), [&]() -> absl::Status {
-    absl::StatusOr<SessionState> state =
-        LoadForUpdate(*store_, request->session_id(), request->expected_version());
-    if (!state.ok()) return state.status();
-    if (state->session.drawings_size() < 2) {
-      return absl::FailedPreconditionError(
-          absl::StrCat("BuildMultimesh needs at least 2 drawings, session ", request->session_id(),
-                       " has ", state->session.drawings_size()));
-    }
-    const bool own_meshing = request->has_meshing();
-    const v1::MeshingParameters& meshing =
-        own_meshing ? request->meshing() : state->session.parameters().meshing();
-    if (auto s = ValidateMeshing(meshing, own_meshing ? "meshing" : "session parameters.meshing");
-        !s.ok()) {
-      return s;
-    }
+  Caller caller;
+  return RunRpc(
+      options_, context, "BuildMultimesh", request->session_id(), &caller, [&]() -> absl::Status {
+        absl::StatusOr<SessionState> state =
+            LoadForUpdate(*store_, request->session_id(), request->expected_version(), caller);
+        if (!state.ok()) return state.status();
+        if (state->session.drawings_size() < 2) {
+          return absl::FailedPreconditionError(
+              absl::StrCat("BuildMultimesh needs at least 2 drawings, session ",
+                           request->session_id(), " has ", state->session.drawings_size()));
+        }
+        const bool own_meshing = request->has_meshing();
+        const v1::MeshingParameters& meshing =
+            own_meshing ? request->meshing() : state->session.parameters().meshing();
+        if (auto s =
+                ValidateMeshing(meshing, own_meshing ? "meshing" : "session parameters.meshing");
+            !s.ok()) {
+          return s;
+        }
 
-    solver::CancelToken token;
-    CancelWatcher watcher(context, &token);
-    std::mutex write_mutex;  // in case the solver reports progress from worker threads
-    solver::ProgressFn progress = [&](const std::string& stage, double fraction,
-                                      const std::string& detail) {
-      if (context->IsCancelled()) {
-        token.Cancel();
-        return;
-      }
-      v1::BuildMultimeshResponse message;
-      v1::Progress* p = message.mutable_progress();
-      p->set_stage(stage);
-      p->set_fraction(std::clamp(fraction, 0.0, 1.0));
-      p->set_detail(detail);
-      std::lock_guard lock(write_mutex);
-      if (!writer->Write(message)) token.Cancel();
-    };
-    const Clock::time_point start = Clock::now();
-    solver::MultimeshReport report;
-    absl::StatusOr<solver::Multimesh> mesh = solver::BuildMultimesh(
-        state->parsed, ToMultimeshOptions(meshing), &token, progress, &report);
-    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    if (token.IsCancelled() || context->IsCancelled()) {
-      return StoppedStatus(*context, "BuildMultimesh");
-    }
-    if (!mesh.ok()) return mesh.status();
-    // The solver promises a valid mesh; a stored multimesh is never silently flipped.
-    if (mesh->num_shapes() != state->session.drawings_size()) {
-      return absl::InternalError(absl::StrCat("the multimesh builder returned ", mesh->num_shapes(),
-                                              " shapes for ", state->session.drawings_size(),
-                                              " drawings"));
-    }
-    if (absl::Status s = solver::ValidateMultimesh(*mesh); !s.ok()) {
-      return absl::InternalError(
-          absl::StrCat("the multimesh builder returned an invalid mesh: ", s.message()));
-    }
-    v1::MultimeshStats stats = StatsOf(*mesh);
-    stats.set_build_seconds(report.seconds > 0 ? report.seconds : seconds);
+        if (meshing.boundary_vertices() >
+            static_cast<uint32_t>(options_.limits.max_mesh_vertices)) {
+          return absl::ResourceExhaustedError(absl::StrCat(
+              "meshing.boundary_vertices = ", meshing.boundary_vertices(), " exceeds the limit of ",
+              options_.limits.max_mesh_vertices, " mesh vertices (--max-mesh-vertices)"));
+        }
+        absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
+        if (!slot.ok()) return slot.status();
 
-    v1::BuildMultimeshResponse message;
-    v1::BuildMultimeshResult* result = message.mutable_result();
-    *result->mutable_multimesh() = ToProto(*mesh);
-    state->multimesh = std::make_shared<const solver::Multimesh>(*std::move(mesh));
-    state->session.set_stage(v1::STAGE_MULTIMESH);
-    *state->session.mutable_multimesh_stats() = stats;
-    absl::StatusOr<SessionState> stored =
-        store_->Put(*std::move(state), request->expected_version());
-    if (!stored.ok()) return stored.status();
-    *result->mutable_session() = Compact(stored->session);
-    *result->mutable_stats() = stats;
-    std::lock_guard lock(write_mutex);
-    if (!writer->Write(message)) return StoppedStatus(*context, "BuildMultimesh");
-    return absl::OkStatus();
-  });
+        solver::CancelToken token;
+        CancelWatcher watcher(context, &token);
+        std::mutex write_mutex;  // in case the solver reports progress from worker threads
+        solver::ProgressFn progress = [&](const std::string& stage, double fraction,
+                                          const std::string& detail) {
+          if (context->IsCancelled()) {
+            token.Cancel();
+            return;
+          }
+          v1::BuildMultimeshResponse message;
+          v1::Progress* p = message.mutable_progress();
+          p->set_stage(stage);
+          p->set_fraction(std::clamp(fraction, 0.0, 1.0));
+          p->set_detail(detail);
+          std::lock_guard lock(write_mutex);
+          if (!writer->Write(message)) token.Cancel();
+        };
+        const Clock::time_point start = Clock::now();
+        solver::MultimeshReport report;
+        solver::MultimeshOptions options = ToMultimeshOptions(meshing);
+        for (const v1::Correspondence& mark : state->session.correspondences()) {
+          options.marks.push_back(FromProto(mark.points()));
+        }
+        absl::StatusOr<solver::Multimesh> mesh =
+            solver::BuildMultimesh(state->parsed, options, &token, progress, &report);
+        const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        if (token.IsCancelled() || context->IsCancelled()) {
+          return StoppedStatus(*context, "BuildMultimesh");
+        }
+        if (options_.metrics) options_.metrics->ObserveStage("build", seconds);
+        if (!mesh.ok()) return mesh.status();
+        if (absl::Status s = CheckMeshVertices(*mesh, options_, "the multimesh"); !s.ok()) return s;
+        // The solver promises a valid mesh; a stored multimesh is never silently flipped.
+        if (mesh->num_shapes() != state->session.drawings_size()) {
+          return absl::InternalError(absl::StrCat("the multimesh builder returned ",
+                                                  mesh->num_shapes(), " shapes for ",
+                                                  state->session.drawings_size(), " drawings"));
+        }
+        if (absl::Status s = solver::ValidateMultimesh(*mesh); !s.ok()) {
+          return absl::InternalError(
+              absl::StrCat("the multimesh builder returned an invalid mesh: ", s.message()));
+        }
+        v1::MultimeshStats stats = StatsOf(*mesh);
+        stats.set_build_seconds(report.seconds > 0 ? report.seconds : seconds);
+
+        v1::BuildMultimeshResponse message;
+        v1::BuildMultimeshResult* result = message.mutable_result();
+        *result->mutable_multimesh() = ToProto(*mesh);
+        state->multimesh = std::make_shared<const solver::Multimesh>(*std::move(mesh));
+        state->session.set_stage(v1::STAGE_MULTIMESH);
+        *state->session.mutable_multimesh_stats() = stats;
+        absl::StatusOr<SessionState> stored =
+            store_->Put(*std::move(state), request->expected_version());
+        if (!stored.ok()) return stored.status();
+        *result->mutable_session() = Compact(stored->session);
+        *result->mutable_stats() = stats;
+        std::lock_guard lock(write_mutex);
+        if (!writer->Write(message)) return StoppedStatus(*context, "BuildMultimesh");
+        return absl::OkStatus();
+      });
 }
 
-grpc::Status InbetweenService::OptimizeComesh(grpc::ServerContext*,
-                                              const v1::OptimizeComeshRequest* request,
-                                              grpc::ServerWriter<v1::OptimizeComeshResponse>*) {
-  return NotImplemented("OptimizeComesh", request->session_id());
+grpc::Status InbetweenService::OptimizeComesh(
+    grpc::ServerContext* context, const v1::OptimizeComeshRequest* request,
+    grpc::ServerWriter<v1::OptimizeComeshResponse>* writer) {
+  Caller caller;
+  return RunRpc(
+      options_, context, "OptimizeComesh", request->session_id(), &caller, [&]() -> absl::Status {
+        absl::StatusOr<SessionState> state =
+            LoadForUpdate(*store_, request->session_id(), request->expected_version(), caller);
+        if (!state.ok()) return state.status();
+        if (state->session.stage() < v1::STAGE_MULTIMESH || !state->multimesh) {
+          return absl::FailedPreconditionError(
+              absl::StrCat("session ", request->session_id(),
+                           " has no multimesh: build the multimesh first (BuildMultimesh)"));
+        }
+        const bool own_comesh = request->has_comesh();
+        const v1::ComeshParameters& comesh =
+            own_comesh ? request->comesh() : state->session.parameters().comesh();
+        if (auto s = ValidateComesh(comesh, own_comesh ? "comesh" : "session parameters.comesh");
+            !s.ok()) {
+          return s;
+        }
+        solver::ComeshOptions options = ToComeshOptions(comesh);
+        absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
+        if (!slot.ok()) return slot.status();
+
+        solver::CancelToken token;
+        CancelWatcher watcher(context, &token);
+        std::mutex write_mutex;
+        auto write = [&](const v1::OptimizeComeshResponse& message) {
+          std::lock_guard lock(write_mutex);
+          if (!writer->Write(message)) token.Cancel();
+        };
+        // One ComeshIteration per accepted iterate: on_iterate opens it (iteration number, vertex
+        // count), the progress call that follows in the same iteration adds the energies.
+        ComeshIterationStream iterations;
+        options.on_iterate = [&](int iteration, const std::vector<solver::Points>& shapes) {
+          if (std::optional<v1::OptimizeComeshResponse> done =
+                  iterations.Begin(iteration, shapes)) {
+            write(*done);
+          }
+        };
+        solver::ProgressFn progress = [&](const std::string& stage, double fraction,
+                                          const std::string& detail) {
+          if (context->IsCancelled()) {
+            token.Cancel();
+            return;
+          }
+          write(iterations.OnProgress(stage, fraction, detail));
+        };
+        solver::ComeshReport report;
+        absl::StatusOr<solver::Multimesh> mesh =
+            solver::OptimizeComesh(*state->multimesh, options, &token, progress, &report);
+        if (std::optional<v1::OptimizeComeshResponse> last = iterations.Flush()) write(*last);
+        if (options_.metrics) options_.metrics->ObserveStage("optimize", report.seconds);
+        if (token.IsCancelled() || context->IsCancelled()) {
+          return StoppedStatus(*context, "OptimizeComesh");
+        }
+        if (!mesh.ok()) return mesh.status();
+        if (absl::Status s = solver::ValidateMultimesh(*mesh); !s.ok()) {
+          return absl::InternalError(
+              absl::StrCat("the comesh optimizer returned an invalid mesh: ", s.message()));
+        }
+        v1::MultimeshStats stats = StatsOf(*mesh);
+        stats.set_map_energy(report.map_energy);
+        stats.set_mesh_energy(report.mesh_energy);
+        stats.set_build_seconds(state->session.multimesh_stats().build_seconds());
+
+        v1::OptimizeComeshResponse message;
+        v1::OptimizeComeshResult* result = message.mutable_result();
+        *result->mutable_multimesh() = ToProto(*mesh);
+        result->set_inner_iterations(report.inner);
+        result->set_outer_iterations(report.outer);
+        result->set_seconds(report.seconds);
+        state->multimesh = std::make_shared<const solver::Multimesh>(*std::move(mesh));
+        state->session.set_stage(v1::STAGE_OPTIMIZED);
+        *state->session.mutable_multimesh_stats() = stats;
+        absl::StatusOr<SessionState> stored =
+            store_->Put(*std::move(state), request->expected_version());
+        if (!stored.ok()) return stored.status();
+        *result->mutable_session() = Compact(stored->session);
+        *result->mutable_stats() = stats;
+        std::lock_guard lock(write_mutex);
+        if (!writer->Write(message)) return StoppedStatus(*context, "OptimizeComesh");
+        return absl::OkStatus();
+      });
 }
 
 grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
                                          const v1::InbetweenRequest* request,
                                          grpc::ServerWriter<v1::InbetweenResponse>* writer) {
-  return RunRpc("Inbetween", request->session_id(), [&]() -> absl::Status {
-    absl::StatusOr<SessionState> state = Load(*store_, request->session_id());
-    if (!state.ok()) return state.status();
-    const v1::Session& session = state->session;
-    if (session.stage() < v1::STAGE_MULTIMESH || !state->multimesh) {
-      return absl::FailedPreconditionError(
-          absl::StrCat("session ", session.id(),
-                       " has no multimesh: build the multimesh first (BuildMultimesh)"));
-    }
-    const solver::Multimesh& mesh = *state->multimesh;
-    const v1::InbetweenParameters parameters =
-        MergeInbetween(session.parameters().inbetween(), request->parameters());
-    absl::StatusOr<InbetweenPlan> plan = ToInbetweenPlan(parameters, "parameters");
-    if (!plan.ok()) return plan.status();
-    plan->options.stiffness = StiffnessPerTriangle(mesh, parameters.stiffness());
-    const int num_drawings = session.drawings_size();
-    if (plan->frames < num_drawings) {
-      return absl::InvalidArgumentError(absl::StrCat("parameters.frames = ", plan->frames,
-                                                     " is fewer than the ", num_drawings,
-                                                     " drawings (every drawing is a key frame)"));
-    }
-    if (request->start_frame() >= static_cast<uint32_t>(plan->frames)) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "start_frame = ", request->start_frame(), " is not in [0, frames = ", plan->frames, ")"));
-    }
-    // Key times come from the drawings when every drawing has one, else keys are evenly spaced.
-    std::vector<double> key_times;
-    for (const v1::Drawing& drawing : session.drawings()) {
-      if (drawing.has_key_time()) key_times.push_back(drawing.key_time());
-    }
-    if (!key_times.empty() && static_cast<int>(key_times.size()) != num_drawings) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("key_time is set on ", key_times.size(), " of ", num_drawings,
-                       " drawings: set it on every drawing or on none"));
-    }
-    absl::StatusOr<solver::Schedule> schedule =
-        solver::MakeSchedule(num_drawings, plan->frames, key_times);
-    if (!schedule.ok()) {
-      return absl::Status(
-          schedule.status().code(),
-          absl::StrCat(key_times.empty() ? "frame schedule: " : "drawings' key_time: ",
-                       schedule.status().message()));
-    }
+  Caller caller;
+  return RunRpc(
+      options_, context, "Inbetween", request->session_id(), &caller, [&]() -> absl::Status {
+        absl::StatusOr<SessionState> state = Load(*store_, request->session_id(), caller);
+        if (!state.ok()) return state.status();
+        const v1::Session& session = state->session;
+        if (session.stage() < v1::STAGE_MULTIMESH || !state->multimesh) {
+          return absl::FailedPreconditionError(
+              absl::StrCat("session ", session.id(),
+                           " has no multimesh: build the multimesh first (BuildMultimesh)"));
+        }
+        const solver::Multimesh& mesh = *state->multimesh;
+        const v1::InbetweenParameters parameters =
+            MergeInbetween(session.parameters().inbetween(), request->parameters());
+        absl::StatusOr<InbetweenPlan> plan = ToInbetweenPlan(parameters, "parameters");
+        if (!plan.ok()) return plan.status();
+        plan->options.stiffness = StiffnessPerTriangle(mesh, parameters.stiffness());
+        if (plan->frames > options_.limits.max_frames) {
+          return absl::ResourceExhaustedError(
+              absl::StrCat("parameters.frames = ", plan->frames, " exceeds the limit of ",
+                           options_.limits.max_frames, " frames per request (--max-frames)"));
+        }
+        const int num_drawings = session.drawings_size();
+        if (plan->frames < num_drawings) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("parameters.frames = ", plan->frames, " is fewer than the ",
+                           num_drawings, " drawings (every drawing is a key frame)"));
+        }
+        if (request->start_frame() >= static_cast<uint32_t>(plan->frames)) {
+          return absl::InvalidArgumentError(absl::StrCat("start_frame = ", request->start_frame(),
+                                                         " is not in [0, frames = ", plan->frames,
+                                                         ")"));
+        }
+        // Key times come from the drawings when every drawing has one, else keys are evenly spaced.
+        std::vector<double> key_times;
+        for (const v1::Drawing& drawing : session.drawings()) {
+          if (drawing.has_key_time()) key_times.push_back(drawing.key_time());
+        }
+        if (!key_times.empty() && static_cast<int>(key_times.size()) != num_drawings) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("key_time is set on ", key_times.size(), " of ", num_drawings,
+                           " drawings: set it on every drawing or on none"));
+        }
+        absl::StatusOr<solver::Schedule> schedule =
+            solver::MakeSchedule(num_drawings, plan->frames, key_times);
+        if (!schedule.ok()) {
+          return absl::Status(
+              schedule.status().code(),
+              absl::StrCat(key_times.empty() ? "frame schedule: " : "drawings' key_time: ",
+                           schedule.status().message()));
+        }
 
-    solver::CancelToken token;
-    CancelWatcher watcher(context, &token);
-    absl::StatusOr<solver::Inbetweener> inbetweener =
-        solver::Inbetweener::Create(mesh, plan->options);
-    if (!inbetweener.ok()) return inbetweener.status();
+        absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
+        if (!slot.ok()) return slot.status();
+        const Clock::time_point stage_start = Clock::now();
+        struct StageTimer {
+          Metrics* metrics;
+          Clock::time_point start;
+          ~StageTimer() {
+            if (metrics) {
+              metrics->ObserveStage("inbetween",
+                                    std::chrono::duration<double>(Clock::now() - start).count());
+            }
+          }
+        } stage_timer{options_.metrics.get(), stage_start};
 
-    v1::InbetweenResponse message;
-    v1::InbetweenHeader* header = message.mutable_header();
-    for (const solver::Triangle& t : mesh.triangles) {
-      v1::Triangle* triangle = header->add_triangles();
-      triangle->set_a(t[0]);
-      triangle->set_b(t[1]);
-      triangle->set_c(t[2]);
-    }
-    for (int key : schedule->keys) header->add_keys(key);
-    header->set_frames(plan->frames);
-    header->set_session_version(session.version());
-    if (!writer->Write(message)) return StoppedStatus(*context, "Inbetween");
+        solver::CancelToken token;
+        CancelWatcher watcher(context, &token);
+        absl::StatusOr<solver::Inbetweener> inbetweener =
+            solver::Inbetweener::Create(mesh, plan->options);
+        if (!inbetweener.ok()) return inbetweener.status();
 
-    // Frames before start_frame are solved but not sent: each frame warm-starts from the
-    // previous one, so a resumed stream must replay them to stay identical.
-    solver::Frame previous;
-    for (int i = 0; i < plan->frames; ++i) {
-      if (token.IsCancelled()) return StoppedStatus(*context, "Inbetween");
-      const solver::FrameTiming& timing = schedule->frames[i];
-      solver::FrameReport report;
-      const Clock::time_point start = Clock::now();
-      absl::StatusOr<solver::Frame> frame =
-          inbetweener->Solve(timing.weights, previous, &token, &report);
-      const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-      if (token.IsCancelled()) return StoppedStatus(*context, "Inbetween");
-      if (!frame.ok()) {
-        return absl::Status(frame.status().code(),
-                            absl::StrCat("frame ", i, ": ", frame.status().message()));
-      }
-      if (static_cast<int>(frame->vertices.size()) != mesh.num_vertices()) {
-        return absl::InternalError(absl::StrCat("frame ", i, " has ", frame->vertices.size(),
-                                                " vertices, the mesh has ", mesh.num_vertices()));
-      }
-      if (i >= static_cast<int>(request->start_frame())) {
-        message.Clear();
-        v1::InbetweenFrame* out = message.mutable_frame();
-        out->set_index(i);
-        out->set_time(timing.time);
-        for (double w : timing.weights) out->add_weights(w);
-        ToProto(frame->vertices, out->mutable_vertices());
-        v1::FrameStats* stats = out->mutable_stats();
-        stats->set_iterations(report.iterations);
-        stats->set_energy(report.energy);
-        stats->set_inverted_triangles(solver::CountInverted(mesh.triangles, frame->vertices));
-        stats->set_seconds(report.seconds > 0 ? report.seconds : seconds);
+        v1::InbetweenResponse message;
+        v1::InbetweenHeader* header = message.mutable_header();
+        for (const solver::Triangle& t : mesh.triangles) {
+          v1::Triangle* triangle = header->add_triangles();
+          triangle->set_a(t[0]);
+          triangle->set_b(t[1]);
+          triangle->set_c(t[2]);
+        }
+        for (int key : schedule->keys) header->add_keys(key);
+        header->set_frames(plan->frames);
+        header->set_session_version(session.version());
         if (!writer->Write(message)) return StoppedStatus(*context, "Inbetween");
-      }
-      previous = *std::move(frame);
-    }
-    return absl::OkStatus();
-  });
+
+        // Frames before start_frame are solved but not sent: each frame warm-starts from the
+        // previous one, so a resumed stream must replay them to stay identical.
+        solver::Frame previous;
+        for (int i = 0; i < plan->frames; ++i) {
+          if (token.IsCancelled()) return StoppedStatus(*context, "Inbetween");
+          const solver::FrameTiming& timing = schedule->frames[i];
+          solver::FrameReport report;
+          const Clock::time_point start = Clock::now();
+          absl::StatusOr<solver::Frame> frame =
+              inbetweener->Solve(timing.weights, previous, &token, &report);
+          const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+          if (token.IsCancelled()) return StoppedStatus(*context, "Inbetween");
+          if (!frame.ok()) {
+            return absl::Status(frame.status().code(),
+                                absl::StrCat("frame ", i, ": ", frame.status().message()));
+          }
+          if (static_cast<int>(frame->vertices.size()) != mesh.num_vertices()) {
+            return absl::InternalError(absl::StrCat("frame ", i, " has ", frame->vertices.size(),
+                                                    " vertices, the mesh has ",
+                                                    mesh.num_vertices()));
+          }
+          if (i >= static_cast<int>(request->start_frame())) {
+            message.Clear();
+            v1::InbetweenFrame* out = message.mutable_frame();
+            out->set_index(i);
+            out->set_time(timing.time);
+            for (double w : timing.weights) out->add_weights(w);
+            ToProto(frame->vertices, out->mutable_vertices());
+            v1::FrameStats* stats = out->mutable_stats();
+            stats->set_iterations(report.iterations);
+            stats->set_energy(report.energy);
+            stats->set_inverted_triangles(solver::CountInverted(mesh.triangles, frame->vertices));
+            stats->set_seconds(report.seconds > 0 ? report.seconds : seconds);
+            if (!writer->Write(message)) return StoppedStatus(*context, "Inbetween");
+          }
+          previous = *std::move(frame);
+        }
+        return absl::OkStatus();
+      });
 }
 
 }  // namespace inbetween::server

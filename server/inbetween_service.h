@@ -6,6 +6,11 @@
 #include <memory>
 
 #include "inbetween/v1/inbetween.grpc.pb.h"
+#include "server/auth.h"
+#include "server/drawing_import.h"
+#include "server/heavy_jobs.h"
+#include "server/metrics.h"
+#include "server/parameters.h"
 #include "server/session_store.h"
 
 namespace inbetween::server {
@@ -14,9 +19,30 @@ inline constexpr int kMaxDrawingsPerSession = 16;
 inline constexpr uint32_t kDefaultPageSize = 100;
 inline constexpr uint32_t kMaxPageSize = 1000;
 
+// Limits enforced by the handlers (flags of inbetween-server); each error names its flag.
+struct ServiceLimits {
+  int max_drawings = kMaxDrawingsPerSession;      // --max-drawings (shapes per session, <= 16)
+  int max_drawing_points = kMaxPointsPerDrawing;  // --max-drawing-points
+  int max_mesh_vertices = 2'000'000;              // --max-mesh-vertices
+  int max_frames = kMaxFrames;                    // --max-frames (per Inbetween request)
+  size_t max_sessions_per_token = 1000;           // --max-sessions-per-token
+};
+
+struct ServiceOptions {
+  ServiceLimits limits;
+  HeavyJobOptions heavy;
+  std::shared_ptr<const TokenTable> tokens;  // null = no authentication
+  std::shared_ptr<Metrics> metrics;          // null = not collected
+  // Successful RPCs are logged at info (inbetween-server) or debug (embedded, tests).
+  bool log_ok_rpcs_at_info = false;
+};
+
 class InbetweenService final : public inbetween::v1::Inbetween::Service {
  public:
-  explicit InbetweenService(std::shared_ptr<SessionStore> store);
+  explicit InbetweenService(std::shared_ptr<SessionStore> store, ServiceOptions options = {});
+
+  // Heavy jobs running and waiting (for metrics).
+  const HeavyJobs& heavy_jobs() const { return heavy_; }
 
   grpc::Status CreateSession(grpc::ServerContext* context,
                              const inbetween::v1::CreateSessionRequest* request,
@@ -62,6 +88,8 @@ class InbetweenService final : public inbetween::v1::Inbetween::Service {
 
  private:
   std::shared_ptr<SessionStore> store_;
+  ServiceOptions options_;
+  HeavyJobs heavy_;
 };
 
 }  // namespace inbetween::server

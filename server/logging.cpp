@@ -96,15 +96,17 @@ absl::Status ConfigureLogging(absl::string_view level, absl::string_view format)
   return absl::OkStatus();
 }
 
-void LogRpc(absl::string_view rpc_name, absl::string_view session_id, const grpc::Status& status,
-            double seconds) {
+void LogRpc(absl::string_view request_id, absl::string_view rpc_name, absl::string_view session_id,
+            const grpc::Status& status, double seconds, bool ok_at_info) {
   const std::string_view rpc(rpc_name.data(), rpc_name.size());
+  const std::string_view request(request_id.data(), request_id.size());
   const std::string session =
       session_id.empty() ? std::string() : absl::StrCat(" session=", session_id);
   if (status.ok()) {
-    spdlog::debug("rpc={}{} status=OK seconds={:.3f}", rpc, session, seconds);
+    spdlog::log(ok_at_info ? spdlog::level::info : spdlog::level::debug,
+                "request={} rpc={}{} status=OK seconds={:.3f}", request, rpc, session, seconds);
   } else {
-    spdlog::warn("rpc={}{} status={} seconds={:.3f} error={}", rpc, session,
+    spdlog::warn("request={} rpc={}{} status={} seconds={:.3f} error={}", request, rpc, session,
                  absl::StatusCodeToString(static_cast<absl::StatusCode>(status.error_code())),
                  seconds, status.error_message());
   }

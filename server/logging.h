@@ -14,8 +14,10 @@ namespace inbetween::server {
 // INVALID_ARGUMENT naming the flag (--log-level / --log-format).
 absl::Status ConfigureLogging(absl::string_view level, absl::string_view format);
 
-// One line per finished RPC: debug when OK, warn otherwise; names the session when known.
-void LogRpc(absl::string_view rpc, absl::string_view session_id, const grpc::Status& status,
-            double seconds);
+// One line per finished RPC: request id, method, session (when known), status, duration; at
+// info (or debug when !ok_at_info, e.g. the embedded CLI) when OK, warn otherwise with the
+// error message.
+void LogRpc(absl::string_view request_id, absl::string_view rpc, absl::string_view session_id,
+            const grpc::Status& status, double seconds, bool ok_at_info = true);
 
 }  // namespace inbetween::server

@@ -37,7 +37,57 @@ int main(int argc, char** argv) {
   int64_t grace_ms = 5000;
   app.add_option("--listen", listen, "HOST:PORT to listen on; port 0 picks a free port")
       ->capture_default_str();
-  app.add_option("--store", store, "session store: memory")->capture_default_str();
+  app.add_option("--store", store,
+                 "session store: memory | dir:PATH (one snapshot file per session version)")
+      ->capture_default_str();
+  inbetween::server::ServerOptions options;
+  inbetween::server::ServiceLimits& limits = options.service.limits;
+  inbetween::server::HeavyJobOptions& heavy = options.service.heavy;
+  app.add_option("--max-heavy-jobs", heavy.max_running,
+                 "heavy jobs (build, optimize, inbetween) running at once; 0 = hardware threads")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 4096));
+  app.add_option("--heavy-queue", heavy.max_queued,
+                 "heavy jobs waiting for a slot before RESOURCE_EXHAUSTED; -1 = 4 x max-heavy-jobs")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, 100000));
+  app.add_option("--max-heavy-jobs-per-token", heavy.max_per_owner,
+                 "heavy jobs running or waiting per token; 0 = max-heavy-jobs")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 4096));
+  app.add_option("--max-message-bytes", options.max_message_bytes,
+                 "largest request or response message")
+      ->capture_default_str()
+      ->check(CLI::Range(1024, 1 << 30));
+  app.add_option("--max-drawing-points", limits.max_drawing_points, "points per drawing")
+      ->capture_default_str()
+      ->check(CLI::Range(3, 100'000'000));
+  app.add_option("--max-drawings", limits.max_drawings, "drawings (shapes) per session, 2..16")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 16));
+  app.add_option("--max-mesh-vertices", limits.max_mesh_vertices, "multimesh vertices")
+      ->capture_default_str()
+      ->check(CLI::Range(3, 100'000'000));
+  app.add_option("--max-frames", limits.max_frames, "frames per Inbetween request")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 100000));
+  app.add_option("--max-sessions", options.max_sessions, "sessions in the whole server")
+      ->capture_default_str();
+  app.add_option("--max-sessions-per-token", limits.max_sessions_per_token,
+                 "sessions per bearer token (with --tokens)")
+      ->capture_default_str();
+  app.add_option("--tokens", options.tokens_file,
+                 "file of bearer tokens, one per line: TOKEN [NAME]; required on every call")
+      ->check(CLI::ExistingFile);
+  app.add_option("--tls-cert", options.tls_cert, "PEM certificate chain: serve TLS")
+      ->check(CLI::ExistingFile);
+  app.add_option("--tls-key", options.tls_key, "PEM private key of --tls-cert")
+      ->check(CLI::ExistingFile);
+  app.add_option("--tls-client-ca", options.tls_client_ca,
+                 "PEM CA: require client certificates it signed (mTLS)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--metrics-listen", options.metrics_listen,
+                 "HOST:PORT for Prometheus GET /metrics (off when empty)");
   app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off")
       ->capture_default_str();
   app.add_option("--log-format", log_format, "text|json")->capture_default_str();
@@ -65,8 +115,8 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  inbetween::server::ServerOptions options;
   options.listen = listen;
+  options.service.log_ok_rpcs_at_info = true;
   options.store = store;
   options.reflection = !no_reflection;
   options.shutdown_grace = std::chrono::milliseconds(grace_ms);
@@ -76,8 +126,13 @@ int main(int argc, char** argv) {
     return server.status().code() == absl::StatusCode::kInvalidArgument ? 2 : 1;
   }
   const std::string address = HostOf(listen) + ":" + std::to_string((*server)->port());
-  spdlog::info("listening on {} (store {}, reflection {})", address, store,
-               no_reflection ? "off" : "on");
+  spdlog::info("listening on {} (store {}, reflection {}, tls {}, tokens {})", address, store,
+               no_reflection ? "off" : "on", options.tls_cert.empty() ? "off" : "on",
+               options.tokens_file.empty() ? "off" : "on");
+  if ((*server)->metrics_port() != 0) {
+    spdlog::info("metrics on {}:{}/metrics", HostOf(options.metrics_listen),
+                 (*server)->metrics_port());
+  }
   std::cout << "inbetween-server listening on " << address << std::endl;  // endl flushes
 
   int signal_number = 0;

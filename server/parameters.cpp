@@ -18,6 +18,8 @@ absl::Status CheckRange(double value, double lo, double hi, bool lo_open, absl::
                                                  lo_open ? "(" : "[", lo, ", ", hi, "]"));
 }
 
+}  // namespace
+
 absl::Status ValidateComesh(const inbetween::v1::ComeshParameters& comesh,
                             absl::string_view field) {
   if (comesh.has_map_weight()) {
@@ -42,8 +44,6 @@ absl::Status ValidateComesh(const inbetween::v1::ComeshParameters& comesh,
   }
   return absl::OkStatus();
 }
-
-}  // namespace
 
 absl::Status ValidateMeshing(const inbetween::v1::MeshingParameters& meshing,
                              absl::string_view field) {
@@ -146,6 +146,20 @@ solver::MultimeshOptions ToMultimeshOptions(const inbetween::v1::MeshingParamete
   options.boundary_vertices = static_cast<int>(meshing.boundary_vertices());
   options.max_edge_relative = meshing.max_edge_relative();
   if (meshing.shape_bound() != 0) options.shape_bound = meshing.shape_bound();
+  return options;
+}
+
+solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& comesh) {
+  solver::ComeshOptions options;
+  options.map_weight = comesh.has_map_weight() ? comesh.map_weight() : kDefaultMapWeight;
+  options.max_outer = comesh.max_outer_iterations() == 0
+                          ? kDefaultMaxOuterIterations
+                          : static_cast<int>(comesh.max_outer_iterations());
+  options.max_iterations = comesh.max_inner_iterations() == 0
+                               ? kDefaultMaxInnerIterations
+                               : static_cast<int>(comesh.max_inner_iterations());
+  options.relative_decrease_tolerance =
+      comesh.tolerance() == 0 ? kDefaultComeshTolerance : comesh.tolerance();
   return options;
 }
 

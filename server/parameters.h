@@ -6,6 +6,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "inbetween/v1/inbetween.pb.h"
+#include "solver/comesh/comesh_optimizer.h"
 #include "solver/interp/inbetweener.h"
 #include "solver/mesh/build_multimesh.h"
 
@@ -13,6 +14,11 @@ namespace inbetween::server {
 
 inline constexpr int kDefaultFrames = 24;
 inline constexpr int kMaxFrames = 100000;
+// ComeshParameters defaults (inbetween.proto).
+inline constexpr double kDefaultMapWeight = 0.5;
+inline constexpr int kDefaultMaxOuterIterations = 50;
+inline constexpr int kDefaultMaxInnerIterations = 200;
+inline constexpr double kDefaultComeshTolerance = 1e-6;
 
 // Range checks of every field (the ranges in inbetween.proto). Errors are INVALID_ARGUMENT
 // naming `field`.subfield, or RESOURCE_EXHAUSTED for frames above kMaxFrames.
@@ -20,11 +26,16 @@ absl::Status ValidateParameters(const inbetween::v1::Parameters& parameters,
                                 absl::string_view field);
 absl::Status ValidateMeshing(const inbetween::v1::MeshingParameters& meshing,
                              absl::string_view field);
+absl::Status ValidateComesh(const inbetween::v1::ComeshParameters& comesh, absl::string_view field);
 absl::Status ValidateInbetween(const inbetween::v1::InbetweenParameters& inbetween,
                                absl::string_view field);
 
 // Validated meshing parameters -> solver options (zero fields take the solver's defaults).
 solver::MultimeshOptions ToMultimeshOptions(const inbetween::v1::MeshingParameters& meshing);
+
+// Validated comesh parameters -> solver options with the proto's defaults (w 0.5, 50 outer and
+// 200 inner iterations, relative decrease 1e-6); other options keep the solver's defaults.
+solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& comesh);
 
 // Request fields that are set (non-zero, present or non-empty) override the session's.
 inbetween::v1::InbetweenParameters MergeInbetween(

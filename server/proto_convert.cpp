@@ -89,14 +89,30 @@ absl::StatusOr<solver::Multimesh> MultimeshFromProto(const inbetween::v1::Multim
   return out;
 }
 
-solver::Drawing DrawingFromElements(const inbetween::v1::Drawing& drawing) {
+solver::Points FromProto(const google::protobuf::RepeatedPtrField<inbetween::v1::Point>& points) {
+  solver::Points out;
+  out.reserve(points.size());
+  for (const inbetween::v1::Point& p : points) out.emplace_back(p.x(), p.y());
+  return out;
+}
+
+solver::Drawing SolverDrawing(
+    const google::protobuf::RepeatedPtrField<inbetween::v1::TopologyElement>& elements) {
   solver::Drawing out;
-  for (const inbetween::v1::TopologyElement& element : drawing.elements()) {
-    if (element.kind() != inbetween::v1::ELEMENT_KIND_OUTLINE) continue;
-    solver::Outline& outline = out.outlines.emplace_back();
-    outline.points.reserve(element.polyline().points_size());
-    for (const inbetween::v1::Point& p : element.polyline().points()) {
-      outline.points.emplace_back(p.x(), p.y());
+  for (const inbetween::v1::TopologyElement& element : elements) {
+    solver::Points points = FromProto(element.polyline().points());
+    switch (element.kind()) {
+      case inbetween::v1::ELEMENT_KIND_OUTLINE:
+        out.outlines.push_back({std::move(points)});
+        break;
+      case inbetween::v1::ELEMENT_KIND_CUT:
+        out.cuts.push_back(std::move(points));
+        break;
+      case inbetween::v1::ELEMENT_KIND_OPENING:
+        out.openings.push_back(std::move(points));
+        break;
+      default:
+        break;
     }
   }
   return out;

@@ -19,7 +19,11 @@ inbetween::v1::Multimesh ToProto(const solver::Multimesh& mesh);
 absl::StatusOr<solver::Multimesh> MultimeshFromProto(const inbetween::v1::Multimesh& mesh,
                                                      absl::string_view field);
 
-// The solver drawing of an imported drawing: its OUTLINE elements, in element order.
-solver::Drawing DrawingFromElements(const inbetween::v1::Drawing& drawing);
+// The solver drawing of a drawing's elements: OUTLINE -> outlines, CUT -> cuts, OPENING ->
+// openings, each in element order (what ImportDrawing produced from the same elements).
+solver::Drawing SolverDrawing(
+    const google::protobuf::RepeatedPtrField<inbetween::v1::TopologyElement>& elements);
+
+solver::Points FromProto(const google::protobuf::RepeatedPtrField<inbetween::v1::Point>& points);
 
 }  // namespace inbetween::server

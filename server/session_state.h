@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "inbetween/v1/inbetween.pb.h"
@@ -22,6 +23,8 @@ struct SessionState {
   std::shared_ptr<const solver::Multimesh> multimesh;
   // Next drawing id to hand out; ids are never reused within a session.
   uint32_t next_drawing_id = 1;
+  // Who may see the session: the caller's token name (auth.h), "" when the server has no tokens.
+  std::string owner;
 };
 
 }  // namespace inbetween::server

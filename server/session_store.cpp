@@ -21,11 +21,36 @@ int64_t NowUnixMs() {
       .count();
 }
 
-namespace {
-
-absl::Status NotFound(absl::string_view id) {
+absl::Status SessionNotFoundError(absl::string_view id) {
   return absl::NotFoundError(absl::StrCat("session ", id, " not found"));
 }
+
+absl::StatusOr<uint64_t> ParsePageToken(absl::string_view page_token) {
+  uint64_t after = 0;
+  if (page_token.empty()) return after;
+  auto [end, error] =
+      std::from_chars(page_token.data(), page_token.data() + page_token.size(), after);
+  if (error != std::errc() || end != page_token.data() + page_token.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("page_token '", page_token, "' is not a token from ListSessions"));
+  }
+  return after;
+}
+
+std::string RandomSessionId(std::mt19937_64& rng) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  uint64_t bits = rng();
+  std::string id(16, '0');
+  for (char& c : id) {
+    c = kHex[bits & 0xf];
+    bits >>= 4;
+  }
+  return id;
+}
+
+namespace {
+
+absl::Status NotFound(absl::string_view id) { return SessionNotFoundError(id); }
 
 }  // namespace
 
@@ -33,14 +58,8 @@ MemorySessionStore::MemorySessionStore(size_t max_sessions)
     : max_sessions_(max_sessions), rng_(std::random_device{}()) {}
 
 std::string MemorySessionStore::NewIdLocked() {
-  static constexpr char kHex[] = "0123456789abcdef";
   while (true) {
-    uint64_t bits = rng_();
-    std::string id(16, '0');
-    for (char& c : id) {
-      c = kHex[bits & 0xf];
-      bits >>= 4;
-    }
+    std::string id = RandomSessionId(rng_);
     if (!by_id_.contains(id)) return id;
   }
 }
@@ -91,29 +110,37 @@ absl::StatusOr<SessionState> MemorySessionStore::Put(SessionState state,
   return it->second.state;
 }
 
-absl::StatusOr<SessionPage> MemorySessionStore::List(size_t page_size,
-                                                     absl::string_view page_token) const {
+absl::StatusOr<SessionPage> MemorySessionStore::List(size_t page_size, absl::string_view page_token,
+                                                     absl::string_view owner) const {
   // The token is the sequence number of the last session of the previous page, so pages stay
   // consistent while sessions are created and deleted in between.
-  uint64_t after = 0;
-  if (!page_token.empty()) {
-    auto [end, error] =
-        std::from_chars(page_token.data(), page_token.data() + page_token.size(), after);
-    if (error != std::errc() || end != page_token.data() + page_token.size()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("page_token '", page_token, "' is not a token from ListSessions"));
-    }
-  }
+  absl::StatusOr<uint64_t> after = ParsePageToken(page_token);
+  if (!after.ok()) return after.status();
   std::lock_guard lock(mutex_);
   SessionPage page;
-  for (auto it = by_sequence_.upper_bound(after); it != by_sequence_.end(); ++it) {
+  for (auto it = by_sequence_.upper_bound(*after); it != by_sequence_.end(); ++it) {
+    const SessionState& state = by_id_.find(it->second)->second.state;
+    if (state.owner != owner) continue;
     if (page.sessions.size() == page_size) {
-      page.next_page_token = absl::StrCat(std::prev(it)->first);
+      page.next_page_token = absl::StrCat(page.last_sequence);
       break;
     }
-    page.sessions.push_back(by_id_.find(it->second)->second.state);
+    page.sessions.push_back(state);
+    page.last_sequence = it->first;
   }
   return page;
+}
+
+size_t MemorySessionStore::CountOwned(absl::string_view owner) const {
+  std::lock_guard lock(mutex_);
+  size_t n = 0;
+  for (const auto& [id, entry] : by_id_) n += entry.state.owner == owner;
+  return n;
+}
+
+size_t MemorySessionStore::Count() const {
+  std::lock_guard lock(mutex_);
+  return by_id_.size();
 }
 
 absl::Status MemorySessionStore::Delete(absl::string_view id, uint64_t expected_version) {

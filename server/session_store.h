@@ -21,6 +21,7 @@ namespace inbetween::server {
 struct SessionPage {
   std::vector<SessionState> sessions;
   std::string next_page_token;  // empty = last page
+  uint64_t last_sequence = 0;   // the store's position of the last session on the page
 };
 
 class SessionStore {
@@ -40,16 +41,30 @@ class SessionStore {
   // version and created fields are ignored. Returns the stored state.
   virtual absl::StatusOr<SessionState> Put(SessionState state, uint64_t expected_version) = 0;
 
-  // Up to page_size sessions after page_token (from a previous page; empty = the first page).
-  virtual absl::StatusOr<SessionPage> List(size_t page_size,
-                                           absl::string_view page_token) const = 0;
+  // Up to page_size sessions of `owner` after page_token (from a previous page; empty = the
+  // first page).
+  virtual absl::StatusOr<SessionPage> List(size_t page_size, absl::string_view page_token,
+                                           absl::string_view owner) const = 0;
+
+  // Number of sessions of `owner` (for the sessions-per-token limit) and in total.
+  virtual size_t CountOwned(absl::string_view owner) const = 0;
+  virtual size_t Count() const = 0;
 
   // Deletes the session; expected_version 0 deletes whatever the version.
   virtual absl::Status Delete(absl::string_view id, uint64_t expected_version) = 0;
 };
 
 // The ABORTED status of a stale expected version, worded the same by every store.
+// (NOT_FOUND is worded by NotFoundError below.)
 absl::Status StaleVersionError(absl::string_view id, uint64_t current, uint64_t expected);
+
+absl::Status SessionNotFoundError(absl::string_view id);
+
+// Parses a List page token (a sequence number); INVALID_ARGUMENT if it is not one.
+absl::StatusOr<uint64_t> ParsePageToken(absl::string_view page_token);
+
+// A fresh random session id (16 lowercase hex digits).
+std::string RandomSessionId(std::mt19937_64& rng);
 
 // Milliseconds since the Unix epoch (wall clock).
 int64_t NowUnixMs();
@@ -62,7 +77,10 @@ class MemorySessionStore final : public SessionStore {
   absl::StatusOr<SessionState> Get(absl::string_view id) const override;
   absl::StatusOr<SessionState> Create(SessionState state) override;
   absl::StatusOr<SessionState> Put(SessionState state, uint64_t expected_version) override;
-  absl::StatusOr<SessionPage> List(size_t page_size, absl::string_view page_token) const override;
+  absl::StatusOr<SessionPage> List(size_t page_size, absl::string_view page_token,
+                                   absl::string_view owner) const override;
+  size_t CountOwned(absl::string_view owner) const override;
+  size_t Count() const override;
   absl::Status Delete(absl::string_view id, uint64_t expected_version) override;
 
  private:

@@ -235,36 +235,6 @@ TEST_F(InbetweenServiceTest, UnknownOrMissingSessionId) {
   EXPECT_THAT(status.error_message(), HasSubstr("session_id"));
 }
 
-TEST_F(InbetweenServiceTest, UnimplementedRpcs) {
-  {
-    grpc::ClientContext context;
-    auto stream = stub_->EditTopology(&context);
-    v1::TopologyEdit edit;
-    edit.set_session_id("x");
-    stream->Write(edit);
-    stream->WritesDone();
-    v1::TopologyState state;
-    while (stream->Read(&state)) {
-    }
-    grpc::Status status = stream->Finish();
-    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
-    EXPECT_THAT(status.error_message(), HasSubstr("EditTopology"));
-  }
-  {
-    grpc::ClientContext context;
-    v1::OptimizeComeshRequest request;
-    auto reader = stub_->OptimizeComesh(&context, request);
-    v1::OptimizeComeshResponse message;
-    while (reader->Read(&message)) {
-    }
-    grpc::Status status = reader->Finish();
-    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
-    EXPECT_THAT(status.error_message(), HasSubstr("OptimizeComesh"));
-  }
-  // The server is still fine.
-  EXPECT_FALSE(CreateSession().id().empty());
-}
-
 // ---------------------------------------------------------------------------------------------
 // Drawings
 
@@ -332,7 +302,9 @@ TEST_F(InbetweenServiceTest, PolylineDrawingsAreValidated) {
 
   v1::TopologyElement cut = SquareOutline(0, 0, 1);
   cut.set_kind(v1::ELEMENT_KIND_CUT);
-  EXPECT_EQ(PutPolylines(session, cut, &response).error_code(), grpc::StatusCode::UNIMPLEMENTED);
+  status = PutPolylines(session, cut, &response);  // a cut alone has no outline to cut
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("no outer outline"));
 
   grpc::ClientContext context;
   v1::PutDrawingRequest no_source;

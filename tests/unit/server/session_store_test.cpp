@@ -84,7 +84,7 @@ TEST(MemorySessionStoreTest, ListPagesInCreationOrder) {
   std::string token;
   int pages = 0;
   do {
-    absl::StatusOr<SessionPage> page = store.List(3, token);
+    absl::StatusOr<SessionPage> page = store.List(3, token, "");
     ASSERT_TRUE(page.ok()) << page.status();
     for (const SessionState& s : page->sessions) listed.push_back(s.session.id());
     token = page->next_page_token;
@@ -94,9 +94,9 @@ TEST(MemorySessionStoreTest, ListPagesInCreationOrder) {
   EXPECT_EQ(pages, 3);
 
   // A deletion between pages neither repeats nor skips the remaining sessions.
-  absl::StatusOr<SessionPage> first = store.List(3, "");
+  absl::StatusOr<SessionPage> first = store.List(3, "", "");
   ASSERT_TRUE(store.Delete(created[3], 0).ok());
-  absl::StatusOr<SessionPage> second = store.List(3, first->next_page_token);
+  absl::StatusOr<SessionPage> second = store.List(3, first->next_page_token, "");
   ASSERT_EQ(second->sessions.size(), 3u);
   EXPECT_EQ(second->sessions[0].session.id(), created[4]);
   EXPECT_TRUE(second->next_page_token.empty());
@@ -104,7 +104,7 @@ TEST(MemorySessionStoreTest, ListPagesInCreationOrder) {
 
 TEST(MemorySessionStoreTest, BadPageTokenIsInvalidArgument) {
   MemorySessionStore store;
-  absl::Status status = store.List(10, "garbage").status();
+  absl::Status status = store.List(10, "garbage", "").status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("page_token"));
 }

@@ -3,9 +3,12 @@
 #pragma once
 
 #include <grpcpp/client_context.h>
+#include <grpcpp/generic/generic_stub.h>
+#include <grpcpp/support/byte_buffer.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <future>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -17,6 +20,37 @@
 namespace inbetween::server::testing {
 
 namespace v1 = ::inbetween::v1;
+
+// grpc.health.v1.Health/Check through a generic stub (Debian ships no generated health proto):
+// the request is `string service = 1`, the reply `ServingStatus status = 1` (SERVING = 1).
+// Returns the status value, or -1 on an RPC error.
+inline int HealthCheck(const std::shared_ptr<grpc::Channel>& channel, const std::string& service) {
+  std::string request_bytes;
+  if (!service.empty()) {
+    request_bytes.push_back(0x0a);                               // field 1, length-delimited
+    request_bytes.push_back(static_cast<char>(service.size()));  // < 128: one varint byte
+    request_bytes += service;
+  }
+  grpc::Slice slice(request_bytes);
+  grpc::ByteBuffer request(&slice, 1);
+  grpc::ByteBuffer response;
+  grpc::GenericStub stub(channel);
+  grpc::ClientContext context;
+  std::promise<grpc::Status> done;
+  stub.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request, &response,
+                 [&done](grpc::Status status) { done.set_value(status); });
+  grpc::Status status = done.get_future().get();
+  if (!status.ok()) return -1;
+  std::vector<grpc::Slice> slices;
+  EXPECT_TRUE(response.Dump(&slices).ok());
+  std::string bytes;
+  for (const grpc::Slice& s : slices)
+    bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
+  if (bytes.empty()) return 0;  // UNKNOWN (the default) is encoded as nothing
+  EXPECT_EQ(bytes.size(), 2u);
+  EXPECT_EQ(bytes[0], 0x08);  // field 1, varint
+  return bytes[1];
+}
 
 inline std::string ReadExample(const std::string& relative) {
   std::ifstream in(std::string(INBETWEEN_SOURCE_DIR) + "/" + relative);

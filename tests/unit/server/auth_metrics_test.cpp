@@ -1,0 +1,197 @@
+// Bearer tokens (--tokens): UNAUTHENTICATED without a valid token, sessions owned by their token
+// (another token sees NOT_FOUND, lists only its own), health open; limits with their flags;
+// metrics text and the /metrics responder.
+#include <arpa/inet.h>
+#include <gmock/gmock.h>
+#include <grpcpp/client_context.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "server/auth.h"
+#include "server/metrics.h"
+#include "tests/unit/server/test_server.h"
+
+namespace inbetween::server::testing {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(TokenTableTest, ParsesTokensWithOptionalNames) {
+  auto table = TokenTable::Parse("# comment\n\nsecret-a alice\nsecret-b\n", "tokens");
+  ASSERT_TRUE(table.ok()) << table.status();
+  EXPECT_EQ(table->size(), 2u);
+  EXPECT_EQ(*table->Owner("Bearer secret-a"), "alice");
+  EXPECT_THAT(*table->Owner("bearer secret-b"), HasSubstr("token-"));
+  EXPECT_EQ(table->Owner("").status().code(), absl::StatusCode::kUnauthenticated);
+  EXPECT_EQ(table->Owner("Bearer nope").status().code(), absl::StatusCode::kUnauthenticated);
+  EXPECT_EQ(table->Owner("Basic secret-a").status().code(), absl::StatusCode::kUnauthenticated);
+  EXPECT_THAT(TokenTable::Parse("a b c\n", "tokens").status().message(), HasSubstr("line 1"));
+  EXPECT_THAT(TokenTable::Parse("a\na\n", "tokens").status().message(), HasSubstr("repeated"));
+}
+
+TEST(MetricsTest, RendersCountersHistogramsAndGauges) {
+  Metrics metrics;
+  metrics.ObserveRpc("GetSession", "OK", 0.002);
+  metrics.ObserveRpc("GetSession", "NOT_FOUND", 0.2);
+  metrics.ObserveStage("build", 1.5);
+  const std::string text = metrics.Render({{"inbetween_active_sessions", "Sessions.", 3}});
+  EXPECT_THAT(text, HasSubstr("inbetween_rpcs_total{method=\"GetSession\",code=\"OK\"} 1"));
+  EXPECT_THAT(text, HasSubstr("inbetween_rpcs_total{method=\"GetSession\",code=\"NOT_FOUND\"} 1"));
+  EXPECT_THAT(
+      text,
+      HasSubstr("inbetween_rpc_duration_seconds_bucket{method=\"GetSession\",le=\"0.005\"} 1"));
+  EXPECT_THAT(
+      text,
+      HasSubstr("inbetween_rpc_duration_seconds_bucket{method=\"GetSession\",le=\"+Inf\"} 2"));
+  EXPECT_THAT(text, HasSubstr("inbetween_stage_seconds_count{stage=\"build\"} 1"));
+  EXPECT_THAT(text, HasSubstr("inbetween_active_sessions 3"));
+}
+
+// GET `path` from 127.0.0.1:port; the whole response.
+std::string HttpGet(int port, const std::string& path) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    close(fd);
+    return "";
+  }
+  const std::string request = "GET " + path + " HTTP/1.1\r\nHost: x\r\n\r\n";
+  (void)!write(fd, request.data(), request.size());
+  std::string response;
+  char buffer[4096];
+  ssize_t n;
+  while ((n = read(fd, buffer, sizeof(buffer))) > 0) response.append(buffer, n);
+  close(fd);
+  return response;
+}
+
+class SecuredServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    tokens_ =
+        std::filesystem::temp_directory_path() / ("tokens_" + std::to_string(getpid()) + ".txt");
+    std::ofstream(tokens_) << "token-a alice\ntoken-b bob\n";
+    ServerOptions options;
+    options.listen = "127.0.0.1:0";
+    options.metrics_listen = "127.0.0.1:0";
+    options.tokens_file = tokens_.string();
+    options.shutdown_grace = std::chrono::milliseconds(200);
+    options.service.limits.max_sessions_per_token = 2;
+    options.service.limits.max_frames = 10;
+    auto server = InbetweenServer::Start(options);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = *std::move(server);
+    channel_ = server_->InProcessChannel();
+    stub_ = v1::Inbetween::NewStub(channel_);
+  }
+  void TearDown() override { std::filesystem::remove(tokens_); }
+
+  void Authorize(grpc::ClientContext* context, const std::string& token) {
+    if (!token.empty()) context->AddMetadata("authorization", "Bearer " + token);
+  }
+
+  grpc::Status Create(const std::string& token, v1::Session* session) {
+    grpc::ClientContext context;
+    Authorize(&context, token);
+    v1::CreateSessionRequest request;
+    v1::CreateSessionResponse response;
+    grpc::Status status = stub_->CreateSession(&context, request, &response);
+    *session = response.session();
+    return status;
+  }
+
+  grpc::Status Get(const std::string& token, const std::string& id) {
+    grpc::ClientContext context;
+    Authorize(&context, token);
+    v1::GetSessionRequest request;
+    request.set_session_id(id);
+    v1::GetSessionResponse response;
+    return stub_->GetSession(&context, request, &response);
+  }
+
+  std::filesystem::path tokens_;
+  std::unique_ptr<InbetweenServer> server_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::Inbetween::Stub> stub_;
+};
+
+TEST_F(SecuredServerTest, TokensOwnSessions) {
+  v1::Session session;
+  EXPECT_EQ(Create("", &session).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(Create("wrong", &session).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  ASSERT_TRUE(Create("token-a", &session).ok());
+  const std::string id = session.id();
+  EXPECT_TRUE(Get("token-a", id).ok());
+  grpc::Status other = Get("token-b", id);
+  EXPECT_EQ(other.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(other.error_message(), Get("token-b", "does-not-exist")
+                                       .error_message()
+                                       .replace(8, std::string("does-not-exist").size(), id));
+  EXPECT_EQ(Get("", id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  {
+    grpc::ClientContext context;
+    Authorize(&context, "token-b");
+    v1::DeleteSessionRequest request;
+    request.set_session_id(id);
+    v1::DeleteSessionResponse response;
+    EXPECT_EQ(stub_->DeleteSession(&context, request, &response).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+  }
+  v1::Session b;
+  ASSERT_TRUE(Create("token-b", &b).ok());
+  for (const auto& [token, expected] : {std::pair{"token-a", id}, {"token-b", b.id()}}) {
+    grpc::ClientContext context;
+    Authorize(&context, token);
+    v1::ListSessionsRequest request;
+    v1::ListSessionsResponse response;
+    ASSERT_TRUE(stub_->ListSessions(&context, request, &response).ok());
+    ASSERT_EQ(response.sessions_size(), 1) << token;
+    EXPECT_EQ(response.sessions(0).id(), expected);
+  }
+  // --max-sessions-per-token = 2.
+  ASSERT_TRUE(Create("token-a", &session).ok());
+  grpc::Status full = Create("token-a", &session);
+  EXPECT_EQ(full.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(full.error_message(), HasSubstr("--max-sessions-per-token"));
+
+  // Health needs no token.
+  EXPECT_EQ(HealthCheck(channel_, "inbetween.v1.Inbetween"), 1);
+}
+
+TEST_F(SecuredServerTest, FrameLimitAndMetricsEndpoint) {
+  v1::Session session;
+  ASSERT_TRUE(Create("token-a", &session).ok());
+  grpc::ClientContext context;
+  Authorize(&context, "token-a");
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(11);
+  auto reader = stub_->Inbetween(&context, request);
+  v1::InbetweenResponse message;
+  while (reader->Read(&message)) {
+  }
+  // The stage check comes first for a session without a multimesh.
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+
+  ASSERT_GT(server_->metrics_port(), 0);
+  const std::string metrics = HttpGet(server_->metrics_port(), "/metrics");
+  EXPECT_THAT(metrics, HasSubstr("HTTP/1.1 200 OK"));
+  EXPECT_THAT(metrics, HasSubstr("inbetween_rpcs_total{method=\"CreateSession\",code=\"OK\"} 1"));
+  EXPECT_THAT(metrics, HasSubstr("code=\"FAILED_PRECONDITION\""));
+  EXPECT_THAT(metrics, HasSubstr("inbetween_active_sessions 1"));
+  EXPECT_THAT(metrics, HasSubstr("inbetween_heavy_queue_depth 0"));
+  EXPECT_THAT(HttpGet(server_->metrics_port(), "/other"), HasSubstr("404"));
+}
+
+}  // namespace
+}  // namespace inbetween::server::testing

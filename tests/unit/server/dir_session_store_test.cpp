@@ -1,0 +1,136 @@
+// DirSessionStore: versions on disk, reopening finds every session with its multimesh, listing
+// by owner, deletion, old snapshots trimmed.
+#include "server/dir_session_store.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "server/drawing_import.h"
+#include "tests/unit/server/test_server.h"
+
+namespace inbetween::server::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+class DirSessionStoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() /
+            ("dir_store_test_" + std::to_string(getpid()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(root_);
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  std::unique_ptr<DirSessionStore> Open() {
+    auto store = DirSessionStore::Open(root_.string());
+    EXPECT_TRUE(store.ok()) << store.status();
+    return store.ok() ? *std::move(store) : nullptr;
+  }
+
+  // A state with one drawing (square with an opening) and a two-triangle multimesh.
+  static SessionState State(const std::string& owner) {
+    SessionState state;
+    state.owner = owner;
+    state.session.set_display_name("squares");
+    v1::Drawing* drawing = state.session.add_drawings();
+    drawing->set_id(1);
+    *drawing->add_elements() = SquareOutline(0, 0, 1);
+    drawing->mutable_elements(0)->set_id(1);
+    auto imported = ImportDrawingElements(*drawing, "drawing 1", 1);
+    EXPECT_TRUE(imported.ok()) << imported.status();
+    state.parsed.push_back(imported->parsed);
+    state.next_drawing_id = 2;
+    auto mesh = std::make_shared<solver::Multimesh>();
+    mesh->triangles = {{0, 1, 2}, {0, 2, 3}};
+    mesh->shapes = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{0, 0}, {2, 0}, {2, 2}, {0, 2}}};
+    mesh->boundary = {0, 1, 2, 3};
+    mesh->boundary_loops = {{0, 1, 2, 3}};
+    state.multimesh = mesh;
+    state.session.set_stage(v1::STAGE_MULTIMESH);
+    return state;
+  }
+
+  fs::path root_;
+};
+
+TEST_F(DirSessionStoreTest, SessionsSurviveReopeningWithTheirMultimesh) {
+  std::string id;
+  {
+    auto store = Open();
+    auto created = store->Create(State("alice"));
+    ASSERT_TRUE(created.ok()) << created.status();
+    id = created->session.id();
+    for (uint64_t v = 1; v <= 4; ++v) {
+      SessionState next = *created;
+      next.session.set_display_name("v" + std::to_string(v + 1));
+      auto put = store->Put(next, v);
+      ASSERT_TRUE(put.ok()) << put.status();
+      EXPECT_EQ(put->session.version(), v + 1);
+    }
+    EXPECT_EQ(store->Put(*created, 1).status().code(), absl::StatusCode::kAborted);
+    ASSERT_TRUE(store->Create(State("bob")).ok());
+  }
+  // Only the newest snapshots are kept.
+  int files = 0;
+  for (const auto& f : fs::directory_iterator(root_ / "sessions" / id))
+    files += f.is_regular_file();
+  EXPECT_EQ(files, 2);
+
+  auto store = Open();
+  EXPECT_EQ(store->Count(), 2u);
+  EXPECT_EQ(store->CountOwned("alice"), 1u);
+  auto got = store->Get(id);
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->session.version(), 5u);
+  EXPECT_EQ(got->session.display_name(), "v5");
+  EXPECT_EQ(got->owner, "alice");
+  EXPECT_EQ(got->next_drawing_id, 2u);
+  ASSERT_EQ(got->parsed.size(), 1u);
+  EXPECT_EQ(got->parsed[0].outlines.size(), 1u);
+  ASSERT_TRUE(got->multimesh);
+  EXPECT_EQ(got->multimesh->triangles.size(), 2u);
+  EXPECT_EQ(got->multimesh->shapes[1][2], solver::Point(2, 2));
+  EXPECT_EQ(got->multimesh->boundary_loops.size(), 1u);
+
+  auto page = store->List(10, "", "alice");
+  ASSERT_TRUE(page.ok());
+  ASSERT_EQ(page->sessions.size(), 1u);
+  EXPECT_EQ(page->sessions[0].session.id(), id);
+
+  // Versions go on after a restart; a deletion is durable.
+  ASSERT_TRUE(store->Put(*got, 5).ok());
+  ASSERT_TRUE(store->Delete(id, 6).ok());
+  EXPECT_EQ(store->Get(id).status().code(), absl::StatusCode::kNotFound);
+  store.reset();
+  store = Open();
+  EXPECT_EQ(store->Get(id).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(store->Count(), 1u);
+}
+
+TEST_F(DirSessionStoreTest, LeftoverTempFilesAreIgnored) {
+  std::string id;
+  {
+    auto store = Open();
+    auto created = store->Create(State(""));
+    ASSERT_TRUE(created.ok());
+    id = created->session.id();
+  }
+  // A crash between write and rename leaves a temp file behind; it is not a version.
+  std::FILE* f = std::fopen((root_ / "sessions" / id / ".tmp-junk").c_str(), "w");
+  std::fputs("partial", f);
+  std::fclose(f);
+  auto store = Open();
+  auto got = store->Get(id);
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->session.version(), 1u);
+  EXPECT_FALSE(fs::exists(root_ / "sessions" / id / ".tmp-junk"));
+}
+
+}  // namespace
+}  // namespace inbetween::server::testing
