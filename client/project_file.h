@@ -27,7 +27,7 @@ struct ProjectDrawing {
 };
 
 struct OutputSettings {
-  std::vector<std::string> formats = {"svg", "json"};
+  std::vector<std::string> formats = {"svg", "json", "gif"};
   int width = 512;      // raster width in pixels
   double fps = 24.0;    // animation rate for GIF/WebP/Lottie
   std::string fill = "#3b7dd8";
