@@ -8,7 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "solver/comesh/mips_energy.h"
 #include "solver/comesh/odt_energy.h"
-#include "solver/comesh/parallel_chunks.h"
+#include "solver/core/parallel_chunks.h"
 
 namespace inbetween::solver {
 

@@ -19,7 +19,7 @@
 #include "absl/strings/str_format.h"
 #include "solver/comesh/comesh_objective.h"
 #include "solver/comesh/comesh_topology.h"
-#include "solver/comesh/parallel_chunks.h"
+#include "solver/core/parallel_chunks.h"
 #include "solver/core/sparse_cholesky.h"
 
 namespace inbetween::solver {

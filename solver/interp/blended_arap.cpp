@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "solver/comesh/parallel_chunks.h"  // shared deterministic parallel-for
+#include "solver/core/parallel_chunks.h"
 #include "solver/interp/example_rotations.h"
 #include "solver/interp/polar.h"
 

@@ -1,4 +1,5 @@
-// A deterministic parallel-for over fixed-size chunks for the comesh stage (std::thread, no pool).
+// A deterministic parallel-for over fixed-size chunks (std::thread, no pool), shared by the
+// comesh and inbetweening stages.
 //
 // Work [0, n) is cut into chunks of a fixed size that does NOT depend on the thread count, and
 // chunk c always runs on thread c % threads. Callers write per-chunk results into per-chunk slots
