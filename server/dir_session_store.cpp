@@ -188,6 +188,7 @@ absl::Status DirSessionStore::WriteSnapshotLocked(const SessionState& state) {
 
 absl::StatusOr<SessionState*> DirSessionStore::LoadLocked(Entry& entry) const {
   entry.last_used = ++clock_;
+  entry.used_at = std::chrono::steady_clock::now();
   if (entry.cached) return &*entry.cached;
   const fs::path file = SessionDir(entry.summary.id()) / VersionFile(entry.summary.version());
   absl::StatusOr<std::string> bytes = ReadFile(file);
@@ -214,6 +215,25 @@ void DirSessionStore::TrimCacheLocked() const {
   }
 }
 
+size_t DirSessionStore::EvictIdle(std::chrono::steady_clock::time_point idle_before) {
+  std::lock_guard lock(mutex_);
+  size_t evicted = 0;
+  for (auto& [id, entry] : by_id_) {
+    if (entry.cached && entry.used_at < idle_before) {
+      entry.cached.reset();  // the newest snapshot on disk is this version
+      ++evicted;
+    }
+  }
+  return evicted;
+}
+
+size_t DirSessionStore::CachedCount() const {
+  std::lock_guard lock(mutex_);
+  size_t n = 0;
+  for (const auto& [id, entry] : by_id_) n += entry.cached.has_value();
+  return n;
+}
+
 absl::StatusOr<SessionState> DirSessionStore::Get(absl::string_view id) const {
   std::lock_guard lock(mutex_);
   auto it = by_id_.find(id);
@@ -237,11 +257,7 @@ absl::StatusOr<SessionState> DirSessionStore::Create(SessionState state) {
   } else if (by_id_.contains(id)) {
     return absl::AlreadyExistsError(absl::StrCat("session ", id, " already exists"));
   }
-  const int64_t now = NowUnixMs();
-  state.session.set_id(id);
-  if (state.session.version() == 0) state.session.set_version(1);
-  if (state.session.created_unix_ms() == 0) state.session.set_created_unix_ms(now);
-  state.session.set_updated_unix_ms(now);
+  StampCreated(state, id);
   if (absl::Status s = WriteSnapshotLocked(state); !s.ok()) return s;
   Entry entry;
   entry.sequence = next_sequence_++;
@@ -249,6 +265,7 @@ absl::StatusOr<SessionState> DirSessionStore::Create(SessionState state) {
   entry.summary = SessionSummary(state.session);
   entry.cached = state;
   entry.last_used = ++clock_;
+  entry.used_at = std::chrono::steady_clock::now();
   by_sequence_.emplace(entry.sequence, id);
   by_id_.emplace(id, std::move(entry));
   TrimCacheLocked();
@@ -260,17 +277,17 @@ absl::StatusOr<SessionState> DirSessionStore::Put(SessionState state, uint64_t e
   auto it = by_id_.find(state.session.id());
   if (it == by_id_.end()) return SessionNotFoundError(state.session.id());
   Entry& entry = it->second;
-  if (entry.summary.version() != expected_version) {
-    return StaleVersionError(entry.summary.id(), entry.summary.version(), expected_version);
+  if (auto s = CheckPutVersion(entry.summary.id(), entry.summary.version(), expected_version);
+      !s.ok()) {
+    return s;
   }
-  state.session.set_version(entry.summary.version() + 1);
-  state.session.set_created_unix_ms(entry.summary.created_unix_ms());
-  state.session.set_updated_unix_ms(NowUnixMs());
+  StampPut(state, entry.summary);
   state.owner = entry.owner;
   if (absl::Status s = WriteSnapshotLocked(state); !s.ok()) return s;
   entry.summary = SessionSummary(state.session);
   entry.cached = state;
   entry.last_used = ++clock_;
+  entry.used_at = std::chrono::steady_clock::now();
   TrimCacheLocked();
   return state;
 }
@@ -280,21 +297,15 @@ absl::StatusOr<SessionPage> DirSessionStore::List(size_t page_size, absl::string
   absl::StatusOr<uint64_t> after = ParsePageToken(page_token);
   if (!after.ok()) return after.status();
   std::lock_guard lock(mutex_);
-  SessionPage page;
-  for (auto it = by_sequence_.upper_bound(*after); it != by_sequence_.end(); ++it) {
-    const Entry& entry = by_id_.find(it->second)->second;
-    if (entry.owner != owner) continue;
-    if (page.sessions.size() == page_size) {
-      page.next_page_token = absl::StrCat(page.last_sequence);
-      break;
-    }
-    // Summaries only: listing does not load sessions.
-    SessionState& state = page.sessions.emplace_back();
-    state.session = entry.summary;
-    state.owner = entry.owner;
-    page.last_sequence = it->first;
-  }
-  return page;
+  // Summaries only: listing does not load sessions.
+  return PageBySequence(by_sequence_, page_size, *after,
+                        [&](const std::string& id, SessionState* state) {
+                          const Entry& entry = by_id_.find(id)->second;
+                          if (entry.owner != owner) return false;
+                          state->session = entry.summary;
+                          state->owner = entry.owner;
+                          return true;
+                        });
 }
 
 size_t DirSessionStore::CountOwned(absl::string_view owner) const {
@@ -313,9 +324,8 @@ absl::Status DirSessionStore::Delete(absl::string_view id, uint64_t expected_ver
   std::lock_guard lock(mutex_);
   auto it = by_id_.find(id);
   if (it == by_id_.end()) return SessionNotFoundError(id);
-  const uint64_t version = it->second.summary.version();
-  if (expected_version != 0 && expected_version != version) {
-    return StaleVersionError(id, version, expected_version);
+  if (auto s = CheckDeleteVersion(id, it->second.summary.version(), expected_version); !s.ok()) {
+    return s;
   }
   // One rename makes the deletion durable; the files go afterwards (or at the next start).
   const fs::path trash = root_ / "trash" / absl::StrCat(id, "-", it->second.sequence);

@@ -6,6 +6,7 @@
 // cached (at most max_cached sessions in memory, least recently used dropped first).
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -40,6 +41,8 @@ class DirSessionStore final : public SessionStore {
   size_t CountOwned(absl::string_view owner) const override;
   size_t Count() const override;
   absl::Status Delete(absl::string_view id, uint64_t expected_version) override;
+  size_t EvictIdle(std::chrono::steady_clock::time_point idle_before) override;
+  size_t CachedCount() const override;
 
  private:
   struct Entry {
@@ -48,6 +51,7 @@ class DirSessionStore final : public SessionStore {
     inbetween::v1::Session summary;
     std::optional<SessionState> cached;  // mutable through the const Get (a cache)
     uint64_t last_used = 0;
+    std::chrono::steady_clock::time_point used_at;  // for EvictIdle
   };
 
   DirSessionStore(std::filesystem::path root, DirStoreOptions options);

@@ -8,6 +8,7 @@
 #include <grpcpp/support/channel_arguments.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <utility>
@@ -17,6 +18,8 @@
 #include "server/dir_session_store.h"
 #include "server/inbetween_service.h"
 #include "server/metrics.h"
+#include "server/request_parse_errors.h"
+#include "server/redis_session_store.h"
 #include "server/session_store.h"
 
 namespace inbetween::server {
@@ -71,8 +74,17 @@ absl::StatusOr<std::shared_ptr<SessionStore>> OpenStore(const ServerOptions& opt
     if (!store.ok()) return store.status();
     return std::shared_ptr<SessionStore>(*std::move(store));
   }
+  if (absl::StartsWith(options.store, "redis://")) {
+    RedisStoreOptions redis;
+    redis.max_sessions = options.max_sessions;
+    absl::StatusOr<std::unique_ptr<RedisSessionStore>> store =
+        RedisSessionStore::Open(options.store, redis);
+    if (!store.ok()) return store.status();
+    return std::shared_ptr<SessionStore>(*std::move(store));
+  }
   return absl::InvalidArgumentError(
-      absl::StrCat("--store: '", options.store, "' is not supported (use 'memory' or 'dir:PATH')"));
+      absl::StrCat("--store: '", options.store,
+                   "' is not supported (use 'memory', 'dir:PATH' or 'redis://HOST:PORT[/DB]')"));
 }
 
 }  // namespace
@@ -117,6 +129,7 @@ absl::StatusOr<std::unique_ptr<InbetweenServer>> InbetweenServer::Start(
   builder.SetMaxReceiveMessageSize(options.max_message_bytes);
   builder.SetMaxSendMessageSize(options.max_message_bytes);
   builder.RegisterService(server->service_.get());
+  builder.experimental().SetInterceptorCreators(RequestParseErrorInterceptors());
   server->server_ = builder.BuildAndStart();
   if (!server->server_) {
     return absl::UnavailableError(
@@ -132,6 +145,10 @@ absl::StatusOr<std::unique_ptr<InbetweenServer>> InbetweenServer::Start(
     health->SetServingStatus("", true);
     health->SetServingStatus("inbetween.v1.Inbetween", true);
   }
+  if (options.idle_evict.count() > 0 && options.store != "memory") {
+    InbetweenServer* self = server.get();
+    server->evictor_ = std::thread([self] { self->EvictIdleLoop(); });
+  }
   if (!options.metrics_listen.empty()) {
     InbetweenServer* self = server.get();
     absl::StatusOr<std::unique_ptr<MetricsHttpServer>> http =
@@ -142,7 +159,29 @@ absl::StatusOr<std::unique_ptr<InbetweenServer>> InbetweenServer::Start(
   return server;
 }
 
+void InbetweenServer::EvictIdleLoop() {
+  // Sweep a few times per idle period (at most once a second), so a session leaves memory at
+  // most ~1.25 idle periods after its last use.
+  const auto idle = options_.idle_evict;
+  const auto period = std::clamp<std::chrono::milliseconds>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(idle) / 4,
+      std::chrono::milliseconds(50), std::chrono::milliseconds(1000));
+  std::unique_lock lock(evictor_mutex_);
+  while (!evictor_stop_.wait_for(lock, period, [this] { return evictor_stopping_; })) {
+    const size_t evicted = store_->EvictIdle(std::chrono::steady_clock::now() - idle);
+    if (evicted > 0) spdlog::debug("evicted {} idle sessions from memory", evicted);
+  }
+}
+
 InbetweenServer::~InbetweenServer() {
+  if (evictor_.joinable()) {
+    {
+      std::lock_guard lock(evictor_mutex_);
+      evictor_stopping_ = true;
+    }
+    evictor_stop_.notify_all();
+    evictor_.join();
+  }
   if (server_) {
     Shutdown();
     Wait();
@@ -165,6 +204,8 @@ std::string InbetweenServer::RenderMetrics() const {
   const HeavyJobs& heavy = service_->heavy_jobs();
   return metrics_->Render({
       {"inbetween_active_sessions", "Sessions in the store.", static_cast<double>(store_->Count())},
+      {"inbetween_cached_sessions", "Sessions held in this process's memory.",
+       static_cast<double>(store_->CachedCount())},
       {"inbetween_heavy_jobs_running", "Heavy jobs (build, optimize, inbetween) running.",
        static_cast<double>(heavy.running())},
       {"inbetween_heavy_queue_depth", "Heavy jobs waiting for a slot.",

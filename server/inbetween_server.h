@@ -7,9 +7,11 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 
 #include "absl/status/statusor.h"
 #include "server/inbetween_service.h"
@@ -23,9 +25,13 @@ inline constexpr int kMaxMessageBytes = 64 * 1024 * 1024;
 struct ServerOptions {
   // "host:port"; empty = no listening port (in-process only); port 0 = pick a free port.
   std::string listen;
-  // "memory" (default; the embedded CLI) or "dir:PATH" (snapshots, dir_session_store.h);
-  // anything else -> InvalidArgument naming the flag (--store).
+  // "memory" (default; the embedded CLI), "dir:PATH" (snapshots, dir_session_store.h) or
+  // "redis://HOST:PORT[/DB]" (shared by replicas, redis_session_store.h); anything else ->
+  // InvalidArgument naming the flag (--store).
   std::string store = "memory";
+  // Sessions of the dir and Redis stores not used for this long are dropped from memory (they
+  // stay in the store and reload on next use); 0 = never. --idle-evict-seconds.
+  std::chrono::seconds idle_evict{600};
   bool reflection = true;
   std::chrono::milliseconds shutdown_grace{5000};
   int max_message_bytes = kMaxMessageBytes;  // --max-message-bytes, both directions
@@ -56,9 +62,12 @@ class InbetweenServer {
   void Wait();  // blocks until the server has shut down
   // The Prometheus exposition text served on --metrics-listen.
   std::string RenderMetrics() const;
+  // The session store (tests look at its cache).
+  SessionStore& store() { return *store_; }
 
  private:
   InbetweenServer() = default;
+  void EvictIdleLoop();
 
   ServerOptions options_;
   int port_ = 0;
@@ -69,6 +78,11 @@ class InbetweenServer {
   std::unique_ptr<MetricsHttpServer> metrics_server_;
   std::once_flag shutdown_once_;
   std::atomic<bool> draining_{false};
+  // Idle eviction (--idle-evict-seconds): a thread sweeping the store's cache.
+  std::thread evictor_;
+  std::mutex evictor_mutex_;
+  std::condition_variable evictor_stop_;
+  bool evictor_stopping_ = false;
 };
 
 }  // namespace inbetween::server

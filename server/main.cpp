@@ -38,8 +38,10 @@ int main(int argc, char** argv) {
   app.add_option("--listen", listen, "HOST:PORT to listen on; port 0 picks a free port")
       ->capture_default_str();
   app.add_option("--store", store,
-                 "session store: memory | dir:PATH (one snapshot file per session version)")
+                 "session store: memory | dir:PATH (one snapshot file per session version) | "
+                 "redis://HOST:PORT[/DB] (shared by replicas)")
       ->capture_default_str();
+  int64_t idle_evict_seconds = 600;
   inbetween::server::ServerOptions options;
   inbetween::server::ServiceLimits& limits = options.service.limits;
   inbetween::server::HeavyJobOptions& heavy = options.service.heavy;
@@ -88,6 +90,11 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--metrics-listen", options.metrics_listen,
                  "HOST:PORT for Prometheus GET /metrics (off when empty)");
+  app.add_option("--idle-evict-seconds", idle_evict_seconds,
+                 "dir/redis stores: drop sessions unused this long from memory (they reload from "
+                 "the store on next use); 0 = never")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t{0}, int64_t{30'000'000}));
   app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off")
       ->capture_default_str();
   app.add_option("--log-format", log_format, "text|json")->capture_default_str();
@@ -118,6 +125,7 @@ int main(int argc, char** argv) {
   options.listen = listen;
   options.service.log_ok_rpcs_at_info = true;
   options.store = store;
+  options.idle_evict = std::chrono::seconds(idle_evict_seconds);
   options.reflection = !no_reflection;
   options.shutdown_grace = std::chrono::milliseconds(grace_ms);
   auto server = inbetween::server::InbetweenServer::Start(options);

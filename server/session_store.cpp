@@ -48,6 +48,48 @@ std::string RandomSessionId(std::mt19937_64& rng) {
   return id;
 }
 
+absl::Status CheckPutVersion(absl::string_view id, uint64_t current, uint64_t expected) {
+  if (current != expected) return StaleVersionError(id, current, expected);
+  return absl::OkStatus();
+}
+
+absl::Status CheckDeleteVersion(absl::string_view id, uint64_t current, uint64_t expected) {
+  if (expected == 0) return absl::OkStatus();
+  return CheckPutVersion(id, current, expected);
+}
+
+void StampCreated(SessionState& state, const std::string& id) {
+  const int64_t now = NowUnixMs();
+  state.session.set_id(id);
+  if (state.session.version() == 0) state.session.set_version(1);
+  if (state.session.created_unix_ms() == 0) state.session.set_created_unix_ms(now);
+  state.session.set_updated_unix_ms(now);
+}
+
+void StampPut(SessionState& state, const inbetween::v1::Session& current) {
+  state.session.set_version(current.version() + 1);
+  state.session.set_created_unix_ms(current.created_unix_ms());
+  state.session.set_updated_unix_ms(NowUnixMs());
+}
+
+absl::StatusOr<SessionPage> PageBySequence(
+    const std::map<uint64_t, std::string>& by_sequence, size_t page_size, uint64_t after,
+    const std::function<bool(const std::string& id, SessionState* state)>& listed) {
+  SessionPage page;
+  SessionState state;
+  for (auto it = by_sequence.upper_bound(after); it != by_sequence.end(); ++it) {
+    if (!listed(it->second, &state)) continue;
+    if (page.sessions.size() == page_size) {
+      page.next_page_token = absl::StrCat(page.last_sequence);
+      break;
+    }
+    page.sessions.push_back(std::move(state));
+    state = SessionState();
+    page.last_sequence = it->first;
+  }
+  return page;
+}
+
 namespace {
 
 absl::Status NotFound(absl::string_view id) { return SessionNotFoundError(id); }
@@ -83,11 +125,7 @@ absl::StatusOr<SessionState> MemorySessionStore::Create(SessionState state) {
   } else if (by_id_.contains(id)) {
     return absl::AlreadyExistsError(absl::StrCat("session ", id, " already exists"));
   }
-  const int64_t now = NowUnixMs();
-  state.session.set_id(id);
-  if (state.session.version() == 0) state.session.set_version(1);
-  if (state.session.created_unix_ms() == 0) state.session.set_created_unix_ms(now);
-  state.session.set_updated_unix_ms(now);
+  StampCreated(state, id);
   const uint64_t sequence = next_sequence_++;
   by_sequence_.emplace(sequence, id);
   auto [it, inserted] = by_id_.emplace(id, Entry{sequence, std::move(state)});
@@ -100,35 +138,26 @@ absl::StatusOr<SessionState> MemorySessionStore::Put(SessionState state,
   auto it = by_id_.find(state.session.id());
   if (it == by_id_.end()) return NotFound(state.session.id());
   const inbetween::v1::Session& current = it->second.state.session;
-  if (current.version() != expected_version) {
-    return StaleVersionError(current.id(), current.version(), expected_version);
+  if (auto s = CheckPutVersion(current.id(), current.version(), expected_version); !s.ok()) {
+    return s;
   }
-  state.session.set_version(current.version() + 1);
-  state.session.set_created_unix_ms(current.created_unix_ms());
-  state.session.set_updated_unix_ms(NowUnixMs());
+  StampPut(state, current);
   it->second.state = std::move(state);
   return it->second.state;
 }
 
 absl::StatusOr<SessionPage> MemorySessionStore::List(size_t page_size, absl::string_view page_token,
                                                      absl::string_view owner) const {
-  // The token is the sequence number of the last session of the previous page, so pages stay
-  // consistent while sessions are created and deleted in between.
   absl::StatusOr<uint64_t> after = ParsePageToken(page_token);
   if (!after.ok()) return after.status();
   std::lock_guard lock(mutex_);
-  SessionPage page;
-  for (auto it = by_sequence_.upper_bound(*after); it != by_sequence_.end(); ++it) {
-    const SessionState& state = by_id_.find(it->second)->second.state;
-    if (state.owner != owner) continue;
-    if (page.sessions.size() == page_size) {
-      page.next_page_token = absl::StrCat(page.last_sequence);
-      break;
-    }
-    page.sessions.push_back(state);
-    page.last_sequence = it->first;
-  }
-  return page;
+  return PageBySequence(by_sequence_, page_size, *after,
+                        [&](const std::string& id, SessionState* out) {
+                          const SessionState& state = by_id_.find(id)->second.state;
+                          if (state.owner != owner) return false;
+                          *out = state;
+                          return true;
+                        });
 }
 
 size_t MemorySessionStore::CountOwned(absl::string_view owner) const {
@@ -148,9 +177,7 @@ absl::Status MemorySessionStore::Delete(absl::string_view id, uint64_t expected_
   auto it = by_id_.find(id);
   if (it == by_id_.end()) return NotFound(id);
   const uint64_t version = it->second.state.session.version();
-  if (expected_version != 0 && expected_version != version) {
-    return StaleVersionError(id, version, expected_version);
-  }
+  if (auto s = CheckDeleteVersion(id, version, expected_version); !s.ok()) return s;
   by_sequence_.erase(it->second.sequence);
   by_id_.erase(it);
   return absl::OkStatus();

@@ -1,9 +1,11 @@
-// Session storage behind one interface (memory now; disk and Redis later) with optimistic
+// Session storage behind one interface (memory, directory snapshots, Redis) with optimistic
 // locking: every mutation increments the version, a stale expected version is ABORTED.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <random>
@@ -52,6 +54,16 @@ class SessionStore {
 
   // Deletes the session; expected_version 0 deletes whatever the version.
   virtual absl::Status Delete(absl::string_view id, uint64_t expected_version) = 0;
+
+  // Stores that keep a durable copy (dir, Redis) cache loaded sessions in memory; this drops
+  // the cached sessions not used since `idle_before` (they reload on next use) and returns how
+  // many it dropped. The memory store has nowhere to evict to and keeps everything.
+  virtual size_t EvictIdle(std::chrono::steady_clock::time_point idle_before) {
+    (void)idle_before;
+    return 0;
+  }
+  // Sessions held in memory (all of them for the memory store).
+  virtual size_t CachedCount() const { return Count(); }
 };
 
 // The ABORTED status of a stale expected version, worded the same by every store.
@@ -62,6 +74,23 @@ absl::Status SessionNotFoundError(absl::string_view id);
 
 // Parses a List page token (a sequence number); INVALID_ARGUMENT if it is not one.
 absl::StatusOr<uint64_t> ParsePageToken(absl::string_view page_token);
+
+// The version check of Put (exact match) and Delete (expected 0 = any version).
+absl::Status CheckPutVersion(absl::string_view id, uint64_t current, uint64_t expected);
+absl::Status CheckDeleteVersion(absl::string_view id, uint64_t current, uint64_t expected);
+
+// Create's stamping: sets the id, version 1 unless given, created (if unset) and updated times.
+void StampCreated(SessionState& state, const std::string& id);
+// Put's stamping: the version after `current`'s, `current`'s created time, updated = now.
+void StampPut(SessionState& state, const inbetween::v1::Session& current);
+
+// One List page over an index ordered by sequence (creation order), shared by every store.
+// `listed(id, &state)` fills the state to list and returns true, or returns false for sessions
+// of other owners. The page token is the sequence of the last listed session, so pages stay
+// consistent while sessions are created and deleted in between.
+absl::StatusOr<SessionPage> PageBySequence(
+    const std::map<uint64_t, std::string>& by_sequence, size_t page_size, uint64_t after,
+    const std::function<bool(const std::string& id, SessionState* state)>& listed);
 
 // A fresh random session id (16 lowercase hex digits).
 std::string RandomSessionId(std::mt19937_64& rng);

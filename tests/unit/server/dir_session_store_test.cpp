@@ -9,7 +9,6 @@
 #include <memory>
 #include <string>
 
-#include "server/drawing_import.h"
 #include "tests/unit/server/test_server.h"
 
 namespace inbetween::server::testing {
@@ -33,29 +32,6 @@ class DirSessionStoreTest : public ::testing::Test {
     return store.ok() ? *std::move(store) : nullptr;
   }
 
-  // A state with one drawing (square with an opening) and a two-triangle multimesh.
-  static SessionState State(const std::string& owner) {
-    SessionState state;
-    state.owner = owner;
-    state.session.set_display_name("squares");
-    v1::Drawing* drawing = state.session.add_drawings();
-    drawing->set_id(1);
-    *drawing->add_elements() = SquareOutline(0, 0, 1);
-    drawing->mutable_elements(0)->set_id(1);
-    auto imported = ImportDrawingElements(*drawing, "drawing 1", 1);
-    EXPECT_TRUE(imported.ok()) << imported.status();
-    state.parsed.push_back(imported->parsed);
-    state.next_drawing_id = 2;
-    auto mesh = std::make_shared<solver::Multimesh>();
-    mesh->triangles = {{0, 1, 2}, {0, 2, 3}};
-    mesh->shapes = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{0, 0}, {2, 0}, {2, 2}, {0, 2}}};
-    mesh->boundary = {0, 1, 2, 3};
-    mesh->boundary_loops = {{0, 1, 2, 3}};
-    state.multimesh = mesh;
-    state.session.set_stage(v1::STAGE_MULTIMESH);
-    return state;
-  }
-
   fs::path root_;
 };
 
@@ -63,7 +39,7 @@ TEST_F(DirSessionStoreTest, SessionsSurviveReopeningWithTheirMultimesh) {
   std::string id;
   {
     auto store = Open();
-    auto created = store->Create(State("alice"));
+    auto created = store->Create(StoredSessionState("alice"));
     ASSERT_TRUE(created.ok()) << created.status();
     id = created->session.id();
     for (uint64_t v = 1; v <= 4; ++v) {
@@ -74,7 +50,7 @@ TEST_F(DirSessionStoreTest, SessionsSurviveReopeningWithTheirMultimesh) {
       EXPECT_EQ(put->session.version(), v + 1);
     }
     EXPECT_EQ(store->Put(*created, 1).status().code(), absl::StatusCode::kAborted);
-    ASSERT_TRUE(store->Create(State("bob")).ok());
+    ASSERT_TRUE(store->Create(StoredSessionState("bob")).ok());
   }
   // Only the newest snapshots are kept.
   int files = 0;
@@ -117,7 +93,7 @@ TEST_F(DirSessionStoreTest, LeftoverTempFilesAreIgnored) {
   std::string id;
   {
     auto store = Open();
-    auto created = store->Create(State(""));
+    auto created = store->Create(StoredSessionState(""));
     ASSERT_TRUE(created.ok());
     id = created->session.id();
   }
@@ -130,6 +106,24 @@ TEST_F(DirSessionStoreTest, LeftoverTempFilesAreIgnored) {
   ASSERT_TRUE(got.ok()) << got.status();
   EXPECT_EQ(got->session.version(), 1u);
   EXPECT_FALSE(fs::exists(root_ / "sessions" / id / ".tmp-junk"));
+}
+
+TEST_F(DirSessionStoreTest, IdleSessionsLeaveMemoryAndReload) {
+  auto store = Open();
+  auto created = store->Create(StoredSessionState("alice"));
+  ASSERT_TRUE(created.ok()) << created.status();
+  EXPECT_EQ(store->CachedCount(), 1u);
+  // Used just now: not idle before a point in the past.
+  EXPECT_EQ(store->EvictIdle(std::chrono::steady_clock::now() - std::chrono::hours(1)), 0u);
+  EXPECT_EQ(store->CachedCount(), 1u);
+  EXPECT_EQ(store->EvictIdle(std::chrono::steady_clock::now() + std::chrono::seconds(1)), 1u);
+  EXPECT_EQ(store->CachedCount(), 0u);
+  auto got = store->Get(created->session.id());
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(store->CachedCount(), 1u);
+  EXPECT_EQ(got->session.version(), 1u);
+  ASSERT_TRUE(got->multimesh);
+  EXPECT_EQ(got->multimesh->triangles.size(), 2u);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <string>
 #include <thread>
 
+#include "tests/unit/server/redis_fixture.h"
 #include "tests/unit/server/test_server.h"
 
 namespace inbetween::server::testing {
@@ -62,10 +63,21 @@ TEST(InbetweenServerTest, ReflectionListsTheService) {
 
 TEST(InbetweenServerTest, UnknownStoreNamesTheFlag) {
   ServerOptions options;
-  options.store = "redis://localhost:6379";
+  options.store = "s3://bucket";
   auto server = InbetweenServer::Start(options);
   ASSERT_FALSE(server.ok());
   EXPECT_EQ(server.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(server.status().message()), HasSubstr("--store"));
+  options.store = "redis://127.0.0.1";  // no port
+  EXPECT_EQ(InbetweenServer::Start(options).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(InbetweenServerTest, UnreachableRedisIsUnavailableNamingTheFlag) {
+  ServerOptions options;
+  options.store = "redis://127.0.0.1:" + std::to_string(FreeLoopbackPort());  // nobody there
+  auto server = InbetweenServer::Start(options);
+  ASSERT_FALSE(server.ok());
+  EXPECT_EQ(server.status().code(), absl::StatusCode::kUnavailable);
   EXPECT_THAT(std::string(server.status().message()), HasSubstr("--store"));
 }
 

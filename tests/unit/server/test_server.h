@@ -15,7 +15,9 @@
 #include <vector>
 
 #include "inbetween/v1/inbetween.grpc.pb.h"
+#include "server/drawing_import.h"
 #include "server/inbetween_server.h"
+#include "server/session_state.h"
 
 namespace inbetween::server::testing {
 
@@ -70,6 +72,29 @@ inline v1::TopologyElement SquareOutline(double x0, double y0, double size) {
     p->set_y(y);
   }
   return element;
+}
+
+// A stored state (for store tests): one drawing (a unit square) and a two-triangle multimesh.
+inline SessionState StoredSessionState(const std::string& owner) {
+  SessionState state;
+  state.owner = owner;
+  state.session.set_display_name("squares");
+  v1::Drawing* drawing = state.session.add_drawings();
+  drawing->set_id(1);
+  *drawing->add_elements() = SquareOutline(0, 0, 1);
+  drawing->mutable_elements(0)->set_id(1);
+  auto imported = ImportDrawingElements(*drawing, "drawing 1", 1);
+  EXPECT_TRUE(imported.ok()) << imported.status();
+  if (imported.ok()) state.parsed.push_back(imported->parsed);
+  state.next_drawing_id = 2;
+  auto mesh = std::make_shared<solver::Multimesh>();
+  mesh->triangles = {{0, 1, 2}, {0, 2, 3}};
+  mesh->shapes = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{0, 0}, {2, 0}, {2, 2}, {0, 2}}};
+  mesh->boundary = {0, 1, 2, 3};
+  mesh->boundary_loops = {{0, 1, 2, 3}};
+  state.multimesh = mesh;
+  state.session.set_stage(v1::STAGE_MULTIMESH);
+  return state;
 }
 
 class ServerTest : public ::testing::Test {

@@ -1,0 +1,22 @@
+"""Python client of the Inbetween gRPC service (proto/inbetween/v1/inbetween.proto).
+
+The protobuf/gRPC stubs are generated, not committed: run ``client/python/generate_stubs.sh DIR``
+and put DIR on ``sys.path`` (or PYTHONPATH) next to this package; ``inbetween.v1`` is then found
+there (this package's path is extended over every ``inbetween`` directory on ``sys.path``).
+
+    import inbetween
+    with inbetween.Client("127.0.0.1:50051") as client:
+        session = client.create_session("walk")
+        session = client.upload_svgs(session, ["a.svg", "b.svg"])
+        session = client.build(session)
+        session = client.optimize(session, on_progress=print)
+        paths = client.stream_frames(session, "out", frames=24)
+"""
+
+import pkgutil
+
+__path__ = pkgutil.extend_path(__path__, __name__)
+
+from inbetween.client import Client, InbetweenError  # noqa: E402
+
+__all__ = ["Client", "InbetweenError"]

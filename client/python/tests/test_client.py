@@ -1,0 +1,174 @@
+"""Tests of the inbetween Python module against the real inbetween-server binary.
+
+Environment: INBETWEEN_SERVER_BIN (the server binary), INBETWEEN_SRC (the source tree, for the
+examples); the stubs' directory must be on sys.path (tests/e2e/python_client_test.sh does it).
+"""
+
+import json
+import os
+import re
+import subprocess
+import tempfile
+import threading
+import unittest
+
+import inbetween
+from inbetween.v1 import inbetween_pb2 as pb
+
+EXAMPLES = os.path.join(os.environ.get("INBETWEEN_SRC", "."), "examples", "square_hexagon")
+SQUARE = os.path.join(EXAMPLES, "square.svg")
+HEXAGON = os.path.join(EXAMPLES, "hexagon.svg")
+
+
+def start_server(*flags):
+    """Starts inbetween-server on 127.0.0.1:0; returns (process, "127.0.0.1:PORT")."""
+    binary = os.environ["INBETWEEN_SERVER_BIN"]
+    process = subprocess.Popen([binary, "--listen", "127.0.0.1:0", "--log-level", "warn", *flags],
+                               stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    line = process.stdout.readline()
+    match = re.search(r"listening on (127\.0\.0\.1:\d+)", line)
+    if not match:
+        process.kill()
+        raise RuntimeError(f"server did not start: {line!r}")
+    return process, match.group(1)
+
+
+def stop_server(process):
+    process.terminate()
+    try:
+        process.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+    process.stdout.close()
+
+
+class ClientTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.server, cls.address = start_server()
+        cls.client = inbetween.Client(cls.address, timeout=120)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.client.close()
+        stop_server(cls.server)
+
+    def setUp(self):
+        self.out = tempfile.mkdtemp(prefix="inbetween_py_")
+
+    def built_session(self, name):
+        session = self.client.create_session(name)
+        session = self.client.upload_svgs(session, [SQUARE, HEXAGON])
+        self.assertEqual(len(session.drawings), 2)
+        self.assertEqual(session.stage, pb.STAGE_DRAWINGS)
+        return self.client.build(session)
+
+    def test_whole_job_build_optimize_with_progress_and_frames_to_files(self):
+        session = self.built_session("py-whole-job")
+        self.assertEqual(session.stage, pb.STAGE_MULTIMESH)
+        events = []
+        session = self.client.optimize(session, on_progress=events.append, max_outer_iterations=2)
+        self.assertEqual(session.stage, pb.STAGE_OPTIMIZED)
+        self.assertTrue(any(isinstance(e, pb.ComeshIteration) for e in events), events[:3])
+
+        _, mesh = self.client.get_session(session.id, full=True)
+        paths = self.client.stream_frames(session, self.out, frames=5)
+        self.assertEqual([os.path.basename(p) for p in paths],
+                         [f"frame_{i:04d}.json" for i in range(5)])
+        frames = []
+        for path in paths:
+            with open(path, encoding="utf-8") as source:
+                frames.append(json.load(source))
+            self.assertTrue(os.path.getsize(path[:-5] + ".svg") > 0)
+        # Frames 0 and 4 are the keys: the optimized shapes' vertices.
+        for frame, shape in ((frames[0], mesh.shapes[0]), (frames[-1], mesh.shapes[1])):
+            self.assertEqual(len(frame["vertices"]), len(shape.vertices))
+            for (x, y), p in zip(frame["vertices"], shape.vertices):
+                self.assertAlmostEqual(x, p.x, places=6)
+                self.assertAlmostEqual(y, p.y, places=6)
+        self.assertEqual([f["index"] for f in frames], list(range(5)))
+        self.assertAlmostEqual(frames[2]["time"], 0.5)
+
+    def test_stale_version_and_unknown_session_raise_with_their_codes(self):
+        session = self.client.create_session("py-errors")
+        newer = self.client.put_svg(session, SQUARE)
+        with self.assertRaises(inbetween.InbetweenError) as stale:
+            self.client.put_svg(session, HEXAGON)  # still at the old version
+        self.assertEqual(stale.exception.code, "ABORTED")
+        self.assertEqual(self.client.get_session(session.id).version, newer.version)
+        with self.assertRaises(inbetween.InbetweenError) as missing:
+            self.client.get_session("0000000000000000")
+        self.assertEqual(missing.exception.code, "NOT_FOUND")
+        with self.assertRaises(inbetween.InbetweenError) as early:
+            list(self.client.frames(session.id, frames=4))
+        self.assertEqual(early.exception.code, "FAILED_PRECONDITION")
+
+    def test_export_import_and_list(self):
+        session = self.built_session("py-export")
+        path = self.client.export_session(session.id, os.path.join(self.out, "session.inbsession"))
+        copy = self.client.import_session(path)
+        self.assertNotEqual(copy.id, session.id)
+        self.assertEqual(copy.stage, pb.STAGE_MULTIMESH)
+        self.assertEqual(len(copy.drawings), 2)
+        ids = [s.id for s in self.client.list_sessions(page_size=1)]
+        self.assertIn(session.id, ids)
+        self.assertIn(copy.id, ids)
+        self.client.delete_session(copy)
+        self.assertNotIn(copy.id, [s.id for s in self.client.list_sessions()])
+        # The imported copy animates without a rebuild.
+        self.assertEqual(len(self.client.stream_frames(session, self.out, frames=3)), 3)
+
+    def test_progress_callback_can_cancel_an_optimization(self):
+        session = self.built_session("py-cancel")
+        seen = []
+
+        def stop_after_first(event):
+            seen.append(event)
+            return False
+
+        with self.assertRaises(inbetween.InbetweenError) as cancelled:
+            self.client.optimize(session, on_progress=stop_after_first)
+        self.assertEqual(cancelled.exception.code, "CANCELLED")
+        self.assertEqual(len(seen), 1)
+        # Nothing was stored: the session is still at its built version.
+        after = self.client.get_session(session.id)
+        self.assertEqual(after.version, session.version)
+        self.assertEqual(after.stage, pb.STAGE_MULTIMESH)
+
+
+class BusyServerTest(unittest.TestCase):
+    """With one heavy slot and no queue, a second heavy call is RESOURCE_EXHAUSTED with a retry
+    hint while the first runs."""
+
+    def test_full_pool_is_resource_exhausted_with_retry_hint(self):
+        server, address = start_server("--max-heavy-jobs", "1", "--heavy-queue", "0")
+        try:
+            with inbetween.Client(address, timeout=120) as client:
+                session = client.build(client.upload_svgs(client.create_session("busy"),
+                                                          [SQUARE, HEXAGON]))
+                started, release = threading.Event(), threading.Event()
+
+                def hold(event):
+                    started.set()
+                    release.wait(60)
+                    return False  # then cancel
+
+                holder = threading.Thread(
+                    target=lambda: self.assertRaises(inbetween.InbetweenError, client.optimize,
+                                                     session, hold))
+                holder.start()
+                self.assertTrue(started.wait(60))
+                with self.assertRaises(inbetween.InbetweenError) as busy:
+                    list(client.frames(session.id, frames=3))
+                release.set()
+                holder.join(60)
+                self.assertEqual(busy.exception.code, "RESOURCE_EXHAUSTED")
+                self.assertIsNotNone(busy.exception.retry_after_ms)
+                self.assertGreater(busy.exception.retry_after_ms, 0)
+        finally:
+            stop_server(server)
+
+
+if __name__ == "__main__":
+    unittest.main()

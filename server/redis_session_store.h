@@ -1,0 +1,88 @@
+// Sessions in Redis (--store redis://HOST:PORT[/DB]) so that several inbetween-server replicas
+// share them: a session is loaded lazily on whichever replica gets a call for it, and cached
+// there while its version in Redis is unchanged.
+//
+// Layout (prefix "inbetween:"): hash s:<id> {v: version, o: owner, c: created ms, q: sequence,
+// m: summary (Session proto), d: snapshot (session_snapshot.h: drawings, multimesh, optimized
+// positions, stats)}; sorted sets all and own:<owner> (id by sequence) for counting and listing;
+// counter seq. Create, Put and Delete are Lua scripts, so the version check and the write are
+// one atomic step in Redis: of two replicas writing the same version, one gets ABORTED.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "server/session_store.h"
+
+struct redisContext;
+
+namespace inbetween::server {
+
+struct RedisStoreOptions {
+  size_t max_sessions = 10000;  // in the whole Redis database (all replicas)
+  size_t max_cached = 256;      // sessions cached in this process (least recently used dropped)
+  std::chrono::milliseconds timeout{5000};  // connect and per-command timeout
+};
+
+struct RedisAddress {
+  std::string host;
+  int port = 6379;
+  int db = 0;
+};
+
+// "redis://HOST:PORT[/DB]" (HOST may be [IPv6]); INVALID_ARGUMENT naming --store otherwise.
+absl::StatusOr<RedisAddress> ParseRedisUrl(absl::string_view url);
+
+class RedisSessionStore final : public SessionStore {
+ public:
+  // Connects (and PINGs) once; UNAVAILABLE naming --store when Redis cannot be reached.
+  static absl::StatusOr<std::unique_ptr<RedisSessionStore>> Open(absl::string_view url,
+                                                                 RedisStoreOptions options = {});
+  ~RedisSessionStore() override;
+
+  absl::StatusOr<SessionState> Get(absl::string_view id) const override;
+  absl::StatusOr<SessionState> Create(SessionState state) override;
+  absl::StatusOr<SessionState> Put(SessionState state, uint64_t expected_version) override;
+  absl::StatusOr<SessionPage> List(size_t page_size, absl::string_view page_token,
+                                   absl::string_view owner) const override;
+  size_t CountOwned(absl::string_view owner) const override;
+  size_t Count() const override;
+  absl::Status Delete(absl::string_view id, uint64_t expected_version) override;
+  size_t EvictIdle(std::chrono::steady_clock::time_point idle_before) override;
+  size_t CachedCount() const override;
+
+  class Reply;  // an owned redisReply
+
+ private:
+  struct Cached {
+    SessionState state;
+    uint64_t last_used = 0;
+    std::chrono::steady_clock::time_point used_at;
+  };
+
+  RedisSessionStore(RedisAddress address, RedisStoreOptions options);
+  // Runs one command on a pooled connection (binary-safe arguments). UNAVAILABLE on connection
+  // errors (the connection is dropped), INTERNAL on a Redis error reply.
+  absl::StatusOr<Reply> Command(const std::vector<std::string>& args) const;
+  absl::StatusOr<redisContext*> Connect() const;
+  void Remember(const SessionState& state) const;
+
+  const RedisAddress address_;
+  const RedisStoreOptions options_;
+  mutable std::mutex pool_mutex_;
+  mutable std::vector<redisContext*> idle_;
+  mutable std::mutex cache_mutex_;
+  mutable std::map<std::string, Cached, std::less<>> cache_;
+  mutable uint64_t clock_ = 0;
+  mutable std::mutex rng_mutex_;
+  mutable std::mt19937_64 rng_;
+};
+
+}  // namespace inbetween::server
