@@ -59,6 +59,27 @@ absl::Status CheckOpenPolyline(const solver::Points& points, const std::string& 
   return CheckPoints(points, where);
 }
 
+// Near-duplicate cleaning (docs/project-file.md, "Geometry clean-up"): consecutive points closer
+// than kMergeRelativeTolerance times the element's bounding-box diagonal are merged (the first
+// is kept), and for a closed outline a last point repeating the first is dropped. What remains is
+// checked as usual, so cleaning never hides a degenerate or crossing outline.
+solver::Points MergeNearDuplicates(const solver::Points& points, bool closed) {
+  if (points.size() < 2) return points;
+  solver::Point lo = points[0], hi = points[0];
+  for (const solver::Point& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const double tolerance = kMergeRelativeTolerance * (hi - lo).norm();
+  if (!std::isfinite(tolerance)) return points;  // CheckPoints reports the coordinate
+  solver::Points out;
+  out.reserve(points.size());
+  for (const solver::Point& p : points) {
+    if (out.empty() || (p - out.back()).norm() > tolerance) out.push_back(p);
+  }
+  while (closed && out.size() > 1 && (out.back() - out.front()).norm() <= tolerance) {
+    out.pop_back();
+  }
+  return out;
+}
+
 // `field`[i], plus the element id for stored elements, e.g. "drawing 2.elements[2] (element 5)".
 std::string ElementName(absl::string_view field, int i, const v1::TopologyElement& element,
                         bool with_id) {
@@ -77,14 +98,23 @@ absl::StatusOr<ImportedDrawing> Analyze(TopologyElements elements, absl::string_
   bool has_positive_outline = false;
   for (int i = 0; i < elements.size(); ++i) {
     const v1::TopologyElement& element = elements[i];
-    const std::string where = ElementName(element_field, i, element, with_ids);
+    std::string where = ElementName(element_field, i, element, with_ids);
     total_points += element.polyline().points_size();
     if (total_points > static_cast<size_t>(max_points)) {
       return absl::ResourceExhaustedError(
           absl::StrCat(field, " has more than ", max_points,
                        " points (limit per drawing, --max-drawing-points)"));
     }
+    const bool closed = element.kind() == v1::ELEMENT_KIND_OUTLINE;
     solver::Points points = FromProto(element.polyline().points());
+    if (absl::Status s = CheckPoints(points, where); !s.ok()) return s;  // before merging
+    points = MergeNearDuplicates(points, closed);
+    if (points.size() != static_cast<size_t>(element.polyline().points_size())) {
+      absl::StrAppend(&where, " (", element.polyline().points_size(), " points, ", points.size(),
+                      " after merging near-duplicates)");
+      elements[i].mutable_polyline()->clear_points();  // stored cleaned
+      ToProto(points, elements[i].mutable_polyline()->mutable_points());
+    }
     switch (element.kind()) {
       case v1::ELEMENT_KIND_OUTLINE:
         if (absl::Status s = CheckOutline(points, where); !s.ok()) return s;
@@ -183,10 +213,15 @@ absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing, double
       }
       solver::SvgImportOptions options;
       options.tolerance = flatten_tolerance;
+      options.max_points = max_points;
       absl::StatusOr<solver::Drawing> parsed = solver::ImportSvg(drawing.svg(), options);
       if (!parsed.ok()) {
-        return absl::Status(parsed.status().code(),
-                            absl::StrCat(field, ".svg: ", parsed.status().message()));
+        const bool limit = absl::IsResourceExhausted(parsed.status()) &&
+                           absl::StrContains(parsed.status().message(), " points");
+        return absl::Status(
+            parsed.status().code(),
+            absl::StrCat(field, ".svg: ", parsed.status().message(),
+                         limit ? " (limit per drawing, --max-drawing-points)" : ""));
       }
       if (parsed->outlines.empty()) {
         return absl::InvalidArgumentError(absl::StrCat(field, ".svg has no filled shapes"));

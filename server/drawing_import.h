@@ -14,6 +14,9 @@ inline constexpr double kDefaultFlattenTolerance = 0.05;
 inline constexpr double kMaxCoordinate = 1e9;
 inline constexpr int kMaxPointsPerDrawing = 1'000'000;
 inline constexpr size_t kMaxNameBytes = 256;
+// Consecutive points of an element closer than this times its bounding-box diagonal are merged
+// before the checks (docs/project-file.md, "Geometry clean-up").
+inline constexpr double kMergeRelativeTolerance = 1e-9;
 
 using TopologyElements = google::protobuf::RepeatedPtrField<inbetween::v1::TopologyElement>;
 

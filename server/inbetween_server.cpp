@@ -19,6 +19,7 @@
 #include "server/inbetween_service.h"
 #include "server/metrics.h"
 #include "server/request_parse_errors.h"
+#include "server/request_parse_errors.h"
 #include "server/redis_session_store.h"
 #include "server/session_store.h"
 
@@ -129,6 +130,7 @@ absl::StatusOr<std::unique_ptr<InbetweenServer>> InbetweenServer::Start(
   builder.SetMaxReceiveMessageSize(options.max_message_bytes);
   builder.SetMaxSendMessageSize(options.max_message_bytes);
   builder.RegisterService(server->service_.get());
+  builder.experimental().SetInterceptorCreators(RequestParseErrorInterceptors());
   builder.experimental().SetInterceptorCreators(RequestParseErrorInterceptors());
   server->server_ = builder.BuildAndStart();
   if (!server->server_) {

@@ -253,6 +253,10 @@ struct UnionFind {
 
 }  // namespace
 
+// How far a correspondence mark may sit from the boundary it pins, relative to the length of
+// that boundary loop.
+constexpr double kMarkRelativeTolerance = 0.05;
+
 absl::Status CheckSameEquivalence(const std::vector<BoundaryGraph>& graphs) {
   bool same = true;
   for (const BoundaryGraph& g : graphs) same = same && g.equivalence == graphs[0].equivalence;
@@ -383,8 +387,18 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
       if (dist < best) best = dist, group = g, at0 = a;
     }
     std::vector<double> at(num_shapes, at0);
-    for (int d = 1; d < num_shapes; ++d)
-      at[d] = curve(d, group).Project(options.marks[m][d], nullptr);
+    for (int d = 0; d < num_shapes; ++d) {
+      double dist = best;
+      if (d > 0) at[d] = curve(d, group).Project(options.marks[m][d], &dist);
+      // A mark must sit on (near) a boundary; one far away is a mistake, not a pin.
+      if (!(dist <= kMarkRelativeTolerance * curve(d, group).length())) {
+        const Point& p = options.marks[m][d];
+        return absl::InvalidArgumentError(
+            absl::StrCat("drawing ", d + 1, ": correspondence mark ", m + 1, " at (", p.x(), ", ",
+                         p.y(), ") is ", dist, " from the nearest boundary, more than ",
+                         kMarkRelativeTolerance * 100, "% of that boundary's length"));
+      }
+    }
     marks_on[group].push_back({at0, at});
   }
   for (int g = 0; g < num_groups; ++g) {

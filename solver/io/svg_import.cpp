@@ -43,6 +43,7 @@ using Affine = Eigen::Matrix<double, 2, 3>;  // [A | t]
 constexpr char kSvgNamespace[] = "http://www.w3.org/2000/svg";
 constexpr int kMaxSubdivisionDepth = 18;
 constexpr int kMaxUseDepth = 8;
+constexpr size_t kMaxElements = 100'000;  // elements after <use> expansion (fan-out bombs)
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Our own error raised from inside SVG++ callbacks; SVG++ attaches the element to it.
@@ -50,6 +51,11 @@ struct ImportError : virtual boost::exception, virtual std::exception {
   explicit ImportError(std::string m) : message(std::move(m)) {}
   const char* what() const noexcept override { return message.c_str(); }
   std::string message;
+};
+
+// The document needs more than SvgImportOptions::max_points points.
+struct TooManyPoints : ImportError {
+  explicit TooManyPoints(std::string m) : ImportError(std::move(m)) {}
 };
 
 using ElementInfo = boost::error_info<sv::tag::error_info::xml_element, xmlNode*>;
@@ -93,6 +99,9 @@ void FlattenCubic(const Point& p0, const Point& p1, const Point& p2, const Point
 // Where finished outlines go, in document order.
 struct Collector {
   double tolerance = 0.05;
+  size_t max_points = 1'000'000;
+  size_t raw_points = 0;   // points written in path data so far
+  size_t flat_points = 0;  // points after flattening so far
   std::vector<Outline> outlines;
   std::vector<Points> cuts, openings;     // from class="cut" / class="opening" elements
   std::vector<CorrespondenceMark> marks;  // from data-corr="N" elements
@@ -255,6 +264,10 @@ class Context {
     }
   }
   void Add(double x, double y, bool control) {
+    if (++collector_->raw_points > collector_->max_points) {
+      throw TooManyPoints(
+          absl::StrCat("more than ", collector_->max_points, " points in its path data"));
+    }
     subpaths_.back().points.emplace_back(x, y);
     subpaths_.back().is_control.push_back(control);
     if (!control) pen_ = Point(x, y);
@@ -275,7 +288,14 @@ class Context {
         flat.push_back(Apply(ctm_, raw[i].x(), raw[i].y()));
         ++i;
       }
+      if (collector_->flat_points + flat.size() > collector_->max_points) {
+        throw TooManyPoints(absl::StrCat(
+            "more than ", collector_->max_points,
+            " points once its curves are flattened (raise the flatten tolerance or simplify "
+            "the drawing)"));
+      }
     }
+    collector_->flat_points += flat.size();
     Points out;
     for (const Point& p : flat) {
       if (!p.allFinite()) throw ImportError("the transformed coordinates are not finite");
@@ -418,14 +438,47 @@ void AdoptSvgNamespace(xmlNode* root) {
 // Replaces every <use href="#id" x y transform> by a <g transform="... translate(x y)"> holding
 // a deep copy of the referenced element (ids dropped from the copy), repeatedly so that copies
 // holding <use> expand too. Returns the <use> that cannot be expanded, with the reason.
-std::optional<std::pair<xmlNode*, std::string>> ExpandUses(xmlDoc* doc, xmlNode* root) {
+struct UseError {
+  xmlNode* use;
+  std::string reason;
+  absl::StatusCode code = absl::StatusCode::kInvalidArgument;
+};
+
+// A <use>'s href (or xlink:href).
+std::optional<std::string> UseHref(xmlNode* use) {
+  std::optional<std::string> href = Attribute(use, "href");
+  if (!href) {
+    xmlChar* x = xmlGetNsProp(use, reinterpret_cast<const xmlChar*>("href"),
+                              reinterpret_cast<const xmlChar*>("http://www.w3.org/1999/xlink"));
+    if (x != nullptr) href = reinterpret_cast<const char*>(x), xmlFree(x);
+  }
+  return href;
+}
+
+// Element nodes in the subtree of `node` (itself included).
+size_t CountElements(const xmlNode* node) {
+  size_t n = 0;
+  std::vector<const xmlNode*> stack = {node};
+  while (!stack.empty()) {
+    const xmlNode* e = stack.back();
+    stack.pop_back();
+    if (e->type != XML_ELEMENT_NODE) continue;
+    ++n;
+    for (const xmlNode* child = e->children; child; child = child->next) stack.push_back(child);
+  }
+  return n;
+}
+
+std::optional<UseError> ExpandUses(xmlDoc* doc, xmlNode* root) {
   for (int depth = 0;; ++depth) {
     std::map<std::string, xmlNode*> by_id;
     std::vector<xmlNode*> uses, stack = {root};
+    size_t elements = 0;
     while (!stack.empty()) {
       xmlNode* node = stack.back();
       stack.pop_back();
       if (node->type != XML_ELEMENT_NODE) continue;
+      ++elements;
       if (std::optional<std::string> id = Attribute(node, "id")) by_id.emplace(*id, node);
       if (xmlStrcmp(node->name, reinterpret_cast<const xmlChar*>("use")) == 0) {
         uses.push_back(node);
@@ -435,21 +488,33 @@ std::optional<std::pair<xmlNode*, std::string>> ExpandUses(xmlDoc* doc, xmlNode*
     }
     if (uses.empty()) return std::nullopt;
     if (depth >= kMaxUseDepth) {
-      return std::make_pair(uses[0], "<use> nested too deeply (or referencing itself)");
+      return UseError{uses[0], "<use> nested too deeply (or referencing itself)"};
+    }
+    // Each round multiplies the copies of what the uses reference (fan-out, like entity
+    // expansion): refuse a round that would grow the document past kMaxElements.
+    std::map<const xmlNode*, size_t> sizes;
+    for (xmlNode* use : uses) {
+      std::optional<std::string> href = UseHref(use);
+      if (!href || href->size() < 2) continue;  // reported below
+      auto it = by_id.find(href->substr(1));
+      if (it == by_id.end()) continue;
+      auto [size, inserted] = sizes.emplace(it->second, 0);
+      if (inserted) size->second = CountElements(it->second);
+      elements += size->second;
+      if (elements > kMaxElements) {
+        return UseError{use,
+                        absl::StrCat("<use> expansion makes more than ", kMaxElements, " elements"),
+                        absl::StatusCode::kResourceExhausted};
+      }
     }
     for (xmlNode* use : uses) {
-      std::optional<std::string> href = Attribute(use, "href");
-      if (!href) {
-        xmlChar* x = xmlGetNsProp(use, reinterpret_cast<const xmlChar*>("href"),
-                                  reinterpret_cast<const xmlChar*>("http://www.w3.org/1999/xlink"));
-        if (x != nullptr) href = reinterpret_cast<const char*>(x), xmlFree(x);
-      }
+      std::optional<std::string> href = UseHref(use);
       if (!href || href->size() < 2 || (*href)[0] != '#') {
-        return std::make_pair(use, "<use> needs href=\"#id\" of an element in the document");
+        return UseError{use, "<use> needs href=\"#id\" of an element in the document"};
       }
       auto it = by_id.find(href->substr(1));
       if (it == by_id.end()) {
-        return std::make_pair(use, absl::StrCat("<use> references unknown id \"", *href, "\""));
+        return UseError{use, absl::StrCat("<use> references unknown id \"", *href, "\"")};
       }
       std::string transform = Attribute(use, "transform").value_or("");
       const std::string x = Attribute(use, "x").value_or("0"),
@@ -486,6 +551,9 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   if (!(options.tolerance > 0) || !std::isfinite(options.tolerance)) {
     return absl::InvalidArgumentError("SVG import: tolerance must be a positive number");
   }
+  if (options.max_points < 1) {
+    return absl::InvalidArgumentError("SVG import: max_points must be positive");
+  }
   std::unique_ptr<xmlParserCtxt, ParserDeleter> ctxt(xmlNewParserCtxt());
   if (ctxt == nullptr) return absl::ResourceExhaustedError("SVG import: out of memory");
   // No network, no entity substitution, no DTD loading or validation; keep errors quiet.
@@ -513,15 +581,18 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   }
   AdoptSvgNamespace(root);
   if (auto bad = ExpandUses(doc.get(), root)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("SVG element ", Describe(bad->first), ": ", bad->second));
+    return absl::Status(bad->code,
+                        absl::StrCat("SVG element ", Describe(bad->use), ": ", bad->reason));
   }
 
   Collector collector;
   collector.tolerance = options.tolerance;
+  collector.max_points = static_cast<size_t>(options.max_points);
   try {
     Context context(&collector, root);
     Traversal::load_document(root, context);
+  } catch (const TooManyPoints& e) {
+    return absl::ResourceExhaustedError(absl::StrCat("SVG has ", e.message));
   } catch (const boost::exception& e) {
     xmlNode* const* element = boost::get_error_info<ElementInfo>(e);
     const auto* std_error = dynamic_cast<const std::exception*>(&e);

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# The bad-input catalogue (tests/data/bad/*.json, docs/bad-input.md) against a live
+# inbetween-server with --tokens: every case must get its expected status and message while a
+# healthy session of another token keeps streaming frames identical to a run alone. Afterwards
+# the server must still be alive and shut down cleanly on SIGTERM.
+source "$(dirname "$0")/lib/common.sh"
+RUNNER="$INBETWEEN_BIN/tests/e2e/bad_input_runner"
+printf 'tok-main main\ntok-other other\ntok-healthy healthy\n' >"$WORK/tokens"
+# Four heavy slots so the healthy stream and a case's heavy call never wait on each other.
+start_server --tokens "$WORK/tokens" --max-heavy-jobs 4 --log-level warn
+timeout 240 "$RUNNER" --server "$SERVER_ADDR" --token tok-main --other-token tok-other \
+  --healthy-token tok-healthy --cases "$INBETWEEN_SRC/tests/data/bad" \
+  --examples "$INBETWEEN_SRC/examples" "$@"
+kill -0 "$SERVER_PID" || { cat "$WORK/server.log"; echo "server died"; exit 1; }
+kill -TERM "$SERVER_PID"
+for _ in $(seq 1 200); do kill -0 "$SERVER_PID" 2>/dev/null || break; sleep 0.05; done
+if kill -0 "$SERVER_PID" 2>/dev/null; then echo "server did not stop on SIGTERM"; exit 1; fi
+wait "$SERVER_PID" || { rc=$?; cat "$WORK/server.log"; echo "server exit $rc"; exit 1; }
+echo "ok"
