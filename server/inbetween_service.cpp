@@ -858,6 +858,7 @@ grpc::Status InbetweenService::OptimizeComesh(
           return s;
         }
         solver::ComeshOptions options = ToComeshOptions(comesh);
+        options.threads = options_.solver_threads;
         absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
         if (!slot.ok()) return slot.status();
 
@@ -943,6 +944,7 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
         absl::StatusOr<InbetweenPlan> plan = ToInbetweenPlan(parameters, "parameters");
         if (!plan.ok()) return plan.status();
         plan->options.stiffness = StiffnessPerTriangle(mesh, parameters.stiffness());
+        plan->options.threads = options_.solver_threads;
         if (plan->frames > options_.limits.max_frames) {
           return absl::ResourceExhaustedError(
               absl::StrCat("parameters.frames = ", plan->frames, " exceeds the limit of ",
@@ -959,23 +961,32 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
                                                          " is not in [0, frames = ", plan->frames,
                                                          ")"));
         }
-        // Key times come from the drawings when every drawing has one, else keys are evenly spaced.
-        std::vector<double> key_times;
-        for (const v1::Drawing& drawing : session.drawings()) {
-          if (drawing.has_key_time()) key_times.push_back(drawing.key_time());
+        // Key times: parameters.key_times when set, else the drawings' key_time when every
+        // drawing has one, else evenly spaced keys.
+        std::vector<double> key_times(parameters.key_times().begin(),
+                                      parameters.key_times().end());
+        const bool from_parameters = !key_times.empty();
+        if (!from_parameters) {
+          for (const v1::Drawing& drawing : session.drawings()) {
+            if (drawing.has_key_time()) key_times.push_back(drawing.key_time());
+          }
+          if (!key_times.empty() && static_cast<int>(key_times.size()) != num_drawings) {
+            return absl::InvalidArgumentError(
+                absl::StrCat("key_time is set on ", key_times.size(), " of ", num_drawings,
+                             " drawings: set it on every drawing or on none"));
+          }
         }
-        if (!key_times.empty() && static_cast<int>(key_times.size()) != num_drawings) {
-          return absl::InvalidArgumentError(
-              absl::StrCat("key_time is set on ", key_times.size(), " of ", num_drawings,
-                           " drawings: set it on every drawing or on none"));
-        }
+        absl::StatusOr<solver::TimingOptions> timing =
+            ToTimingOptions(parameters, num_drawings, "parameters");
+        if (!timing.ok()) return timing.status();
         absl::StatusOr<solver::Schedule> schedule =
-            solver::MakeSchedule(num_drawings, plan->frames, key_times);
+            solver::MakeSchedule(num_drawings, plan->frames, key_times, *timing);
         if (!schedule.ok()) {
-          return absl::Status(
-              schedule.status().code(),
-              absl::StrCat(key_times.empty() ? "frame schedule: " : "drawings' key_time: ",
-                           schedule.status().message()));
+          return absl::Status(schedule.status().code(),
+                              absl::StrCat(from_parameters      ? "parameters.key_times: "
+                                           : key_times.empty() ? "frame schedule: "
+                                                               : "drawings' key_time: ",
+                                           schedule.status().message()));
         }
 
         absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);

@@ -35,6 +35,9 @@ struct ServiceOptions {
   std::shared_ptr<Metrics> metrics;          // null = not collected
   // Successful RPCs are logged at info (inbetween-server) or debug (embedded, tests).
   bool log_ok_rpcs_at_info = false;
+  // Threads one heavy job's solver uses (--solver-threads). Results are bit-identical for every
+  // value; more threads only pay on large meshes (see solver/core/parallel_chunks.h).
+  int solver_threads = 1;
 };
 
 class InbetweenService final : public inbetween::v1::Inbetween::Service {

@@ -53,6 +53,10 @@ int main(int argc, char** argv) {
                  "heavy jobs waiting for a slot before RESOURCE_EXHAUSTED; -1 = 4 x max-heavy-jobs")
       ->capture_default_str()
       ->check(CLI::Range(-1, 100000));
+  app.add_option("--solver-threads", options.service.solver_threads,
+                 "threads per heavy job's solver; results are identical for every value")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 256));
   app.add_option("--max-heavy-jobs-per-token", heavy.max_per_owner,
                  "heavy jobs running or waiting per token; 0 = max-heavy-jobs")
       ->capture_default_str()

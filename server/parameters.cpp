@@ -1,6 +1,7 @@
 // Parameter ranges and defaults exactly as documented in proto/inbetween/v1/inbetween.proto.
 #include "server/parameters.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -123,6 +124,12 @@ absl::Status ValidateInbetween(const inbetween::v1::InbetweenParameters& p,
   if (p.has_timestep()) {
     if (auto s = CheckRange(p.timestep(), 0, 10, true, field, "timestep"); !s.ok()) return s;
   }
+  for (int i = 0; i < p.key_times_size(); ++i) {
+    if (auto s = CheckRange(p.key_times(i), 0, 1, false, field, absl::StrCat("key_times[", i, "]"));
+        !s.ok()) {
+      return s;
+    }
+  }
   if (p.max_iterations() > 10000) {
     return absl::InvalidArgumentError(
         absl::StrCat(field, ".max_iterations = ", p.max_iterations(), " is not in [1, 10000]"));
@@ -179,18 +186,13 @@ inbetween::v1::InbetweenParameters MergeInbetween(
   if (request.has_rho()) out.set_rho(request.rho());
   if (request.has_timestep()) out.set_timestep(request.timestep());
   if (request.max_iterations() != 0) out.set_max_iterations(request.max_iterations());
+  if (request.key_times_size() > 0) *out.mutable_key_times() = request.key_times();
   return out;
 }
 
 absl::StatusOr<InbetweenPlan> ToInbetweenPlan(const inbetween::v1::InbetweenParameters& p,
                                               absl::string_view field) {
   if (auto s = ValidateInbetween(p, field); !s.ok()) return s;
-  if (p.timing() != inbetween::v1::TIMING_CURVE_UNSPECIFIED &&
-      p.timing() != inbetween::v1::TIMING_CURVE_LINEAR) {
-    return absl::UnimplementedError(
-        absl::StrCat(field, ".timing = ", inbetween::v1::TimingCurve_Name(p.timing()),
-                     " is not implemented yet in this server version (use TIMING_CURVE_LINEAR)"));
-  }
   InbetweenPlan plan;
   if (p.frames() != 0) plan.frames = static_cast<int>(p.frames());
   solver::InbetweenOptions& o = plan.options;
@@ -215,6 +217,30 @@ absl::StatusOr<InbetweenPlan> ToInbetweenPlan(const inbetween::v1::InbetweenPara
   o.h = p.has_timestep() ? p.timestep() : 1.0 / 24;
   o.max_iterations = p.max_iterations() != 0 ? static_cast<int>(p.max_iterations()) : 20;
   return plan;
+}
+
+absl::StatusOr<solver::TimingOptions> ToTimingOptions(const inbetween::v1::InbetweenParameters& p,
+                                                     int num_drawings, absl::string_view field) {
+  solver::TimingOptions timing;
+  switch (p.timing()) {
+    case inbetween::v1::TIMING_CURVE_CATMULL_ROM:
+      timing.curve = solver::TimingCurve::kCatmullRom;
+      break;
+    case inbetween::v1::TIMING_CURVE_EASE_IN_OUT: {
+      const int segments = std::max(num_drawings - 1, 0);
+      if (p.ease_size() > 0 && p.ease_size() != segments) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(field, ".ease has ", p.ease_size(), " values, expected one per segment (",
+                         segments, " for ", num_drawings, " drawings) or none"));
+      }
+      timing.easing.assign(segments, solver::Easing::kEaseInOut);
+      timing.ease_amount.assign(p.ease().begin(), p.ease().end());
+      break;
+    }
+    default:  // UNSPECIFIED = LINEAR; unknown values were rejected by ValidateInbetween.
+      break;
+  }
+  return timing;
 }
 
 }  // namespace inbetween::server

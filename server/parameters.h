@@ -8,6 +8,7 @@
 #include "inbetween/v1/inbetween.pb.h"
 #include "solver/comesh/comesh_optimizer.h"
 #include "solver/interp/inbetweener.h"
+#include "solver/interp/timing.h"
 #include "solver/mesh/build_multimesh.h"
 
 namespace inbetween::server {
@@ -47,10 +48,17 @@ struct InbetweenPlan {
   solver::InbetweenOptions options;
 };
 
-// Validated, merged parameters -> what the server runs. Features the solver does not have yet
-// (non-linear timing curves) are UNIMPLEMENTED rather than ignored. Stiffness regions need the
-// mesh: the caller fills options.stiffness with StiffnessPerTriangle.
+// Validated, merged parameters -> what the server runs. Stiffness regions need the mesh: the
+// caller fills options.stiffness with StiffnessPerTriangle; the timing needs the number of
+// drawings: the caller uses ToTimingOptions.
 absl::StatusOr<InbetweenPlan> ToInbetweenPlan(const inbetween::v1::InbetweenParameters& params,
                                               absl::string_view field);
+
+// The validated timing curve for `num_drawings` keys: LINEAR (and UNSPECIFIED) = piecewise
+// linear, CATMULL_ROM = smooth through the keys, EASE_IN_OUT = every segment eased at both ends
+// by its `ease` amount (all 1 when `ease` is empty). `ease` is ignored by the other curves; a
+// non-empty `ease` of the wrong length is INVALID_ARGUMENT naming `field`.ease.
+absl::StatusOr<solver::TimingOptions> ToTimingOptions(
+    const inbetween::v1::InbetweenParameters& params, int num_drawings, absl::string_view field);
 
 }  // namespace inbetween::server

@@ -44,8 +44,9 @@ double TimingProgress(const std::vector<double>& key_frames, const TimingOptions
   const double s = (frame - key_frames[i]) / length;
   auto [m0, m1] = CurveSlopes(key_frames, timing.curve, i);
   const Easing easing = timing.easing.empty() ? Easing::kNone : timing.easing[i];
-  if (easing == Easing::kEaseIn || easing == Easing::kEaseInOut) m0 = 0.0;
-  if (easing == Easing::kEaseOut || easing == Easing::kEaseInOut) m1 = 0.0;
+  const double keep = timing.ease_amount.empty() ? 0.0 : 1.0 - timing.ease_amount[i];
+  if (easing == Easing::kEaseIn || easing == Easing::kEaseInOut) m0 *= keep;
+  if (easing == Easing::kEaseOut || easing == Easing::kEaseInOut) m1 *= keep;
   if (timing.curve == TimingCurve::kPiecewiseLinear && easing == Easing::kNone) return i + s;
   // Cubic Hermite from (0, 0) to (1, 1) with slopes m0, m1 in segment units.
   const double a = m0 * length, b = m1 * length;
@@ -61,6 +62,20 @@ absl::StatusOr<Schedule> MakeSchedule(int num_examples, int num_frames,
     return absl::InvalidArgumentError(absl::StrCat("timing.easing has ", timing.easing.size(),
                                                    " values, expected one per segment (",
                                                    num_examples - 1, ") or none"));
+  }
+  if (!timing.ease_amount.empty() &&
+      static_cast<int>(timing.ease_amount.size()) != num_examples - 1) {
+    return absl::InvalidArgumentError(absl::StrCat("timing.ease_amount has ",
+                                                   timing.ease_amount.size(),
+                                                   " values, expected one per segment (",
+                                                   num_examples - 1, ") or none"));
+  }
+  for (size_t i = 0; i < timing.ease_amount.size(); ++i) {
+    const double a = timing.ease_amount[i];
+    if (!(a >= 0.0 && a <= 1.0)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("timing.ease_amount[", i, "] = ", a, " is not in [0, 1]"));
+    }
   }
   if (num_examples < 2) {
     return absl::InvalidArgumentError(

@@ -49,6 +49,10 @@ struct TimingOptions {
   TimingCurve curve = TimingCurve::kPiecewiseLinear;
   // Empty = kNone everywhere, else one per segment (num_examples - 1 values).
   std::vector<Easing> easing;
+  // How much of the easing to apply, per segment in [0, 1]: the speed at an eased end is the
+  // curve's speed times (1 - amount), so 1 = at rest and 0 = no easing. Empty = 1 everywhere,
+  // else one per segment. Progress stays monotone for every amount (end slopes only shrink).
+  std::vector<double> ease_amount;
 };
 
 // MakeSchedule with a timing curve; keys are hit exactly (weights e_i at frame keys[i]) for every

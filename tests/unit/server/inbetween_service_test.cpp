@@ -574,6 +574,45 @@ TEST_F(InbetweenServiceTest, InbetweenWithStiffnessRegions) {
   EXPECT_EQ(RunInbetween(*stub_, request).status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 }
 
+TEST_F(InbetweenServiceTest, InbetweenTimingCurvesAndKeyTimes) {
+  v1::Session session = ImportTwoSquares();
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(9);
+  InbetweenRun linear = RunInbetween(*stub_, request);
+  ASSERT_TRUE(linear.status.ok()) << linear.status.error_message();
+  request.mutable_parameters()->set_timing(v1::TIMING_CURVE_EASE_IN_OUT);
+  InbetweenRun eased = RunInbetween(*stub_, request);
+  ASSERT_TRUE(eased.status.ok()) << eased.status.error_message();
+  ASSERT_EQ(eased.messages.size(), linear.messages.size());
+  // messages[0] is the header; frame f is messages[f + 1]. Keys stay exact, the ease-in-out
+  // frames start slower and end faster than linear ones and meet them in the middle.
+  auto weight2 = [](const InbetweenRun& run, int f) { return run.messages[f + 1].frame().weights(1); };
+  EXPECT_EQ(weight2(eased, 0), 0.0);
+  EXPECT_EQ(weight2(eased, 8), 1.0);
+  EXPECT_DOUBLE_EQ(weight2(linear, 1), 1.0 / 8);
+  EXPECT_LT(weight2(eased, 1), weight2(linear, 1));
+  EXPECT_GT(weight2(eased, 7), weight2(linear, 7));
+  EXPECT_NEAR(weight2(eased, 4), 0.5, 1e-12);
+
+  request.mutable_parameters()->add_ease(0.0);  // no easing at all = linear
+  InbetweenRun none = RunInbetween(*stub_, request);
+  ASSERT_TRUE(none.status.ok()) << none.status.error_message();
+  EXPECT_NEAR(weight2(none, 1), 1.0 / 8, 1e-12);
+
+  request.mutable_parameters()->add_ease(0.5);  // two values for one segment
+  InbetweenRun wrong = RunInbetween(*stub_, request);
+  EXPECT_EQ(wrong.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(wrong.status.error_message(), HasSubstr("parameters.ease"));
+
+  request.mutable_parameters()->clear_ease();
+  request.mutable_parameters()->add_key_times(0.0);
+  request.mutable_parameters()->add_key_times(0.5);  // the last key must be at 1
+  wrong = RunInbetween(*stub_, request);
+  EXPECT_EQ(wrong.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(wrong.status.error_message(), HasSubstr("parameters.key_times"));
+}
+
 TEST_F(InbetweenServiceTest, InbetweenResumesAtStartFrame) {
   v1::Session session = ImportTwoSquares();
   v1::InbetweenRequest request;

@@ -61,10 +61,49 @@ TEST(ParametersTest, OutOfRangeNamesTheField) {
               HasSubstr("meshing.boundary_vertices"));
 }
 
-TEST(ParametersTest, MissingFeaturesAreUnimplemented) {
+TEST(ParametersTest, TimingCurvesMapOntoTheSolver) {
   v1::InbetweenParameters p;
+  absl::StatusOr<solver::TimingOptions> t = ToTimingOptions(p, 3, "parameters");
+  ASSERT_TRUE(t.ok()) << t.status();
+  EXPECT_EQ(t->curve, solver::TimingCurve::kPiecewiseLinear);
+  EXPECT_TRUE(t->easing.empty());
+
   p.set_timing(v1::TIMING_CURVE_CATMULL_ROM);
-  EXPECT_EQ(ToInbetweenPlan(p, "parameters").status().code(), absl::StatusCode::kUnimplemented);
+  p.add_ease(0.5);  // ignored by curves other than EASE_IN_OUT
+  t = ToTimingOptions(p, 3, "parameters");
+  ASSERT_TRUE(t.ok()) << t.status();
+  EXPECT_EQ(t->curve, solver::TimingCurve::kCatmullRom);
+  EXPECT_TRUE(t->easing.empty());
+
+  p.set_timing(v1::TIMING_CURVE_EASE_IN_OUT);
+  p.add_ease(0.25);
+  t = ToTimingOptions(p, 3, "parameters");
+  ASSERT_TRUE(t.ok()) << t.status();
+  EXPECT_EQ(t->easing, (std::vector<solver::Easing>(2, solver::Easing::kEaseInOut)));
+  EXPECT_EQ(t->ease_amount, (std::vector<double>{0.5, 0.25}));
+
+  absl::StatusOr<solver::TimingOptions> wrong = ToTimingOptions(p, 4, "parameters");
+  EXPECT_EQ(wrong.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(wrong.status().message()), HasSubstr("parameters.ease has 2 values"));
+}
+
+TEST(ParametersTest, KeyTimesAreRangeCheckedAndMerged) {
+  v1::InbetweenParameters p;
+  p.add_key_times(0.0);
+  p.add_key_times(1.5);
+  absl::Status s = ValidateInbetween(p, "parameters");
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(s.message()), HasSubstr("parameters.key_times[1]"));
+
+  v1::InbetweenParameters session;
+  session.add_key_times(0.0);
+  session.add_key_times(1.0);
+  v1::InbetweenParameters request;
+  EXPECT_EQ(MergeInbetween(session, request).key_times_size(), 2);
+  request.add_key_times(0.0);
+  request.add_key_times(0.3);
+  request.add_key_times(1.0);
+  EXPECT_EQ(MergeInbetween(session, request).key_times_size(), 3);
 }
 
 }  // namespace

@@ -204,5 +204,46 @@ TEST(TimingCurveTest, RejectsAnEasingListOfTheWrongLength) {
   EXPECT_NE(s.status().message().find("easing"), std::string::npos) << s.status();
 }
 
+TEST(TimingCurveTest, EaseAmountScalesTheSpeedAtEasedEnds) {
+  const std::vector<double> k = {0.0, 10.0, 20.0};
+  const double d = 1e-5;
+  TimingOptions half;
+  half.easing = {Easing::kEaseInOut, Easing::kEaseInOut};
+  half.ease_amount = {0.5, 0.0};
+  // Segment 1 leaves and arrives at half the linear speed 1/10; segment 2 is not eased at all.
+  EXPECT_NEAR(TimingProgress(k, half, d) / d, 0.05, 1e-4);
+  EXPECT_NEAR((1.0 - TimingProgress(k, half, 10.0 - d)) / d, 0.05, 1e-4);
+  for (double f : {11.0, 13.0, 17.5}) {
+    EXPECT_NEAR(TimingProgress(k, half, f), 1.0 + (f - 10.0) / 10.0, 1e-12) << f;
+  }
+  // Full amount equals the default (at rest); progress stays monotone for every amount.
+  TimingOptions rest;
+  rest.easing = half.easing;
+  for (double a : {0.0, 0.3, 0.7, 1.0}) {
+    TimingOptions t = half;
+    t.ease_amount = {a, a};
+    double previous = -1.0;
+    for (double f = 0.0; f <= 20.0; f += 0.25) {
+      const double u = TimingProgress(k, t, f);
+      EXPECT_GE(u, previous) << "amount " << a << " frame " << f;
+      previous = u;
+      if (a == 1.0) EXPECT_EQ(u, TimingProgress(k, rest, f));
+    }
+  }
+  absl::StatusOr<Schedule> s = MakeSchedule(3, 21, {}, half);
+  ASSERT_TRUE(s.ok()) << s.status();
+  EXPECT_EQ(s->keys, (std::vector<int>{0, 10, 20}));
+}
+
+TEST(TimingCurveTest, RejectsEaseAmountsOutOfRangeOrOfTheWrongLength) {
+  TimingOptions t;
+  t.ease_amount = {0.5};
+  EXPECT_EQ(MakeSchedule(3, 10, {}, t).status().code(), absl::StatusCode::kInvalidArgument);
+  t.ease_amount = {0.5, 1.5};
+  absl::StatusOr<Schedule> s = MakeSchedule(3, 10, {}, t);
+  EXPECT_EQ(s.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(s.status().message().find("ease_amount[1] = 1.5"), std::string::npos) << s.status();
+}
+
 }  // namespace
 }  // namespace inbetween::solver
