@@ -126,9 +126,11 @@ try {
       oy: Number(c.dataset.oy),
     }));
     const at = (x, y) => ({ x: view.ox + view.scale * x, y: view.oy + view.scale * y });
-    await editor.click({ position: at(cut[0], cut[1]) });
-    await editor.click({ position: at(cut[2], cut[3]) });
-    assert.ok(box.width > 100);
+    for (const p of [at(cut[0], cut[1]), at(cut[2], cut[3])]) {
+      assert.ok(p.x > 0 && p.y > 0 && p.x < box.width && p.y < box.height,
+        `cut point ${JSON.stringify(p)} outside the ${box.width}×${box.height} editor`);
+      await editor.click({ position: p });
+    }
     const before = Number(await page.locator("#session-info").getAttribute("data-version"));
     await page.click("#finish-stroke");
     await page.locator("#element-list li").first().waitFor();

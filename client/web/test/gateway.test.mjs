@@ -77,12 +77,17 @@ const upstreamImpl = {
   },
 };
 
-let upstream, gateway, staticDir, baseUrl;
+let upstream, gateway, gatewayHandler, staticDir, baseUrl;
+const upstreamSessions = new Set();
 
 before(async () => {
   upstream = createHttp2Server(
     connectNodeAdapter({ routes: (r) => r.service(Inbetween, upstreamImpl) }),
   );
+  upstream.on("session", (s) => {
+    upstreamSessions.add(s);
+    s.on("close", () => upstreamSessions.delete(s));
+  });
   upstream.listen(0, "127.0.0.1");
   await once(upstream, "listening");
   staticDir = await mkdtemp(join(tmpdir(), "gateway-test-"));
@@ -90,12 +95,11 @@ before(async () => {
   await writeFile(join(staticDir, "index.html"), "<!doctype html><title>page</title>");
   await writeFile(join(staticDir, "app.js"), "console.log(1)");
   await writeFile(join(tmpdir(), "gateway-test-outside.txt"), "secret");
-  gateway = createServer(
-    createGatewayHandler({
-      upstream: `http://127.0.0.1:${upstream.address().port}`,
-      staticDir,
-    }),
-  );
+  gatewayHandler = createGatewayHandler({
+    upstream: `http://127.0.0.1:${upstream.address().port}`,
+    staticDir,
+  });
+  gateway = createServer(gatewayHandler);
   gateway.listen(0, "127.0.0.1");
   await once(gateway, "listening");
   baseUrl = `http://127.0.0.1:${gateway.address().port}`;
@@ -104,6 +108,8 @@ before(async () => {
 after(async () => {
   gateway.closeAllConnections();
   gateway.close();
+  gatewayHandler.close();
+  for (const s of upstreamSessions) s.destroy();
   upstream.close();
   await rm(staticDir, { recursive: true, force: true });
   await rm(join(tmpdir(), "gateway-test-outside.txt"), { force: true });
@@ -209,7 +215,8 @@ test("EditTopologyOnce with a stale version is ABORTED", async () => {
 });
 
 test("unreachable upstream is UNAVAILABLE, not a hang", async () => {
-  const dead = createServer(createGatewayHandler({ upstream: "http://127.0.0.1:1" }));
+  const deadHandler = createGatewayHandler({ upstream: "http://127.0.0.1:1" });
+  const dead = createServer(deadHandler);
   dead.listen(0, "127.0.0.1");
   await once(dead, "listening");
   try {
@@ -224,6 +231,7 @@ test("unreachable upstream is UNAVAILABLE, not a hang", async () => {
   } finally {
     dead.closeAllConnections();
     dead.close();
+    deadHandler.close();
   }
 });
 

@@ -15,7 +15,11 @@ import { readFile, stat } from "node:fs/promises";
 import { extname, join, normalize, sep } from "node:path";
 
 import { Code, ConnectError, createClient } from "@connectrpc/connect";
-import { connectNodeAdapter, createGrpcTransport } from "@connectrpc/connect-node";
+import {
+  Http2SessionManager,
+  connectNodeAdapter,
+  createGrpcTransport,
+} from "@connectrpc/connect-node";
 
 import { Inbetween } from "../gen/inbetween/v1/inbetween_pb.js";
 import { Gateway } from "../gen/inbetween/web/v1/gateway_pb.js";
@@ -171,15 +175,18 @@ export function staticFiles(root) {
 // The request handler for node:http / node:http2: Connect routes, then the static page.
 //   upstream:  "http://127.0.0.1:50051" (the inbetween-server, plaintext HTTP/2)
 //   staticDir: directory of the built page, or null for API only
+// handler.close() drops the upstream HTTP/2 connection (it is otherwise kept while idle).
 export function createGatewayHandler({ upstream, staticDir = null, maxBytes = DEFAULT_MAX_BYTES }) {
+  const sessionManager = new Http2SessionManager(upstream);
   const transport = createGrpcTransport({
     baseUrl: upstream,
     httpVersion: "2",
+    sessionManager,
     readMaxBytes: maxBytes,
     writeMaxBytes: maxBytes,
   });
   const client = createClient(Inbetween, transport);
-  return connectNodeAdapter({
+  const handler = connectNodeAdapter({
     readMaxBytes: maxBytes,
     writeMaxBytes: maxBytes,
     routes(router) {
@@ -188,4 +195,6 @@ export function createGatewayHandler({ upstream, staticDir = null, maxBytes = DE
     },
     fallback: staticDir ? staticFiles(staticDir) : undefined,
   });
+  handler.close = () => sessionManager.abort();
+  return handler;
 }

@@ -50,7 +50,8 @@ const listen = splitHostPort(values.listen, "--listen");
 const here = dirname(fileURLToPath(import.meta.url));
 const staticDir = values["no-static"] ? null : (values.static ?? join(here, "..", "..", "dist"));
 
-const server = createServer(createGatewayHandler({ upstream: up, staticDir }));
+const handler = createGatewayHandler({ upstream: up, staticDir });
+const server = createServer(handler);
 server.on("error", (err) => {
   console.error(`inbetween-gateway: ${err.message}`);
   process.exit(1);
@@ -64,6 +65,7 @@ server.listen(listen.port, listen.host, () => {
 function stop() {
   server.close(() => process.exit(0));
   server.closeAllConnections();
+  handler.close();
 }
 process.on("SIGTERM", stop);
 process.on("SIGINT", stop);

@@ -377,7 +377,10 @@ function renderEditor() {
   const b = d ? drawingBounds(d) : emptyBounds();
   for (const p of state.stroke) addPoint(b, p.x, p.y);
   if (isEmpty(b)) addPoint(addPoint(b, 0, 0), 200, 200);
-  const view = fitView(b, w, h, 24);
+  // Room around the drawing: cuts and openings start and end outside the outline.
+  const margin = 0.2 * Math.max(b.maxX - b.minX, b.maxY - b.minY);
+  addPoint(addPoint(b, b.minX - margin, b.minY - margin), b.maxX + margin, b.maxY + margin);
+  const view = fitView(b, w, h, 8);
   state.editorView = view;
   canvas.dataset.scale = String(view.scale);
   canvas.dataset.ox = String(view.ox);
