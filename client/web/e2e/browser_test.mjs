@@ -12,7 +12,11 @@ import { readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import { parseArgs } from "node:util";
 
+import { createClient } from "@connectrpc/connect";
+import { createConnectTransport } from "@connectrpc/connect-node";
 import { chromium } from "playwright-core";
+
+import { Inbetween } from "../src/gen/inbetween/v1/inbetween_pb.js";
 
 const { values: args } = parseArgs({
   options: {
@@ -75,7 +79,16 @@ async function scrubTo(page, i) {
 const browser = await chromium.launch({
   executablePath: args.chromium,
   // root in containers/CI cannot use Chromium's sandbox; the page only talks to loopback.
-  args: ["--no-sandbox", "--disable-gpu"],
+  args: [
+    "--no-sandbox",
+    "--disable-gpu",
+    // No network but loopback here: keep Chromium from reaching out on its own.
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--disable-quic",
+    "--no-first-run",
+  ],
   timeout: STEP_MS,
 });
 const pageErrors = [];
@@ -139,6 +152,35 @@ try {
     const after = Number(await page.locator("#session-info").getAttribute("data-version"));
     assert.equal(after, before + 1);
     await page.screenshot({ path: join(args.out, "cut.png") });
+  });
+
+  await step("a change made elsewhere: the page's stale call is ABORTED and it reloads", async () => {
+    // Another client (Connect over HTTP/1.1 through the same gateway) changes the session.
+    const info = page.locator("#session-info");
+    const sessionId = await info.getAttribute("data-session-id");
+    const other = createClient(
+      Inbetween,
+      createConnectTransport({ baseUrl: args.url, httpVersion: "1.1" }),
+    );
+    const { session } = await other.getSession({ sessionId }, { headers: { "x-session-id": sessionId } });
+    assert.equal(String(session.version), await info.getAttribute("data-version"));
+    const res = await other.setCorrespondences(
+      { sessionId, expectedVersion: session.version, correspondences: [] },
+      { headers: { "x-session-id": sessionId } },
+    );
+    assert.equal(res.session.version, session.version + 1n);
+    await page.click("#send-marks");
+    await page.waitForFunction(() => document.getElementById("error-marks").textContent !== "");
+    const msg = await text(page, "#error-marks");
+    assert.match(msg, /^ABORTED: /, msg);
+    assert.match(msg, /reloaded/);
+    assert.equal(await info.getAttribute("data-version"), String(res.session.version));
+    await page.click("#send-marks"); // now with the reloaded version
+    await page.waitForFunction(
+      (v) => document.getElementById("session-info").dataset.version === v,
+      String(res.session.version + 1n),
+    );
+    assert.equal(await text(page, "#error-marks"), "");
   });
 
   await step("build the multimesh: stats and a first chart point", async () => {

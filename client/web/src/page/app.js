@@ -112,6 +112,7 @@ function applySession(session) {
   $("session-info").textContent =
     `session ${session.id} · v${session.version} · ${drawings().length} drawings · ${stage.toLowerCase()}`;
   $("session-info").dataset.version = String(session.version);
+  $("session-info").dataset.sessionId = session.id;
   if (session.multimeshStats && session.stage >= Stage.MULTIMESH) showStats(session.multimeshStats);
   renderDrawings();
   renderEditor();
