@@ -149,6 +149,10 @@ try {
     await page.locator("#element-list li").first().waitFor();
     assert.equal(await text(page, "#error-edit"), "");
     assert.match(await text(page, "#element-list"), /cut #\d+ \(2 points\)/);
+    // The cut splits the cell: two closed boundaries, joined by cohesive edges along the cut.
+    assert.match(await text(page, "#topology-info"), /^rebuilt: 2 boundaries · [1-9]\d* cohesive edges?$/);
+    const classes = await page.locator("#drawing-list li[data-drawing-id] .class").allTextContents();
+    assert.deepEqual(classes, ["2 comp. · 0 holes", "2 comp. · 0 holes"]);
     const after = Number(await page.locator("#session-info").getAttribute("data-version"));
     assert.equal(after, before + 1);
     await page.screenshot({ path: join(args.out, "cut.png") });

@@ -257,6 +257,14 @@ function paintDrawing(ctx, view, d, index, detailed) {
   }
   const topo = state.topology.get(d.id);
   if (topo && detailed) {
+    // Rebuilt boundaries: each region bounded by a positive loop gets its own tint, so a cut
+    // that separates the shape shows as two colours; every loop is dashed on top.
+    topo.boundaries.forEach((b, i) => {
+      if (signedArea2(b.points) <= 0) return;
+      strokePolyline(ctx, view, b.points, true);
+      ctx.fillStyle = `hsla(${(i * 137) % 360}, 70%, 55%, 0.25)`;
+      ctx.fill();
+    });
     ctx.setLineDash([5, 4]);
     ctx.strokeStyle = COLORS.boundary;
     ctx.lineWidth = 1.5;
@@ -265,6 +273,12 @@ function paintDrawing(ctx, view, d, index, detailed) {
       ctx.stroke();
     }
     ctx.setLineDash([]);
+    ctx.strokeStyle = "#7048e8";
+    ctx.lineWidth = 3;
+    for (const e of topo.cohesiveEdges) {
+      strokePolyline(ctx, view, [e.a, e.b], false);
+      ctx.stroke();
+    }
   }
   const marks = [...state.marks, state.pendingMark];
   marks.forEach((mark, mi) => {
@@ -412,6 +426,10 @@ function renderEditor() {
     list.append(li);
   }
   const topo = d && state.topology.get(d.id);
+  $("topology-info").textContent = topo
+    ? `rebuilt: ${topo.boundaries.length} boundar${topo.boundaries.length === 1 ? "y" : "ies"} · ` +
+      `${topo.cohesiveEdges.length} cohesive edge${topo.cohesiveEdges.length === 1 ? "" : "s"}`
+    : "";
   $("warnings").textContent = "";
   for (const w of topo?.warnings ?? []) {
     const li = document.createElement("li");
