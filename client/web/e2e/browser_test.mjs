@@ -293,6 +293,53 @@ try {
     await page.screenshot({ path: join(args.out, "phone-390x844.png"), fullPage: true });
   });
 
+  await step("new session: two polygons drawn with the mouse, one mark, build, inbetween", async () => {
+    await page.setViewportSize({ width: 1280, height: 800 });
+    await page.click("#server-settings summary");
+    await page.click("#new-session");
+    await page.waitForFunction(() => document.getElementById("session-info").dataset.version === "1");
+    assert.equal(await page.locator("#drawing-list li").count(), 0);
+    const editor = page.locator("#editor");
+    const clickAll = async (points) => {
+      const v = await editor.evaluate((c) => [c.dataset.scale, c.dataset.ox, c.dataset.oy].map(Number));
+      for (const [x, y] of points) await editor.click({ position: { x: v[1] + v[0] * x, y: v[2] + v[0] * y } });
+    };
+    const polygons = [
+      [[50, 50], [150, 50], [150, 150], [50, 150]],
+      [[60, 40], [140, 60], [160, 140], [100, 170], [40, 140]],
+    ];
+    for (const [i, polygon] of polygons.entries()) {
+      await page.check('input[name="tool"][value="polygon"]');
+      await clickAll(polygon);
+      await page.click("#finish-stroke");
+      await page.locator("#drawing-list li[data-drawing-id]").nth(i).waitFor();
+      assert.equal(await text(page, "#error-edit"), "");
+    }
+    assert.deepEqual(await page.locator("#drawing-list .name").allTextContents(), [
+      "1. polygon_1.svg",
+      "2. polygon_2.svg",
+    ]);
+    await page.check('input[name="tool"][value="mark"]');
+    await page.locator("#drawing-list li[data-drawing-id] canvas").first().click();
+    await clickAll([[52, 48]]); // snaps to the corner (50, 50) of drawing 1; then drawing 2
+    await clickAll([[60, 40]]);
+    assert.equal(await text(page, "#marks-info"), "1 mark(s)");
+    const v = Number(await page.locator("#session-info").getAttribute("data-version"));
+    await page.click("#send-marks");
+    await page.waitForFunction((want) => document.getElementById("session-info").dataset.version === want, String(v + 1));
+    assert.equal(await text(page, "#error-marks"), "");
+    await page.click("#build");
+    await page.waitForFunction(() => !document.getElementById("build").disabled);
+    assert.equal(await text(page, "#error-build"), "");
+    assert.match(await text(page, "#mesh-stats"), /^\d+ vertices · \d+ triangles · 2 shapes/);
+    await page.fill("#frames", "6");
+    await page.click("#inbetween");
+    await page.waitForFunction(() => !document.getElementById("inbetween").disabled);
+    assert.equal(await text(page, "#error-inbetween"), "");
+    assert.match(await text(page, "#frame-label"), /^frame \d+ \/ 6/);
+    await page.screenshot({ path: join(args.out, "polygons.png") });
+  });
+
   await step("no uncaught errors in the page", async () => {
     assert.deepEqual(pageErrors, []);
   });

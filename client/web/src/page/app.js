@@ -389,13 +389,19 @@ function renderEditor() {
   const canvas = $("editor");
   const [ctx, w, h] = prepareCanvas(canvas);
   const [d, index] = selectedDrawing();
-  const b = d ? drawingBounds(d) : emptyBounds();
-  for (const p of state.stroke) addPoint(b, p.x, p.y);
-  if (isEmpty(b)) addPoint(addPoint(b, 0, 0), 200, 200);
-  // Room around the drawing: cuts and openings start and end outside the outline.
-  const margin = 0.2 * Math.max(b.maxX - b.minX, b.maxY - b.minY);
-  addPoint(addPoint(b, b.minX - margin, b.minY - margin), b.maxX + margin, b.maxY + margin);
-  const view = fitView(b, w, h, 8);
+  // The view fits the drawing, and stays put while a stroke is being drawn.
+  const old = state.editorView;
+  let view = old;
+  if (!(state.stroke.length && old && old.w === w && old.h === h)) {
+    const b = d ? drawingBounds(d) : emptyBounds();
+    if (isEmpty(b) || Math.max(b.maxX - b.minX, b.maxY - b.minY) < 1e-6) {
+      addPoint(addPoint(b, 0, 0), 200, 200);
+    }
+    // Room around the drawing: cuts and openings start and end outside the outline.
+    const margin = 0.2 * Math.max(b.maxX - b.minX, b.maxY - b.minY);
+    addPoint(addPoint(b, b.minX - margin, b.minY - margin), b.maxX + margin, b.maxY + margin);
+    view = { ...fitView(b, w, h, 8), w, h };
+  }
   state.editorView = view;
   canvas.dataset.scale = String(view.scale);
   canvas.dataset.ox = String(view.ox);
