@@ -1053,7 +1053,11 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
             v1::FrameStats* stats = out->mutable_stats();
             stats->set_iterations(report.iterations);
             stats->set_energy(report.energy);
-            stats->set_inverted_triangles(solver::CountInverted(mesh.triangles, frame->vertices));
+            stats->set_inverted_triangles(report.inverted);
+            stats->set_boundary_overlaps(report.overlaps);
+            stats->set_min_area_ratio(report.min_area_ratio);
+            stats->set_max_area_ratio(report.max_area_ratio);
+            stats->set_separated_cohesive_edges(report.separated_edges);
             stats->set_seconds(report.seconds > 0 ? report.seconds : seconds);
             if (!writer->Write(message)) return StoppedStatus(*context, "Inbetween");
           }

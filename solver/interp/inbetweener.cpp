@@ -38,6 +38,7 @@
 #include "solver/interp/inbetweener.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -57,6 +58,12 @@
 
 namespace inbetween::solver {
 namespace {
+
+double DoubleArea(const Triangle& t, const Coords& x) {
+  const Eigen::Vector2d e1 = x.row(t[1]) - x.row(t[0]);
+  const Eigen::Vector2d e2 = x.row(t[2]) - x.row(t[0]);
+  return e1.x() * e2.y() - e1.y() * e2.x();
+}
 
 // Signed area <= 0 in raw coordinates (see types.h for the orientation convention).
 int CountInverted(const std::vector<Triangle>& triangles, const Coords& x) {
@@ -148,6 +155,7 @@ struct Inbetweener::Impl {
   InbetweenOptions options;
   std::vector<Triangle> triangles;
   std::vector<Coords> shapes;
+  std::vector<Eigen::VectorXd> shape_area2;  // [example][triangle] doubled signed area, lazily
   std::optional<BlendedArap> arap;         // kZhu17 energy (also reported for all methods)
   std::optional<CohesiveEnergy> cohesive;  // may have no edges
   std::optional<OverlapChecker> overlap;
@@ -210,6 +218,9 @@ struct Inbetweener::Impl {
   absl::StatusOr<Coords> Iterate(const Problem& p, Coords x, double energy, Coords rhs,
                                  const CancelToken* cancel, FrameReport* report) const;
   absl::StatusOr<Coords> Alexa(const ExampleWeights& w) const;
+  // Fills report->min/max_area_ratio: each triangle's area in x over its weight-blended area in
+  // the examples.
+  void AreaRatios(const Coords& x, const ExampleWeights& w, FrameReport* report);
   absl::StatusOr<Coords> Zhu17(const ExampleWeights& w, const Frame& previous,
                                const Frame& before_previous, const CancelToken* cancel,
                                FrameReport* report);
@@ -520,6 +531,28 @@ absl::StatusOr<Coords> Inbetweener::Impl::Iterate(const Problem& p, Coords x, do
   return x;
 }
 
+void Inbetweener::Impl::AreaRatios(const Coords& x, const ExampleWeights& w,
+                                    FrameReport* report) {
+  const int num_triangles = static_cast<int>(triangles.size());
+  if (shape_area2.empty()) {
+    shape_area2.resize(shapes.size());
+    for (size_t i = 0; i < shapes.size(); ++i) {
+      shape_area2[i].resize(num_triangles);
+      for (int t = 0; t < num_triangles; ++t) shape_area2[i][t] = DoubleArea(triangles[t], shapes[i]);
+    }
+  }
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int t = 0; t < num_triangles; ++t) {
+    double blended = 0.0;
+    for (size_t i = 0; i < shapes.size(); ++i) blended += w[i] * shape_area2[i][t];
+    const double ratio = DoubleArea(triangles[t], x) / blended;  // examples have positive areas
+    lo = std::min(lo, ratio);
+    hi = std::max(hi, ratio);
+  }
+  report->min_area_ratio = lo;
+  report->max_area_ratio = hi;
+}
+
 absl::StatusOr<Coords> Inbetweener::Impl::Alexa(const ExampleWeights& w) const {
   const int num_t = static_cast<int>(triangles.size());
   std::vector<Eigen::Matrix2d> targets(num_t);
@@ -727,6 +760,7 @@ absl::StatusOr<Frame> Inbetweener::Impl::Solve(const ExampleWeights& weights, co
     local.energy = arap->Value(x, weights);
   }
   local.inverted = CountInverted(triangles, x);
+  AreaRatios(x, weights, &local);
   local.overlaps = known_inside_free ? overlap->Crossings(x) : overlap->Count(x);
   local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (report != nullptr) *report = local;

@@ -82,6 +82,10 @@ struct FrameReport {
   int separated_edges = 0;    // cohesive edge pairs whose zone is open (S-eq.6 capped)
   bool warm_started = false;  // kZhu17 started from `previous`
   double xi = 0.0;            // dynamics blend weight xi(s) (S-eq.28); 0 without dynamics
+  // Smallest and largest ratio of a triangle's signed area to its area blended over the examples
+  // with the frame's weights (1 = area kept; <= 0 = inverted).
+  double min_area_ratio = 1.0;
+  double max_area_ratio = 1.0;
 };
 
 class Inbetweener {

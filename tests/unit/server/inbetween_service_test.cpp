@@ -103,6 +103,9 @@ void ExpectValidAnimation(const InbetweenRun& run, const v1::Multimesh& mesh, in
     EXPECT_EQ(frame.weights_size(), mesh.shapes_size());
     ASSERT_EQ(frame.vertices_size(), mesh.shapes(0).vertices_size());
     EXPECT_EQ(frame.stats().inverted_triangles(), 0u) << "frame " << i;
+    EXPECT_EQ(frame.stats().boundary_overlaps(), 0u) << "frame " << i;
+    EXPECT_GT(frame.stats().min_area_ratio(), 0.0) << "frame " << i;
+    EXPECT_GE(frame.stats().max_area_ratio(), frame.stats().min_area_ratio()) << "frame " << i;
     EXPECT_EQ(solver::CountInverted(triangles, ToPoints(frame.vertices())), 0) << "frame " << i;
   }
   for (int k = 0; k < header.keys_size(); ++k) {

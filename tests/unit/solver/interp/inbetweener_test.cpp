@@ -91,6 +91,8 @@ TEST(InterpInbetweenerTest, AllMethodsHitKeys) {
         }
         EXPECT_EQ(report.inverted, 0);
         EXPECT_LT(report.energy, 1e-18);
+        EXPECT_NEAR(report.min_area_ratio, 1.0, 1e-9) << Name(method) << " key " << i;
+        EXPECT_NEAR(report.max_area_ratio, 1.0, 1e-9) << Name(method) << " key " << i;
       }
     }
   }
@@ -110,6 +112,8 @@ TEST(InterpInbetweenerTest, LinearCollapsesAtHalfOf180TurnArapMethodsDoNot) {
   }
   EXPECT_LT(max_area, 1e-12);  // every triangle degenerates to a point
   EXPECT_GT(report.inverted, 0);
+  EXPECT_LT(std::abs(report.min_area_ratio), 1e-9);  // area ratios report the collapse
+  EXPECT_LT(std::abs(report.max_area_ratio), 1e-9);
 
   for (InterpMethod method : {InterpMethod::kAlexa, InterpMethod::kZhu17}) {
     Inbetweener ib = MakeInbetweener(mesh, Options(method));
@@ -119,6 +123,8 @@ TEST(InterpInbetweenerTest, LinearCollapsesAtHalfOf180TurnArapMethodsDoNot) {
     for (const Triangle& t : mesh.triangles) {
       EXPECT_NEAR(SignedArea(f->vertices, t), 0.5, 1e-9) << Name(method);  // rigid
     }
+    EXPECT_NEAR(report.min_area_ratio, 1.0, 1e-9) << Name(method);
+    EXPECT_NEAR(report.max_area_ratio, 1.0, 1e-9) << Name(method);
     EXPECT_NEAR(std::abs(EdgeAngle(f->vertices)), 0.5 * kPi, 1e-9) << Name(method);
     EXPECT_LT(report.energy, 1e-18);
   }
