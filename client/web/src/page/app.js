@@ -108,7 +108,7 @@ const drawings = () => state.session?.drawings ?? [];
 function applySession(session) {
   state.session = session;
   if (!drawings().some((d) => d.id === state.selected)) state.selected = drawings()[0]?.id ?? 0;
-  const stage = Stage[session.stage] ?? "?";
+  const stage = session.stage === Stage.UNSPECIFIED ? "empty" : (Stage[session.stage] ?? "?");
   $("session-info").textContent =
     `session ${session.id} · v${session.version} · ${drawings().length} drawings · ${stage.toLowerCase()}`;
   $("session-info").dataset.version = String(session.version);
