@@ -1,6 +1,7 @@
 // The `inbetween` subcommands (see commands.h).
 #include "client/commands.h"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -8,7 +9,10 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
+#include "client/auto_topology.h"
+#include "client/drawing_fills.h"
 #include "client/frames_output.h"
+#include "client/render/color.h"
 #include "client/render/export.h"
 #include "client/render/svg_frames.h"
 
@@ -114,10 +118,10 @@ absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::str
 }
 
 absl::StatusOr<v1::BuildMultimeshResult> Build(const v1::Session& session, const RunContext& ctx) {
-  auto built = ctx.client->BuildMultimesh(
-      session, [&](const v1::Progress& p) { ShowProgress(ctx, p); });
+  auto built =
+      ctx.client->BuildMultimesh(session, [&](const v1::Progress& p) { ShowProgress(ctx, p); });
   FinishProgress(ctx);
-  if (!built.ok()) return Annotate(built.status(), "build multimesh");
+  if (!built.ok()) return Annotate(AdviseAutoTopology(built.status()), "build multimesh");
   return built;
 }
 
@@ -172,7 +176,103 @@ render::FrameSet ShapesAsFrames(const v1::Multimesh& mesh) {
   return set;
 }
 
+// Where --auto-topology writes the project: the --project file itself, else OUT/project.json.
+std::filesystem::path AutoTopologyFile(const Inputs& inputs, const std::filesystem::path& out) {
+  return inputs.project.empty() ? out / "project.json" : inputs.project;
+}
+
+absl::Status FlagError(const char* flag, absl::string_view what) {
+  return absl::InvalidArgumentError(absl::StrCat(flag, ": ", what));
+}
+
 }  // namespace
+
+absl::Status ApplyInbetweenOverrides(const InbetweenOverrides& o, Project* project) {
+  v1::InbetweenParameters* params = project->parameters.mutable_inbetween();
+  if (o.frames) params->set_frames(*o.frames);
+  if (o.method) {
+    auto method = ParseMethod(*o.method);
+    if (!method.ok()) return method.status();
+    params->set_method(*method);
+  }
+  if (o.timing) {
+    std::optional<v1::TimingCurve> curve = TimingCurveFromName(*o.timing);
+    if (!curve) {
+      return FlagError("--timing", absl::StrCat("unknown timing curve '", *o.timing,
+                                                "' (linear, catmull-rom, ease-in-out)"));
+    }
+    params->set_timing(*curve);
+  }
+  const size_t segments = project->drawings.size() - 1;
+  if (!o.ease.empty()) {
+    if (o.timing && params->timing() != v1::TIMING_CURVE_EASE_IN_OUT) {
+      return FlagError("--ease", "applies to --timing ease-in-out only");
+    }
+    if (o.ease.size() != 1 && o.ease.size() != segments) {
+      return FlagError("--ease", absl::StrCat("give one amount, or one per segment between keys (",
+                                              segments, "), not ", o.ease.size()));
+    }
+    params->clear_ease();
+    for (size_t i = 0; i < segments; ++i) {
+      const double e = o.ease[o.ease.size() == 1 ? 0 : i];
+      if (!(e >= 0 && e <= 1)) {
+        return FlagError("--ease", absl::StrCat("amount ", e, " is not in [0, 1]"));
+      }
+      params->add_ease(e);
+    }
+    if (!o.timing) params->set_timing(v1::TIMING_CURVE_EASE_IN_OUT);
+  }
+  struct Bounded {
+    const char* flag;
+    const std::optional<double>& value;
+    double min, max;
+    bool open_min;
+    void (v1::InbetweenParameters::*set)(double);
+  };
+  using P = v1::InbetweenParameters;
+  for (const Bounded& b : {Bounded{"--lambda", o.lambda, 0, 1e9, false, &P::set_lambda},
+                           Bounded{"--tau", o.tau, 0, 1e9, false, &P::set_tau},
+                           Bounded{"--alpha", o.alpha, 0, 1, false, &P::set_alpha},
+                           Bounded{"--epsilon", o.epsilon, 0, 1e6, false, &P::set_epsilon},
+                           Bounded{"--rho", o.rho, 0, 1e9, true, &P::set_rho},
+                           Bounded{"--timestep", o.timestep, 0, 10, true, &P::set_timestep}}) {
+    if (!b.value) continue;
+    const double v = *b.value;
+    if (!std::isfinite(v) || v < b.min || v > b.max || (b.open_min && v == b.min)) {
+      return FlagError(b.flag, absl::StrCat("value ", v, " is not in ", b.open_min ? "(" : "[",
+                                            b.min, ", ", b.max, "]"));
+    }
+    (params->*b.set)(v);
+  }
+  if (o.max_iterations) {
+    if (*o.max_iterations < 1 || *o.max_iterations > 10000) {
+      return FlagError("--max-iterations",
+                       absl::StrCat("value ", *o.max_iterations, " is not in [1, 10000]"));
+    }
+    params->set_max_iterations(*o.max_iterations);
+  }
+  // Key times: the flag replaces the drawings' key_time; either way they travel both as
+  // InbetweenParameters.key_times and on each drawing.
+  std::vector<double> key_times = o.key_times;
+  if (!key_times.empty()) {
+    if (absl::Status s = CheckKeyTimes(key_times, project->drawings.size()); !s.ok()) {
+      return FlagError("--key-times", s.message());
+    }
+    for (size_t i = 0; i < key_times.size(); ++i) project->drawings[i].key_time = key_times[i];
+  } else {
+    for (const ProjectDrawing& d : project->drawings) {
+      if (d.key_time) key_times.push_back(*d.key_time);
+    }
+    if (!key_times.empty()) {
+      if (absl::Status s = CheckKeyTimes(key_times, project->drawings.size()); !s.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("drawings' key_time: ", s.message()));
+      }
+    }
+  }
+  params->clear_key_times();
+  for (double t : key_times) params->add_key_times(t);
+  return absl::OkStatus();
+}
 
 absl::StatusOr<Project> ResolveProject(const Inputs& inputs) {
   Project project;
@@ -190,9 +290,9 @@ absl::StatusOr<Project> ResolveProject(const Inputs& inputs) {
     }
   }
   if (project.drawings.size() < 2 || project.drawings.size() > 16) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "need 2 to 16 drawings (on the command line or in --project), got ",
-        project.drawings.size()));
+    return absl::InvalidArgumentError(
+        absl::StrCat("need 2 to 16 drawings (on the command line or in --project), got ",
+                     project.drawings.size()));
   }
   return project;
 }
@@ -200,22 +300,28 @@ absl::StatusOr<Project> ResolveProject(const Inputs& inputs) {
 absl::Status RunAnimate(const AnimateOptions& options, const RunContext& ctx) {
   auto project = ResolveProject(options.inputs);
   if (!project.ok()) return project.status();
-  v1::InbetweenParameters* params = project->parameters.mutable_inbetween();
-  if (options.overrides.frames) params->set_frames(*options.overrides.frames);
-  if (options.overrides.method) {
-    auto method = ParseMethod(*options.overrides.method);
-    if (!method.ok()) return method.status();
-    params->set_method(*method);
+  if (options.auto_topology) {
+    absl::Status s =
+        ApplyAutoTopology(&*project, AutoTopologyFile(options.inputs, options.out_dir), ctx.quiet);
+    if (!s.ok()) return s;
   }
+  if (absl::Status s = ApplyInbetweenOverrides(options.overrides, &*project); !s.ok()) return s;
+  const v1::InbetweenParameters* params = &project->parameters.inbetween();
   render::ExportOptions out;
   out.dir = options.out_dir;
-  auto formats = render::ParseFormats(options.formats.value_or(
-      absl::StrJoin(project->output.formats, ",")));
+  auto formats =
+      render::ParseFormats(options.formats.value_or(absl::StrJoin(project->output.formats, ",")));
   if (!formats.ok()) return Annotate(formats.status(), "--format");
   out.formats = *formats;
   out.width = options.width.value_or(project->output.width);
   out.fps = options.fps.value_or(project->output.fps);
-  out.fill = project->output.fill;
+  // An explicit colour (--fill, then output.fill) wins over the drawings' own fills.
+  const std::optional<std::string> fill = options.fill ? options.fill : project->output.fill;
+  if (fill) {
+    if (auto c = render::ParseColor(*fill); !c.ok()) return Annotate(c.status(), "fill");
+    out.fill = *fill;
+  }
+  out.drawing_fills = !fill.has_value();
   out.mesh_overlay = options.mesh_overlay.value_or(project->output.mesh_overlay);
   out.transparent = options.transparent;
 
@@ -236,19 +342,31 @@ absl::Status RunAnimate(const AnimateOptions& options, const RunContext& ctx) {
 
   out.progress = [&](std::string_view stage, int done, int total) {
     if (ctx.progress) {
-      ctx.progress->Update(absl::StrCat("write ", std::string(stage)), total ? double(done) / total : 1.0);
+      ctx.progress->Update(absl::StrCat("write ", std::string(stage)),
+                           total ? double(done) / total : 1.0);
     }
   };
-  absl::Status written = render::ExportFrames(ToFrameSet(*frames), out);
+  render::FrameSet frame_set = ToFrameSet(*frames);
+  {
+    std::vector<std::string> svgs;
+    for (const ProjectDrawing& d : project->drawings) {
+      auto svg = ReadFile(d.file);
+      if (svg.ok()) svgs.push_back(*std::move(svg));
+    }
+    if (svgs.size() == project->drawings.size()) frame_set.fills = DrawingFills(svgs);
+  }
+  absl::Status written = render::ExportFrames(frame_set, out);
   FinishProgress(ctx);
   if (!written.ok()) return written;
 
   uint32_t inverted = 0;
   for (const auto& f : frames->frames) inverted += f.stats().inverted_triangles();
-  std::fprintf(stderr, "%zu frames, %d triangles, %d vertices, %u inverted triangles -> %s\n",
-               frames->frames.size(), frames->header.triangles_size(),
-               frames->frames.empty() ? 0 : frames->frames[0].vertices_size(), inverted,
-               options.out_dir.string().c_str());
+  if (!ctx.quiet) {
+    std::fprintf(stderr, "%zu frames, %d triangles, %d vertices, %u inverted triangles -> %s\n",
+                 frames->frames.size(), frames->header.triangles_size(),
+                 frames->frames.empty() ? 0 : frames->frames[0].vertices_size(), inverted,
+                 options.out_dir.string().c_str());
+  }
   std::printf("%s\n", (options.out_dir / "frames.json").string().c_str());
   return absl::OkStatus();
 }
@@ -256,8 +374,13 @@ absl::Status RunAnimate(const AnimateOptions& options, const RunContext& ctx) {
 absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
   auto project = ResolveProject(options.inputs);
   if (!project.ok()) return project.status();
-  auto session = UploadProject(*project, options.optimize ? "inbetween optimize" : "inbetween mesh",
-                               ctx);
+  if (options.auto_topology) {
+    absl::Status s =
+        ApplyAutoTopology(&*project, AutoTopologyFile(options.inputs, options.out_dir), ctx.quiet);
+    if (!s.ok()) return s;
+  }
+  auto session =
+      UploadProject(*project, options.optimize ? "inbetween optimize" : "inbetween mesh", ctx);
   if (!session.ok()) return session.status();
   auto built = Build(*session, ctx);
   if (!built.ok()) return built.status();
@@ -278,7 +401,8 @@ absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
   std::error_code ec;
   std::filesystem::create_directories(options.out_dir, ec);
   if (ec) return absl::UnavailableError(absl::StrCat("cannot create ", options.out_dir.string()));
-  absl::Status s = WriteText(options.out_dir / "multimesh.json", MultimeshToJson(mesh).dump() + "\n");
+  absl::Status s =
+      WriteText(options.out_dir / "multimesh.json", MultimeshToJson(mesh).dump() + "\n");
   if (!s.ok()) return s;
   const render::FrameSet shapes = ShapesAsFrames(mesh);
   render::SvgFrameOptions svg;
@@ -293,10 +417,12 @@ absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
     if (!s.ok()) return s;
   }
   const auto& stats = built->stats();
-  std::fprintf(stderr, "%u shapes, %d vertices, %d triangles, %zu cohesive edges -> %s\n",
-               stats.shapes(), mesh.shapes_size() ? mesh.shapes(0).vertices_size() : 0,
-               mesh.triangles_size(), static_cast<size_t>(mesh.cohesive_edges_size()),
-               options.out_dir.string().c_str());
+  if (!ctx.quiet) {
+    std::fprintf(stderr, "%u shapes, %d vertices, %d triangles, %zu cohesive edges -> %s\n",
+                 stats.shapes(), mesh.shapes_size() ? mesh.shapes(0).vertices_size() : 0,
+                 mesh.triangles_size(), static_cast<size_t>(mesh.cohesive_edges_size()),
+                 options.out_dir.string().c_str());
+  }
   std::printf("%s\n", (options.out_dir / "multimesh.json").string().c_str());
   return absl::OkStatus();
 }
@@ -317,7 +443,8 @@ absl::Status RunRender(const RenderOptions& options, ProgressBar& progress) {
   out.formats = *formats;
   out.width = options.width;
   out.fps = options.fps;
-  out.fill = options.fill;
+  if (options.fill) out.fill = *options.fill;
+  out.drawing_fills = !options.fill.has_value();
   out.mesh_overlay = options.mesh_overlay;
   out.transparent = options.transparent;
   out.progress = [&](std::string_view stage, int done, int total) {
@@ -360,10 +487,11 @@ absl::Status RunInspect(const std::string& session_id, const RunContext& ctx) {
   }
   if (s.stage() >= v1::STAGE_MULTIMESH) {
     const auto& m = s.multimesh_stats();
-    std::printf("multimesh: %u shapes, %u vertices, %u triangles, map energy %.4f, "
-                "mesh energy %.4f, %u inverted\n",
-                m.shapes(), m.vertices(), m.triangles(), m.map_energy(), m.mesh_energy(),
-                m.inverted_triangles());
+    std::printf(
+        "multimesh: %u shapes, %u vertices, %u triangles, map energy %.4f, "
+        "mesh energy %.4f, %u inverted\n",
+        m.shapes(), m.vertices(), m.triangles(), m.map_energy(), m.mesh_energy(),
+        m.inverted_triangles());
   }
   return absl::OkStatus();
 }
@@ -402,7 +530,9 @@ absl::Status RunValidate(const Inputs& inputs, const RunContext& ctx) {
     // Whether the drawings fit together (same topology, mappable) only the build can tell.
     if (problems.empty() && imported >= 2) {
       auto built = ctx.client->BuildMultimesh(*session, nullptr);
-      if (!built.ok()) problems.push_back(absl::StrCat("build: ", built.status().message()));
+      if (!built.ok()) {
+        problems.push_back(absl::StrCat("build: ", AdviseAutoTopology(built.status()).message()));
+      }
     }
   }
   for (const auto& p : problems) std::printf("%s\n", p.c_str());
@@ -426,12 +556,7 @@ absl::Status RunInit(const Inputs& inputs, const std::filesystem::path& project_
       return absl::NotFoundError(absl::StrCat("cannot open ", d.file.string()));
     }
   }
-  if (overrides.frames) project->parameters.mutable_inbetween()->set_frames(*overrides.frames);
-  if (overrides.method) {
-    auto method = ParseMethod(*overrides.method);
-    if (!method.ok()) return method.status();
-    project->parameters.mutable_inbetween()->set_method(*method);
-  }
+  if (absl::Status s = ApplyInbetweenOverrides(overrides, &*project); !s.ok()) return s;
   const auto base = std::filesystem::absolute(project_out).parent_path();
   for (auto& d : project->drawings) d.file = std::filesystem::absolute(d.file);
   absl::Status s = WriteText(project_out, ProjectToJson(*project, base).dump(2) + "\n");

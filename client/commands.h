@@ -27,12 +27,25 @@ absl::StatusOr<Project> ResolveProject(const Inputs& inputs);
 struct InbetweenOverrides {
   std::optional<uint32_t> frames;
   std::optional<std::string> method;  // linear | alexa | zhu17
+  std::optional<std::string> timing;  // linear | catmull-rom | ease-in-out (or with '_')
+  std::vector<double> ease;           // one per segment, or one for every segment; [0, 1]
+  std::vector<double> key_times;      // one per drawing: first 0, last 1, strictly increasing
+  std::optional<double> lambda, tau, alpha, epsilon, rho, timestep;
+  std::optional<uint32_t> max_iterations;
 };
+
+// Applies the command-line overrides to the project's inbetween parameters (flags win) and
+// settles the key times: --key-times, else the drawings' key_time, go to both
+// InbetweenParameters.key_times and each drawing's key_time. A single --ease value applies to
+// every segment; --ease without --timing means ease-in-out. Errors name the flag
+// ("--key-times: ...") and are INVALID_ARGUMENT.
+absl::Status ApplyInbetweenOverrides(const InbetweenOverrides& overrides, Project* project);
 
 struct RunContext {
   InbetweenClient* client = nullptr;
   ProgressBar* progress = nullptr;
   bool remote = false;  // print the session id so a studio can come back to it
+  bool quiet = false;   // -q: no notes on stderr
 };
 
 struct AnimateOptions {
@@ -43,8 +56,11 @@ struct AnimateOptions {
   std::optional<int> width;
   std::optional<double> fps;
   std::optional<bool> mesh_overlay;
+  std::optional<std::string> fill;  // unset = output.fill, else the drawings' own fills
   bool transparent = false;
   bool optimize = false;  // run comesh optimization before inbetweening
+  // Propose cuts when the drawings' topology differs; written to --project, else OUT/project.json.
+  bool auto_topology = false;
 };
 absl::Status RunAnimate(const AnimateOptions& options, const RunContext& ctx);
 
@@ -52,6 +68,7 @@ struct MeshOptions {
   Inputs inputs;
   std::filesystem::path out_dir;
   bool optimize = false;  // `inbetween optimize`: also run comesh optimization, write report.json
+  bool auto_topology = false;  // as AnimateOptions::auto_topology
 };
 // Writes DIR/multimesh.json and DIR/shape_N.svg (mesh drawn), plus report.json when optimizing.
 absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx);
@@ -62,7 +79,7 @@ struct RenderOptions {
   std::string formats = "svg,json,gif";
   int width = 512;
   double fps = 24;
-  std::string fill = "#3b7dd8";
+  std::optional<std::string> fill;  // unset = frames.json's "fills", else the default colour
   bool mesh_overlay = false;
   bool transparent = false;
 };

@@ -6,8 +6,11 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "client/commands.h"
 #include "client/inbetween_client.h"
@@ -55,6 +58,51 @@ void AddInputs(CLI::App* cmd, inbetween::client::Inputs* inputs) {
       ->check(CLI::ExistingFile);
 }
 
+// The inbetween parameters animate and init accept (docs/cli.md); flags override the project.
+struct InbetweenFlags {
+  std::string timing;
+  std::vector<double> ease, key_times;
+  double lambda = 0, tau = 0, alpha = 0, epsilon = 0, rho = 0, timestep = 0;
+  uint32_t max_iterations = 0;
+};
+
+void AddInbetweenFlags(CLI::App* cmd, InbetweenFlags* f) {
+  cmd->add_option("--timing", f->timing,
+                  "Weights between keys: linear (default) | catmull-rom | ease-in-out");
+  cmd->add_option("--ease", f->ease,
+                  "Ease amount in [0,1] per segment between keys (comma list; one value = every "
+                  "segment); implies --timing ease-in-out")
+      ->delimiter(',');
+  cmd->add_option("--key-times", f->key_times,
+                  "Normalized time of each key, comma list: first 0, last 1, strictly increasing")
+      ->delimiter(',');
+  cmd->add_option("--lambda", f->lambda, "Cohesive stiffness lambda (S-eq.6), default 1");
+  cmd->add_option("--tau", f->tau, "Separation threshold tau (S-eq.6), default 0.1");
+  cmd->add_option("--alpha", f->alpha,
+                  "Shear vs stretch weight alpha in [0,1] (S-eq.7), default 0.5");
+  cmd->add_option("--epsilon", f->epsilon, "Dynamics compliance epsilon (S-eq.28), 0 = none");
+  cmd->add_option("--rho", f->rho, "Density rho (S-eq.28), default 1");
+  cmd->add_option("--timestep", f->timestep, "Timestep h in seconds (S-eq.28), default 1/24");
+  cmd->add_option("--max-iterations", f->max_iterations,
+                  "Local-global iterations per frame, default 20");
+}
+
+// Copies the flags the user gave (and only those) into the overrides.
+void ApplyInbetweenFlags(const CLI::App& cmd, const InbetweenFlags& f,
+                         inbetween::client::InbetweenOverrides* o) {
+  if (cmd.count("--timing")) o->timing = f.timing;
+  o->ease = f.ease;
+  o->key_times = f.key_times;
+  const std::pair<const char*, std::pair<double, std::optional<double>*>> doubles[] = {
+      {"--lambda", {f.lambda, &o->lambda}}, {"--tau", {f.tau, &o->tau}},
+      {"--alpha", {f.alpha, &o->alpha}},    {"--epsilon", {f.epsilon, &o->epsilon}},
+      {"--rho", {f.rho, &o->rho}},          {"--timestep", {f.timestep, &o->timestep}}};
+  for (const auto& [flag, value] : doubles) {
+    if (cmd.count(flag)) *value.second = value.first;
+  }
+  if (cmd.count("--max-iterations")) o->max_iterations = f.max_iterations;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -87,6 +135,8 @@ int main(int argc, char** argv) {
   int width = 0;
   double fps = 0;
   bool overlay = false;
+  std::string fill;
+  InbetweenFlags animate_flags;
   CLI::App* animate_cmd = app.add_subcommand("animate", "Inbetween frames from 2-16 drawings");
   AddInputs(animate_cmd, &animate.inputs);
   animate_cmd->add_option("--out", animate.out_dir, "Output directory")->required();
@@ -101,14 +151,21 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(8, 16384));
   animate_cmd->add_option("--fps", fps, "Frames per second of GIF/WebP/Lottie (default 24)")
       ->check(CLI::Range(0.1, 240.0));
+  AddInbetweenFlags(animate_cmd, &animate_flags);
+  animate_cmd->add_option("--fill", fill,
+                          "Fill colour (#rrggbb) instead of the drawings' own fill colours");
   animate_cmd->add_flag("--mesh", overlay, "Draw the triangle mesh over every frame");
   animate_cmd->add_flag("--transparent", animate.transparent, "Transparent background");
   animate_cmd->add_flag("--optimize", animate.optimize, "Optimize the comesh before inbetweening");
+  animate_cmd->add_flag("--auto-topology", animate.auto_topology,
+                        "When the drawings' topology differs, propose cuts and write them to "
+                        "--project (else OUT/project.json)");
   animate_cmd->footer(
       "Examples:\n"
       "  inbetween animate square.svg hexagon.svg --frames 24 --out out/\n"
       "  inbetween animate --project walk.json --out out/ --format gif,webp,lottie --size 640\n"
       "  inbetween --server 127.0.0.1:50051 animate a.svg b.svg c.svg --out out/ --method alexa\n"
+      "  inbetween animate a.svg b.svg c.svg --out out/ --key-times 0,0.3,1 --tau 0.05\n"
       "Writes OUT/frames.json, OUT/frame_NNNN.svg, OUT/animation.gif ...; prints the path of "
       "frames.json (and the session id when --server is used).");
 
@@ -117,8 +174,12 @@ int main(int argc, char** argv) {
   CLI::App* mesh_cmd = app.add_subcommand("mesh", "Build the multimesh of 2-16 drawings");
   AddInputs(mesh_cmd, &mesh.inputs);
   mesh_cmd->add_option("--out", mesh.out_dir, "Output directory")->required();
+  mesh_cmd->add_flag("--auto-topology", mesh.auto_topology,
+                     "Propose cuts when the topology differs (see animate)");
   mesh_cmd->footer(
       "Examples:\n  inbetween mesh mouth_closed.svg mouth_open.svg --out mesh/\n"
+      "  inbetween mesh disc.svg ring.svg --out mesh/ --auto-topology   (writes "
+      "mesh/project.json)\n"
       "Writes OUT/multimesh.json and OUT/shape_N.svg (each shape with its mesh).");
   inbetween::client::MeshOptions optimize;
   optimize.optimize = true;
@@ -126,6 +187,8 @@ int main(int argc, char** argv) {
       app.add_subcommand("optimize", "Build and optimize the multimesh (comesh optimization)");
   AddInputs(optimize_cmd, &optimize.inputs);
   optimize_cmd->add_option("--out", optimize.out_dir, "Output directory")->required();
+  optimize_cmd->add_flag("--auto-topology", optimize.auto_topology,
+                         "Propose cuts when the topology differs (see animate)");
   optimize_cmd->footer(
       "Examples:\n  inbetween optimize square.svg hexagon.svg --out mesh/\n"
       "Writes OUT/multimesh.json, OUT/shape_N.svg and OUT/report.json.");
@@ -143,7 +206,10 @@ int main(int argc, char** argv) {
       ->default_val(512)
       ->check(CLI::Range(8, 16384));
   render_cmd->add_option("--fps", render.fps, "Frames per second")->default_val(24);
-  render_cmd->add_option("--fill", render.fill, "Fill colour (#rrggbb)")->default_val("#3b7dd8");
+  std::string render_fill;
+  render_cmd->add_option("--fill", render_fill,
+                         "Fill colour (#rrggbb); default: the drawings' fills in frames.json, else "
+                         "#3b7dd8");
   render_cmd->add_flag("--mesh", render.mesh_overlay, "Draw the triangle mesh");
   render_cmd->add_flag("--transparent", render.transparent, "Transparent background");
   render_cmd->footer("Examples:\n  inbetween render out/frames.json --out out/ --format png,gif");
@@ -162,8 +228,9 @@ int main(int argc, char** argv) {
   CLI::App* validate_cmd =
       app.add_subcommand("validate", "Check drawings and a project file; report every problem");
   AddInputs(validate_cmd, &validate);
-  validate_cmd->footer("Examples:\n  inbetween validate --project walk.json\n"
-                       "  inbetween validate a.svg b.svg");
+  validate_cmd->footer(
+      "Examples:\n  inbetween validate --project walk.json\n"
+      "  inbetween validate a.svg b.svg");
 
   // init
   inbetween::client::Inputs init;
@@ -177,11 +244,13 @@ int main(int argc, char** argv) {
   init_cmd->add_option("--frames", frames, "Frames including the keys");
   init_cmd->add_option("--method", method, "zhu17 | alexa | linear")
       ->check(CLI::IsMember({"linear", "alexa", "zhu17"}));
+  InbetweenFlags init_flags;
+  AddInbetweenFlags(init_cmd, &init_flags);
   init_cmd->add_flag("--force", force, "Overwrite an existing file");
   init_cmd->footer("Examples:\n  inbetween init pose*.svg -o walk.json --frames 48");
 
-  for (CLI::App* cmd : {animate_cmd, mesh_cmd, optimize_cmd, render_cmd, inspect_cmd,
-                        validate_cmd, init_cmd}) {
+  for (CLI::App* cmd :
+       {animate_cmd, mesh_cmd, optimize_cmd, render_cmd, inspect_cmd, validate_cmd, init_cmd}) {
     cmd->fallthrough();  // global options may also follow the subcommand
   }
 
@@ -204,8 +273,14 @@ int main(int argc, char** argv) {
     if (!status.ok()) std::fprintf(stderr, "error: %s\n", std::string(status.message()).c_str());
     return ExitCodeFor(status);
   };
-  if (*render_cmd) return report(inbetween::client::RunRender(render, bar));
-  if (*init_cmd) return report(inbetween::client::RunInit(init, init_out, overrides, force));
+  if (*render_cmd) {
+    if (render_cmd->count("--fill")) render.fill = render_fill;
+    return report(inbetween::client::RunRender(render, bar));
+  }
+  if (*init_cmd) {
+    ApplyInbetweenFlags(*init_cmd, init_flags, &overrides);
+    return report(inbetween::client::RunInit(init, init_out, overrides, force));
+  }
 
   std::unique_ptr<inbetween::server::InbetweenServer> embedded;
   std::shared_ptr<grpc::Channel> channel;
@@ -226,11 +301,13 @@ int main(int argc, char** argv) {
   inbetween::client::InbetweenClient client(channel, {.token = token});
   StartSignalThread(&client);
   const inbetween::client::RunContext ctx{
-      .client = &client, .progress = &bar, .remote = !server.empty()};
+      .client = &client, .progress = &bar, .remote = !server.empty(), .quiet = quiet};
   absl::Status status;
   if (*animate_cmd) {
     if (!animate.inputs.project.empty() || !animate.inputs.drawings.empty()) {
+      ApplyInbetweenFlags(*animate_cmd, animate_flags, &overrides);
       animate.overrides = overrides;
+      if (animate_cmd->count("--fill")) animate.fill = fill;
       if (!formats.empty()) animate.formats = formats;
       if (width != 0) animate.width = width;
       if (fps != 0) animate.fps = fps;

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "client/render/color.h"
 
 namespace inbetween::client {
 namespace {
@@ -34,8 +35,8 @@ class Node {
     std::set<std::string> allowed(known.begin(), known.end());
     for (const auto& [key, unused] : value_.items()) {
       if (allowed.count(key) == 0) {
-        return absl::InvalidArgumentError(absl::StrCat(path_, ".", key, ": unknown field (known: ",
-                                                       absl::StrJoin(allowed, ", "), ")"));
+        return absl::InvalidArgumentError(absl::StrCat(
+            path_, ".", key, ": unknown field (known: ", absl::StrJoin(allowed, ", "), ")"));
       }
     }
     return absl::OkStatus();
@@ -68,7 +69,9 @@ class Node {
     if (!value_.is_boolean()) return TypeError("a boolean");
     return value_.get<bool>();
   }
-  absl::Status Array() const { return value_.is_array() ? absl::OkStatus() : TypeError("an array"); }
+  absl::Status Array() const {
+    return value_.is_array() ? absl::OkStatus() : TypeError("an array");
+  }
 
   absl::StatusOr<XY> Point() const {
     if (!value_.is_array() || value_.size() != 2) return TypeError("a point [x, y]");
@@ -99,8 +102,8 @@ class Node {
   std::string path_;
 };
 
-#define PROJECT_ASSIGN_OR_RETURN(lhs, expr) \
-  auto lhs##_or = (expr);                   \
+#define PROJECT_ASSIGN_OR_RETURN(lhs, expr)     \
+  auto lhs##_or = (expr);                       \
   if (!lhs##_or.ok()) return lhs##_or.status(); \
   auto lhs = *std::move(lhs##_or)
 
@@ -191,17 +194,15 @@ absl::StatusOr<v1::Method> MethodFromName(const Node& node) {
 
 absl::StatusOr<v1::TimingCurve> CurveFromName(const Node& node) {
   PROJECT_ASSIGN_OR_RETURN(name, node.String());
-  if (name == "linear") return v1::TIMING_CURVE_LINEAR;
-  if (name == "catmull_rom") return v1::TIMING_CURVE_CATMULL_ROM;
-  if (name == "ease_in_out") return v1::TIMING_CURVE_EASE_IN_OUT;
-  return node.Error(absl::StrCat("unknown timing curve '", name,
-                                 "' (linear, catmull_rom, ease_in_out)"));
+  if (auto curve = TimingCurveFromName(name)) return *curve;
+  return node.Error(
+      absl::StrCat("unknown timing curve '", name, "' (linear, catmull_rom, ease_in_out)"));
 }
 
 absl::Status ParseInbetween(const Node& node, v1::InbetweenParameters* out) {
-  if (absl::Status s = node.CheckKeys({"method", "frames", "timing", "ease", "stiffness", "lambda",
-                                       "tau", "alpha", "epsilon", "rho", "timestep",
-                                       "max_iterations"});
+  if (absl::Status s =
+          node.CheckKeys({"method", "frames", "timing", "ease", "stiffness", "lambda", "tau",
+                          "alpha", "epsilon", "rho", "timestep", "max_iterations"});
       !s.ok()) {
     return s;
   }
@@ -250,12 +251,13 @@ absl::Status ParseInbetween(const Node& node, v1::InbetweenParameters* out) {
     double min, max;
     void (v1::InbetweenParameters::*set)(double);
   };
-  for (const Bounded& b : {Bounded{"lambda", 0.0, 1e9, &v1::InbetweenParameters::set_lambda},
-                           Bounded{"tau", 0.0, 1e9, &v1::InbetweenParameters::set_tau},
-                           Bounded{"alpha", 0.0, 1.0, &v1::InbetweenParameters::set_alpha},
-                           Bounded{"epsilon", 0.0, 1e6, &v1::InbetweenParameters::set_epsilon},
-                           Bounded{"rho", 1e-9, 1e9, &v1::InbetweenParameters::set_rho},
-                           Bounded{"timestep", 1e-9, 10.0, &v1::InbetweenParameters::set_timestep}}) {
+  for (const Bounded& b :
+       {Bounded{"lambda", 0.0, 1e9, &v1::InbetweenParameters::set_lambda},
+        Bounded{"tau", 0.0, 1e9, &v1::InbetweenParameters::set_tau},
+        Bounded{"alpha", 0.0, 1.0, &v1::InbetweenParameters::set_alpha},
+        Bounded{"epsilon", 0.0, 1e6, &v1::InbetweenParameters::set_epsilon},
+        Bounded{"rho", 1e-9, 1e9, &v1::InbetweenParameters::set_rho},
+        Bounded{"timestep", 1e-9, 10.0, &v1::InbetweenParameters::set_timestep}}) {
     if (!node.Has(b.key)) continue;
     PROJECT_ASSIGN_OR_RETURN(v, node.Child(b.key).Number(b.min, b.max));
     (out->*b.set)(v);
@@ -291,6 +293,8 @@ absl::Status ParseOutput(const Node& node, OutputSettings* out) {
   }
   if (node.Has("fill")) {
     PROJECT_ASSIGN_OR_RETURN(v, node.Child("fill").String());
+    if (auto c = render::ParseColor(v); !c.ok())
+      return node.Child("fill").Error(std::string(c.status().message()));
     out->fill = v;
   }
   if (node.Has("mesh_overlay")) {
@@ -310,8 +314,8 @@ json PolylinesToJson(const std::vector<XYs>& lines) {
 
 absl::StatusOr<Project> ParseProject(const json& doc, const std::filesystem::path& base_dir) {
   Node root(doc, "$");
-  if (absl::Status s = root.CheckKeys({"version", "drawings", "correspondences", "meshing",
-                                       "comesh", "inbetween", "output"});
+  if (absl::Status s = root.CheckKeys(
+          {"version", "drawings", "correspondences", "meshing", "comesh", "inbetween", "output"});
       !s.ok()) {
     return s;
   }
@@ -319,21 +323,34 @@ absl::StatusOr<Project> ParseProject(const json& doc, const std::filesystem::pat
   if (!root.Has("version")) return root.Error("missing field 'version' (use 1)");
   PROJECT_ASSIGN_OR_RETURN(version, root.Child("version").Integer(1, 1000));
   if (version != kProjectFileVersion) {
-    return root.Child("version").Error(
-        absl::StrCat("unsupported version ", version, " (this tool reads version ",
-                     kProjectFileVersion, ")"));
+    return root.Child("version").Error(absl::StrCat(
+        "unsupported version ", version, " (this tool reads version ", kProjectFileVersion, ")"));
   }
   if (!root.Has("drawings")) return root.Error("missing field 'drawings'");
   Node drawings = root.Child("drawings");
   if (absl::Status s = drawings.Array(); !s.ok()) return s;
   if (drawings.value().size() < 2 || drawings.value().size() > 16) {
-    return drawings.Error(
-        absl::StrCat("needs 2 to 16 drawings, has ", drawings.value().size()));
+    return drawings.Error(absl::StrCat("needs 2 to 16 drawings, has ", drawings.value().size()));
   }
   for (size_t i = 0; i < drawings.value().size(); ++i) {
     ProjectDrawing d;
     if (absl::Status s = ParseDrawing(drawings.Item(i), base_dir, &d); !s.ok()) return s;
     project.drawings.push_back(std::move(d));
+  }
+  size_t with_key_time = 0;
+  std::vector<double> key_times;
+  for (const ProjectDrawing& d : project.drawings) {
+    if (d.key_time) ++with_key_time, key_times.push_back(*d.key_time);
+  }
+  if (with_key_time != 0) {
+    if (with_key_time != project.drawings.size()) {
+      return drawings.Error(absl::StrCat("key_time is set on ", with_key_time, " of ",
+                                         project.drawings.size(),
+                                         " drawings: set it on every drawing or on none"));
+    }
+    if (absl::Status s = CheckKeyTimes(key_times, project.drawings.size()); !s.ok()) {
+      return drawings.Error(absl::StrCat("key_time: ", s.message()));
+    }
   }
   if (root.Has("correspondences")) {
     Node marks = root.Child("correspondences");
@@ -342,8 +359,7 @@ absl::StatusOr<Project> ParseProject(const json& doc, const std::filesystem::pat
       PROJECT_ASSIGN_OR_RETURN(points, marks.Item(i).Polyline(project.drawings.size()));
       if (points.size() != project.drawings.size()) {
         return marks.Item(i).Error(absl::StrCat("needs one point per drawing (",
-                                                project.drawings.size(), "), has ",
-                                                points.size()));
+                                                project.drawings.size(), "), has ", points.size()));
       }
       project.correspondences.push_back(std::move(points));
     }
@@ -365,6 +381,37 @@ absl::StatusOr<Project> ParseProject(const json& doc, const std::filesystem::pat
     if (absl::Status s = ParseOutput(root.Child("output"), &project.output); !s.ok()) return s;
   }
   return project;
+}
+
+std::optional<v1::TimingCurve> TimingCurveFromName(std::string_view name) {
+  if (name == "linear") return v1::TIMING_CURVE_LINEAR;
+  if (name == "catmull_rom" || name == "catmull-rom") return v1::TIMING_CURVE_CATMULL_ROM;
+  if (name == "ease_in_out" || name == "ease-in-out") return v1::TIMING_CURVE_EASE_IN_OUT;
+  return std::nullopt;
+}
+
+absl::Status CheckKeyTimes(const std::vector<double>& key_times, size_t drawings) {
+  if (key_times.size() != drawings) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("needs one time per drawing (", drawings, "), has ", key_times.size()));
+  }
+  for (size_t i = 0; i < key_times.size(); ++i) {
+    const double t = key_times[i];
+    if (!std::isfinite(t) || t < 0 || t > 1) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("time ", t, " of drawing ", i + 1, " is not in [0, 1]"));
+    }
+    if (i > 0 && !(t > key_times[i - 1])) {
+      return absl::InvalidArgumentError(absl::StrCat("times must increase strictly: drawing ",
+                                                     i + 1, " has ", t, " after ",
+                                                     key_times[i - 1]));
+    }
+  }
+  if (key_times.front() != 0.0 || key_times.back() != 1.0) {
+    return absl::InvalidArgumentError(absl::StrCat("the first time must be 0 and the last 1, got ",
+                                                   key_times.front(), " and ", key_times.back()));
+  }
+  return absl::OkStatus();
 }
 
 absl::StatusOr<Project> LoadProject(const std::filesystem::path& path) {
@@ -438,8 +485,8 @@ json ProjectToJson(const Project& project, const std::filesystem::path& base_dir
   doc["output"] = {{"formats", project.output.formats},
                    {"width", project.output.width},
                    {"fps", project.output.fps},
-                   {"fill", project.output.fill},
                    {"mesh_overlay", project.output.mesh_overlay}};
+  if (project.output.fill) doc["output"]["fill"] = *project.output.fill;
   return doc;
 }
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -28,9 +29,9 @@ struct ProjectDrawing {
 
 struct OutputSettings {
   std::vector<std::string> formats = {"svg", "json", "gif"};
-  int width = 512;      // raster width in pixels
-  double fps = 24.0;    // animation rate for GIF/WebP/Lottie
-  std::string fill = "#3b7dd8";
+  int width = 512;                  // raster width in pixels
+  double fps = 24.0;                // animation rate for GIF/WebP/Lottie
+  std::optional<std::string> fill;  // unset = the drawings' own fill colours, else the default
   bool mesh_overlay = false;
 };
 
@@ -47,6 +48,13 @@ struct Project {
 // resolved against `base_dir`.
 absl::StatusOr<Project> ParseProject(const nlohmann::json& doc,
                                      const std::filesystem::path& base_dir);
+
+// "linear", "catmull-rom" / "catmull_rom", "ease-in-out" / "ease_in_out"; nullopt otherwise.
+std::optional<v1::TimingCurve> TimingCurveFromName(std::string_view name);
+
+// Key times for `drawings` drawings: one each, first 0, last 1, strictly increasing. The error
+// message says what is wrong (without naming where the list came from).
+absl::Status CheckKeyTimes(const std::vector<double>& key_times, size_t drawings);
 
 // Reads and parses a project file; errors start with the file name.
 absl::StatusOr<Project> LoadProject(const std::filesystem::path& path);

@@ -38,6 +38,7 @@ absl::StatusOr<RgbaImage> RenderContactSheet(const FrameSet& frames,
   absl::StatusOr<FrameRasterizer> raster =
       FrameRasterizer::Create(frames, {.width = options.cell_width,
                                        .fill = options.fill,
+                                       .drawing_fills = options.drawing_fills,
                                        .mesh_overlay = options.mesh_overlay,
                                        .transparent = false});
   if (!raster.ok()) return raster.status();

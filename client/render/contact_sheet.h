@@ -17,6 +17,7 @@ struct ContactSheetOptions {
   int columns = 4;       // at most; fewer when there are fewer cells
   int inbetweens = 6;    // evenly spaced non-key frames added to the keys
   std::string fill = "#3b7dd8";
+  bool drawing_fills = true;  // FrameSet::fills (blended per frame) win over `fill` when present
   bool mesh_overlay = false;
 };
 

@@ -62,6 +62,7 @@ ContactSheetOptions SheetOptions(const ExportOptions& options) {
           .columns = 4,
           .inbetweens = 6,
           .fill = options.fill,
+          .drawing_fills = options.drawing_fills,
           .mesh_overlay = options.mesh_overlay};
 }
 
@@ -175,6 +176,7 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
     absl::StatusOr<FrameRasterizer> r =
         FrameRasterizer::Create(frames, {.width = options.width,
                                          .fill = options.fill,
+                                         .drawing_fills = options.drawing_fills,
                                          .mesh_overlay = options.mesh_overlay,
                                          .transparent = options.transparent});
     if (!r.ok()) return r.status();
@@ -186,7 +188,17 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
                               .transparent = options.transparent,
                               .palette_colors = {}};
     if (!options.transparent) gif_options.palette_colors.push_back(raster->background());
-    gif_options.palette_colors.push_back(*fill);
+    if (options.drawing_fills && !frames.fills.empty()) {
+      // Blends of two key fills lie on the ramp between them, which the palette holds.
+      for (const Rgba8& c : frames.fills) {
+        if (std::find(gif_options.palette_colors.begin(), gif_options.palette_colors.end(), c) ==
+            gif_options.palette_colors.end()) {
+          gif_options.palette_colors.push_back(c);
+        }
+      }
+    } else {
+      gif_options.palette_colors.push_back(*fill);
+    }
     if (options.mesh_overlay) gif_options.palette_colors.push_back(kMeshOverlayColor);
     absl::StatusOr<GifEncoder> e =
         GifEncoder::Create(raster->width(), raster->height(), std::move(gif_options));
@@ -203,7 +215,10 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
   std::string lottie;
   if (wants("lottie")) {
     absl::StatusOr<nlohmann::json> doc =
-        LottieAnimation(frames, {.width = options.width, .fps = options.fps, .fill = options.fill});
+        LottieAnimation(frames, {.width = options.width,
+                                 .fps = options.fps,
+                                 .fill = options.fill,
+                                 .drawing_fills = options.drawing_fills});
     if (!doc.ok()) return doc.status();
     lottie = doc->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   }
@@ -230,8 +245,10 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
     progress("json", 1, 1);
   }
   if (wants("svg")) {
-    if (absl::Status s = WriteSvgFrames(
-            out, frames, {.fill = options.fill, .mesh_overlay = options.mesh_overlay});
+    if (absl::Status s = WriteSvgFrames(out, frames,
+                                        {.fill = options.fill,
+                                         .drawing_fills = options.drawing_fills,
+                                         .mesh_overlay = options.mesh_overlay});
         !s.ok()) {
       return s;
     }

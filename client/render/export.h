@@ -28,10 +28,12 @@ struct ExportOptions {
   int width = 512;               // raster and Lottie width in px; height from the aspect ratio
   double fps = 24;               // GIF, WebP and Lottie frame rate
   std::string fill = "#3b7dd8";  // shape colour, #rgb / #rrggbb (see ParseColor)
-  bool mesh_overlay = false;     // triangle edges on SVG, PNG, GIF, WebP and contact sheet
-  bool transparent = false;      // PNG, GIF (1-bit) and WebP background; else white
-  bool webp_lossless = true;     // else lossy at webp_quality
-  float webp_quality = 80;       // 0..100
+  // The drawings' own fills (FrameSet::fills, blended per frame) instead of `fill` when present.
+  bool drawing_fills = true;
+  bool mesh_overlay = false;  // triangle edges on SVG, PNG, GIF, WebP and contact sheet
+  bool transparent = false;   // PNG, GIF (1-bit) and WebP background; else white
+  bool webp_lossless = true;  // else lossy at webp_quality
+  float webp_quality = 80;    // 0..100
   // Called as work completes: a stage name ("frames", "gif", "webp", "lottie", "contact",
   // "svg", "json"), and done out of total steps of that stage.
   std::function<void(std::string_view stage, int done, int total)> progress;

@@ -1,6 +1,7 @@
 // frames.json <-> FrameSet (see frame_set.h).
 #include "client/render/frame_set.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -132,6 +133,17 @@ absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc) {
       }
     }
   }
+  if (doc.contains("fills")) {  // optional (added field): one colour per key drawing
+    const auto& fills = doc["fills"];
+    if (!fills.is_array()) return PathError("fills", "expected an array of colours");
+    for (size_t i = 0; i < fills.size(); ++i) {
+      const std::string fp = absl::StrCat("fills[", i, "]");
+      if (!fills[i].is_string()) return PathError(fp, "expected a colour string");
+      absl::StatusOr<Rgba8> c = ParseColor(fills[i].get<std::string>());
+      if (!c.ok()) return PathError(fp, std::string(c.status().message()));
+      out.fills.push_back(*c);
+    }
+  }
   return out;
 }
 
@@ -143,7 +155,33 @@ nlohmann::json FrameSetToJson(const FrameSet& frames) {
     out_frames.push_back(
         {{"index", f.index}, {"time", f.time}, {"weights", f.weights}, {"vertices", f.vertices}});
   }
-  return {{"triangles", frames.triangles}, {"keys", frames.keys}, {"frames", out_frames}};
+  nlohmann::json doc = {
+      {"triangles", frames.triangles}, {"keys", frames.keys}, {"frames", out_frames}};
+  if (!frames.fills.empty()) {
+    std::vector<std::string> fills;
+    for (const Rgba8& c : frames.fills) fills.push_back(HexColor(c));
+    doc["fills"] = fills;
+  }
+  return doc;
+}
+
+std::optional<Rgba8> FrameFill(const FrameSet& frames, size_t f) {
+  if (frames.fills.empty()) return std::nullopt;
+  if (f >= frames.frames.size()) return frames.fills[0];
+  const std::vector<double>& w = frames.frames[f].weights;
+  if (w.size() != frames.fills.size()) return frames.fills[0];
+  // Blend in sRGB like the shapes blend: weights sum to 1 (Catmull-Rom ones may be negative).
+  double r = 0, g = 0, b = 0, a = 0;
+  for (size_t i = 0; i < w.size(); ++i) {
+    r += w[i] * frames.fills[i].r;
+    g += w[i] * frames.fills[i].g;
+    b += w[i] * frames.fills[i].b;
+    a += w[i] * frames.fills[i].a;
+  }
+  const auto channel = [](double v) {
+    return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
+  };
+  return Rgba8{channel(r), channel(g), channel(b), channel(a)};
 }
 
 }  // namespace inbetween::render

@@ -2,11 +2,13 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "client/render/color.h"
 #include "nlohmann/json.hpp"
 
 namespace inbetween::render {
@@ -24,7 +26,13 @@ struct FrameSet {
   std::vector<std::array<int, 3>> triangles;  // shared by every frame
   std::vector<int> keys;                      // frame index of each key drawing
   std::vector<FrameData> frames;
+  // Fill colour of each key drawing (input order) as the drawings gave it; empty = none known.
+  std::vector<Rgba8> fills;
 };
+
+// The fill of frame `f`: the key drawings' fills blended by the frame's example weights (clamped
+// to [0, 255]; the first fill when the weights do not match), or nullopt without fills.
+std::optional<Rgba8> FrameFill(const FrameSet& frames, size_t f);
 
 // Parses a frames.json document (docs/file-formats.md). Errors name the JSON path
 // ("frames[3].vertices[10]: expected [x, y]").

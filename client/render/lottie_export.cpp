@@ -4,6 +4,7 @@
 // next keyframe, so "v" is 5.7.
 #include "client/render/lottie_export.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -78,9 +79,33 @@ absl::StatusOr<json> LottieAnimation(const FrameSet& frames, const LottieOptions
     json ks = count == 1 ? Static(keyframes[0]["s"][0]) : json{{"a", 1}, {"k", keyframes}};
     items.push_back({{"ty", "sh"}, {"nm", absl::StrCat("Loop ", l + 1)}, {"ks", std::move(ks)}});
   }
+  const auto rgba = [](const Rgba8& c) {
+    return json::array({c.r / 255.0, c.g / 255.0, c.b / 255.0, 1});
+  };
+  json color = Static(rgba(*fill));
+  if (options.drawing_fills && !frames.fills.empty()) {
+    std::vector<Rgba8> per_frame;
+    for (int f = 0; f < count; ++f) per_frame.push_back(*FrameFill(frames, f));
+    const bool constant = std::all_of(per_frame.begin(), per_frame.end(),
+                                      [&](const Rgba8& c) { return c == per_frame[0]; });
+    if (constant) {
+      color = Static(rgba(per_frame[0]));
+    } else {
+      json keyframes = json::array();
+      for (int f = 0; f < count; ++f) {
+        json key = {{"t", f}, {"s", rgba(per_frame[f])}};
+        if (f + 1 < count) {
+          key["o"] = {{"x", 0}, {"y", 0}};
+          key["i"] = {{"x", 1}, {"y", 1}};
+        }
+        keyframes.push_back(std::move(key));
+      }
+      color = {{"a", 1}, {"k", std::move(keyframes)}};
+    }
+  }
   items.push_back({{"ty", "fl"},
                    {"nm", "Fill"},
-                   {"c", Static({fill->r / 255.0, fill->g / 255.0, fill->b / 255.0, 1})},
+                   {"c", std::move(color)},
                    {"o", Static(100 * fill->a / 255.0)},
                    {"r", 1}});  // nonzero: holes wind the other way
   items.push_back(GroupTransform());

@@ -16,6 +16,9 @@ struct LottieOptions {
   int width = 512;               // composition width "w"; "h" follows the frames' aspect ratio
   double fps = 24;               // "fr"; frame i of the set is Lottie frame i
   std::string fill = "#3b7dd8";  // fill colour (see ParseColor); the background is transparent
+  // FrameSet::fills instead of `fill` when present: a static colour when every frame has the same,
+  // else the colour animated with one keyframe per frame.
+  bool drawing_fills = true;
   std::string name = "inbetween";
 };
 

@@ -26,6 +26,10 @@ absl::StatusOr<FrameRasterizer> FrameRasterizer::Create(const FrameSet& frames,
   absl::StatusOr<Rgba8> fill = ParseColor(options.fill);
   if (!fill.ok()) return fill.status();
   r.fill_ = *fill;
+  if (options.drawing_fills && !frames.fills.empty()) {
+    for (size_t f = 0; f < frames.frames.size(); ++f)
+      r.frame_fills_.push_back(*FrameFill(frames, f));
+  }
   r.background_ = options.transparent ? Rgba8{255, 255, 255, 0} : Rgba8{255, 255, 255, 255};
   absl::StatusOr<std::vector<Loop>> loops = BoundaryLoops(frames.triangles);
   if (!loops.ok()) return loops.status();
@@ -41,6 +45,10 @@ absl::StatusOr<FrameRasterizer> FrameRasterizer::Create(const FrameSet& frames,
   }
   r.options_ = std::move(options);
   return r;
+}
+
+Rgba8 FrameRasterizer::FillOf(size_t f) const {
+  return f < frame_fills_.size() ? frame_fills_[f] : fill_;
 }
 
 RgbaImage FrameRasterizer::Render(size_t f) const {
@@ -65,7 +73,7 @@ RgbaImage FrameRasterizer::Render(size_t f) const {
     }
     cairo_close_path(cr.get());
   }
-  SetSource(cr.get(), fill_);
+  SetSource(cr.get(), FillOf(f));
   cairo_fill(cr.get());
   if (!edges_.empty()) {
     for (const auto& [a, b] : edges_) {

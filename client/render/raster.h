@@ -20,6 +20,7 @@ namespace inbetween::render {
 struct RasterOptions {
   int width = 512;               // output width in pixels; the height follows the aspect ratio
   std::string fill = "#3b7dd8";  // shape colour (see ParseColor)
+  bool drawing_fills = true;     // FrameSet::fills (blended per frame) win over `fill` when present
   bool mesh_overlay = false;     // draw the triangle edges on top
   bool transparent = false;      // transparent instead of white background
 };
@@ -41,6 +42,8 @@ class FrameRasterizer {
   int width() const { return viewport_.width; }
   int height() const { return viewport_.height; }
   Rgba8 fill() const { return fill_; }
+  // The colour frame `f` is filled with (`fill`, or the drawings' fills blended).
+  Rgba8 FillOf(size_t f) const;
   Rgba8 background() const { return background_; }
   const RasterOptions& options() const { return options_; }
 
@@ -51,6 +54,7 @@ class FrameRasterizer {
   RasterOptions options_;
   Viewport viewport_;
   Rgba8 fill_;
+  std::vector<Rgba8> frame_fills_;  // per frame when the drawings' fills are used, else empty
   Rgba8 background_;
   std::vector<Loop> loops_;
   std::vector<std::pair<int, int>> edges_;  // unique triangle edges, for the overlay

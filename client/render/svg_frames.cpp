@@ -1,6 +1,7 @@
 // SVG frame export (see svg_frames.h): the shape as its boundary outline, the mesh optional.
 #include "client/render/svg_frames.h"
 
+#include <optional>
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
@@ -17,6 +18,8 @@ std::string FrameSvg(const FrameSet& frames, size_t f, const SvgFrameOptions& op
   const double seam = 0.002 * b.extent();
   const FrameData& frame = frames.frames[f];
   const auto& v = frame.vertices;
+  std::optional<Rgba8> own = options.drawing_fills ? FrameFill(frames, f) : std::nullopt;
+  const std::string fill = own ? HexColor(*own) : options.fill;
   std::ostringstream triangles;
   for (const auto& t : frames.triangles) {
     triangles << absl::StrFormat("M%.6g %.6gL%.6g %.6gL%.6g %.6gZ", v[t[0]][0], v[t[0]][1],
@@ -39,12 +42,11 @@ std::string FrameSvg(const FrameSet& frames, size_t f, const SvgFrameOptions& op
       }
       outline << "Z";
     }
-    absl::StrAppend(&svg, "<path fill=\"", options.fill, "\" fill-rule=\"nonzero\" d=\"",
-                    outline.str(), "\"/>\n");
-  } else {
-    absl::StrAppend(&svg, "<path fill=\"", options.fill, "\" stroke=\"", options.fill,
-                    "\" stroke-width=\"", absl::StrFormat("%.6g", seam), "\" d=\"", triangles.str(),
+    absl::StrAppend(&svg, "<path fill=\"", fill, "\" fill-rule=\"nonzero\" d=\"", outline.str(),
                     "\"/>\n");
+  } else {
+    absl::StrAppend(&svg, "<path fill=\"", fill, "\" stroke=\"", fill, "\" stroke-width=\"",
+                    absl::StrFormat("%.6g", seam), "\" d=\"", triangles.str(), "\"/>\n");
   }
   if (options.mesh_overlay) {
     absl::StrAppend(&svg, "<path fill=\"none\" stroke=\"#222\" stroke-width=\"",

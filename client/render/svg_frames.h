@@ -12,6 +12,7 @@ namespace inbetween::render {
 
 struct SvgFrameOptions {
   std::string fill = "#3b7dd8";
+  bool drawing_fills = true;  // FrameSet::fills (blended per frame) win over `fill` when present
   bool mesh_overlay = false;  // draw triangle edges on top
 };
 

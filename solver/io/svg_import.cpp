@@ -105,6 +105,9 @@ struct Collector {
   std::vector<Outline> outlines;
   std::vector<Points> cuts, openings;     // from class="cut" / class="opening" elements
   std::vector<CorrespondenceMark> marks;  // from data-corr="N" elements
+  // The explicit fill of the filled element with the largest outline (SvgImportInfo::fill_rgb).
+  double largest_area = 0;
+  std::optional<uint32_t> largest_fill;
 };
 
 // The value of attribute `name`, or nullopt.
@@ -156,6 +159,7 @@ class Context {
         node_(node),
         ctm_(parent.ctm_),
         filled_(parent.filled_),
+        fill_rgb_(parent.fill_rgb_),
         evenodd_(parent.evenodd_) {}
 
   // Transform (SVG++ composes the attribute's list into one matrix [a b c d e f]).
@@ -169,11 +173,20 @@ class Context {
     ctm_ = composed;
   }
 
-  // Paint: only "none" matters; any colour, paint server or currentColor fills.
-  void set(sv::tag::attribute::fill, sv::tag::value::none) { filled_ = false; }
+  // Paint: "none" does not fill; any colour, paint server or currentColor fills. A plain colour
+  // (SVG++'s integer colour 0xRRGGBB) is kept for renderers.
+  void set(sv::tag::attribute::fill, sv::tag::value::none) {
+    filled_ = false;
+    fill_rgb_.reset();
+  }
+  void set(sv::tag::attribute::fill, int rgb) {
+    filled_ = true;
+    fill_rgb_ = static_cast<uint32_t>(rgb) & 0xffffffu;
+  }
   template <class... Args>
   void set(sv::tag::attribute::fill, Args&&...) {
     filled_ = true;
+    fill_rgb_.reset();
   }
   // fill-rule (inherited; SVG's initial value is nonzero).
   void set(sv::tag::attribute::fill_rule, sv::tag::value::nonzero) { evenodd_ = false; }
@@ -248,7 +261,14 @@ class Context {
     std::vector<Outline> outlines;
     for (const Subpath& subpath : subpaths_) Emit(subpath, &outlines);
     if (!evenodd_) DropNonzeroInnerBoundaries(&outlines);
-    for (Outline& o : outlines) collector_->outlines.push_back(std::move(o));
+    for (Outline& o : outlines) {
+      const double area = std::abs(PolygonSignedArea(o.points));
+      if (area > collector_->largest_area) {
+        collector_->largest_area = area;
+        collector_->largest_fill = fill_rgb_;
+      }
+      collector_->outlines.push_back(std::move(o));
+    }
   }
 
  private:
@@ -345,8 +365,9 @@ class Context {
   Collector* collector_;
   xmlNode* node_;
   Affine ctm_;
-  bool filled_ = true;    // SVG's initial fill is black
-  bool evenodd_ = false;  // SVG's initial fill-rule is nonzero
+  bool filled_ = true;                // SVG's initial fill is black
+  std::optional<uint32_t> fill_rgb_;  // the fill when given as a plain colour
+  bool evenodd_ = false;              // SVG's initial fill-rule is nonzero
   std::vector<Subpath> subpaths_;
   Point pen_ = Point::Zero();
   bool open_ = false;
@@ -547,7 +568,8 @@ std::optional<UseError> ExpandUses(xmlDoc* doc, xmlNode* root) {
 
 }  // namespace
 
-absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOptions& options) {
+absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOptions& options,
+                                  SvgImportInfo* info) {
   if (!(options.tolerance > 0) || !std::isfinite(options.tolerance)) {
     return absl::InvalidArgumentError("SVG import: tolerance must be a positive number");
   }
@@ -606,6 +628,7 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
     return absl::InvalidArgumentError(
         "SVG has no filled shape (elements with fill=\"none\" and empty paths are ignored)");
   }
+  if (info != nullptr) info->fill_rgb = collector.largest_fill;
   OrientByNesting(&collector.outlines);
   Drawing drawing;
   drawing.outlines = std::move(collector.outlines);

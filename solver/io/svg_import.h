@@ -1,6 +1,8 @@
 // SVG in: filled shapes of an SVG document become the outlines of one Drawing.
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <string_view>
 
 #include "absl/status/statusor.h"
@@ -16,10 +18,20 @@ struct SvgImportOptions {
   int max_points = 1'000'000;
 };
 
+// What the import saw besides the geometry (for renderers that want the drawing's look).
+struct SvgImportInfo {
+  // The fill colour 0xRRGGBB of the filled element whose outline encloses the largest area, when
+  // the document gives it as a plain colour (fill attribute or style, possibly inherited);
+  // nullopt when that element is filled by SVG's initial black, currentColor or a paint server.
+  std::optional<uint32_t> fill_rgb;
+};
+
 // Parses an SVG document (text) and returns its filled outlines, outer ones positive, holes
 // negative (see types.h). Errors are INVALID_ARGUMENT naming the element and the reason;
 // RESOURCE_EXHAUSTED above options.max_points or when <use> expansion would exceed 100000
 // elements.
-absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOptions& options = {});
+// `info` (optional) receives what else the import saw.
+absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOptions& options = {},
+                                  SvgImportInfo* info = nullptr);
 
 }  // namespace inbetween::solver

@@ -7,8 +7,8 @@
 namespace inbetween::client {
 namespace {
 
-using ::testing::HasSubstr;
 using nlohmann::json;
+using ::testing::HasSubstr;
 
 json Minimal() { return json::parse(R"({"version": 1, "drawings": ["a.svg", "b.svg"]})"); }
 
@@ -86,7 +86,36 @@ INSTANTIATE_TEST_SUITE_P(
                     "inbetween": {"stiffness": [{"polygon": [[0,0],[1,0],[1,"x"]], "kappa": 1}]}})",
                 "$.inbetween.stiffness[0].polygon[2][1]: expected a number"},
         BadCase{R"({"version": 1, "drawings": ["a", "b"], "output": {"width": 1.5}})",
-                "$.output.width: expected an integer"}));
+                "$.output.width: expected an integer"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "output": {"fill": "bluish"}})",
+                "$.output.fill: colour \"bluish\""},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "inbetween": {"timing": "bouncy"}})",
+                "$.inbetween.timing: unknown timing curve 'bouncy'"},
+        BadCase{R"({"version": 1, "drawings": [{"file": "a", "key_time": 0}, "b"]})",
+                "$.drawings: key_time is set on 1 of 2 drawings"},
+        BadCase{R"({"version": 1, "drawings": [{"file": "a", "key_time": 0},
+                    {"file": "b", "key_time": 0.5}, {"file": "c", "key_time": 0.4}]})",
+                "$.drawings: key_time: times must increase strictly: drawing 3"},
+        BadCase{R"({"version": 1, "drawings": [{"file": "a", "key_time": 0},
+                    {"file": "b", "key_time": 0.5}]})",
+                "$.drawings: key_time: the first time must be 0 and the last 1"}));
+
+TEST(ProjectFileTest, TimingAcceptsHyphensAndUnderscores) {
+  for (const char* name : {"catmull-rom", "catmull_rom"}) {
+    json doc = Minimal();
+    doc["inbetween"] = {{"timing", name}};
+    auto p = ParseProject(doc, "/base");
+    ASSERT_TRUE(p.ok()) << p.status();
+    EXPECT_EQ(p->parameters.inbetween().timing(), v1::TIMING_CURVE_CATMULL_ROM);
+  }
+}
+
+TEST(ProjectFileTest, FillIsOnlyWrittenWhenSet) {
+  auto p = ParseProject(Minimal(), "/base");
+  ASSERT_TRUE(p.ok());
+  EXPECT_FALSE(p->output.fill.has_value());
+  EXPECT_FALSE(ProjectToJson(*p, "/base")["output"].contains("fill"));
+}
 
 }  // namespace
 }  // namespace inbetween::client

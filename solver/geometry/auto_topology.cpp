@@ -1,0 +1,250 @@
+// Auto-topology proposals (see auto_topology.h): shortest inside cuts from extra holes to their
+// component's outline.
+#include "solver/geometry/auto_topology.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "solver/geometry/polygon.h"
+#include "solver/mesh/cgal_predicates.h"
+
+namespace inbetween::solver {
+namespace {
+
+struct Segment {
+  Point a, b;
+};
+
+// The point of segment a-b nearest to p.
+Point NearestOnSegment(const Point& p, const Point& a, const Point& b) {
+  const Point d = b - a;
+  const double len2 = d.squaredNorm();
+  if (len2 == 0) return a;
+  const double t = std::clamp((p - a).dot(d) / len2, 0.0, 1.0);
+  return a + t * d;
+}
+
+// The point of the closed loop nearest to p.
+Point NearestOnLoop(const Point& p, const Points& loop) {
+  Point best = loop[0];
+  double best_d2 = (p - best).squaredNorm();
+  for (size_t i = 0; i < loop.size(); ++i) {
+    const Point q = NearestOnSegment(p, loop[i], loop[(i + 1) % loop.size()]);
+    const double d2 = (p - q).squaredNorm();
+    if (d2 < best_d2) best_d2 = d2, best = q;
+  }
+  return best;
+}
+
+// True when the open segment p-q meets no obstacle (its end points lie on boundaries, so a tiny
+// piece at each end is left out) and its midpoint is inside the component: inside the outer
+// loop, outside every hole.
+bool CutStaysInside(const Point& p, const Point& q, const std::vector<Segment>& obstacles,
+                    const Points& outer, const std::vector<const Points*>& holes) {
+  const Point d = q - p;
+  if (d.squaredNorm() == 0) return false;
+  constexpr double kTrim = 1e-7;
+  const Point p1 = p + kTrim * d, q1 = q - kTrim * d;
+  for (const Segment& s : obstacles) {
+    if (ExactSegmentContact(p1, q1, s.a, s.b).kind != SegmentContact::kNone) return false;
+  }
+  const Point mid = 0.5 * (p + q);
+  if (!PolygonContains(outer, mid)) return false;
+  for (const Points* h : holes) {
+    if (PolygonContains(*h, mid)) return false;
+  }
+  return true;
+}
+
+// Component ids of `graph` ordered by hole count (descending, then id), as EquivalenceClass
+// orders holes_per_component; plus the hole loops of each component.
+struct Components {
+  std::vector<int> by_rank;
+  std::vector<std::vector<int>> hole_loops;  // per component id
+  std::vector<int> outer_loop;               // per component id
+};
+
+Components ComponentsOf(const BoundaryGraph& graph) {
+  Components c;
+  const int n = graph.equivalence.components;
+  c.hole_loops.resize(n);
+  c.outer_loop.assign(n, -1);
+  for (int l = 0; l < static_cast<int>(graph.loops.size()); ++l) {
+    const BoundaryLoop& loop = graph.loops[l];
+    if (loop.component < 0 || loop.component >= n) continue;
+    if (loop.outer) {
+      c.outer_loop[loop.component] = l;
+    } else {
+      c.hole_loops[loop.component].push_back(l);
+    }
+  }
+  c.by_rank.resize(n);
+  std::iota(c.by_rank.begin(), c.by_rank.end(), 0);
+  std::stable_sort(c.by_rank.begin(), c.by_rank.end(),
+                   [&](int a, int b) { return c.hole_loops[a].size() > c.hole_loops[b].size(); });
+  return c;
+}
+
+// The shortest cut from hole loop `hole` to outer loop `outer` that stays inside, or nullopt.
+std::optional<Segment> ShortestCut(const Points& hole, const Points& outer,
+                                   const std::vector<Segment>& obstacles,
+                                   const std::vector<const Points*>& holes,
+                                   const AutoTopologyOptions& options) {
+  // Edge midpoints first, so that among equally short cuts (parallel edges) the stable sort
+  // keeps one from the middle of an edge rather than from a corner.
+  std::vector<std::pair<double, Segment>> candidates;
+  for (size_t i = 0; i < hole.size(); ++i) {
+    const Point h = 0.5 * (hole[i] + hole[(i + 1) % hole.size()]);
+    const Point o = NearestOnLoop(h, outer);
+    candidates.push_back({(o - h).squaredNorm(), {h, o}});
+  }
+  for (const Point& h : hole) {
+    const Point o = NearestOnLoop(h, outer);
+    candidates.push_back({(o - h).squaredNorm(), {h, o}});
+  }
+  for (const Point& o : outer) {
+    const Point h = NearestOnLoop(o, hole);
+    candidates.push_back({(o - h).squaredNorm(), {h, o}});
+  }
+  const auto by_length = [](const auto& x, const auto& y) { return x.first < y.first; };
+  std::stable_sort(candidates.begin(), candidates.end(), by_length);
+  for (const auto& [unused, s] : candidates) {
+    if (CutStaysInside(s.a, s.b, obstacles, outer, holes)) return s;
+  }
+  // Something is in the way of every nearest-point cut: try vertex pairs, shortest first.
+  candidates.clear();
+  for (const Point& h : hole) {
+    for (const Point& o : outer) candidates.push_back({(o - h).squaredNorm(), {h, o}});
+  }
+  const size_t keep = std::min(candidates.size(), static_cast<size_t>(options.max_pair_candidates));
+  std::partial_sort(candidates.begin(), candidates.begin() + keep, candidates.end(), by_length);
+  for (size_t i = 0; i < keep; ++i) {
+    if (CutStaysInside(candidates[i].second.a, candidates[i].second.b, obstacles, outer, holes)) {
+      return candidates[i].second;
+    }
+  }
+  return std::nullopt;
+}
+
+// The cut drawn the way docs/svg-convention.md asks for: crossing the boundary at both ends (the
+// builder clips the overhang), so an end point that rounding put a hair inside the shape still
+// reaches the boundary. The overhang is 1% of the cut, less if that would leave the hole or
+// re-enter the shape; an end whose overhang cannot be placed (a slit hole) stays on the boundary.
+Points CrossBothEnds(const Segment& cut, const Points& hole, const Points& outer) {
+  const Point u = (cut.b - cut.a).normalized();
+  Point a = cut.a, b = cut.b;
+  for (double step = 0.01 * (cut.b - cut.a).norm(), i = 0; i < 8; ++i, step /= 4) {
+    if (PolygonContains(hole, cut.a - step * u)) {
+      a = cut.a - step * u;
+      break;
+    }
+  }
+  for (double step = 0.01 * (cut.b - cut.a).norm(), i = 0; i < 8; ++i, step /= 4) {
+    if (!PolygonContains(outer, cut.b + step * u)) {
+      b = cut.b + step * u;
+      break;
+    }
+  }
+  return {a, b};
+}
+
+}  // namespace
+
+absl::StatusOr<AutoTopologyResult> ProposeTopology(const std::vector<Drawing>& drawings,
+                                                   const AutoTopologyOptions& options) {
+  if (drawings.empty()) return absl::InvalidArgumentError("auto-topology: no drawings");
+  std::vector<BoundaryGraph> graphs;
+  for (size_t d = 0; d < drawings.size(); ++d) {
+    absl::StatusOr<BoundaryGraph> g = BuildBoundaries(drawings[d], static_cast<int>(d) + 1);
+    if (!g.ok()) return g.status();
+    graphs.push_back(*std::move(g));
+  }
+  for (size_t d = 1; d < graphs.size(); ++d) {
+    if (graphs[d].equivalence.components != graphs[0].equivalence.components) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "auto-topology: drawing 1 has ", graphs[0].equivalence.ToString(), ", drawing ", d + 1,
+          " has ", graphs[d].equivalence.ToString(),
+          "; it only cuts extra holes: draw a cut that splits a component (or an opening) in "
+          "the drawing with fewer components, in the project file's \"cuts\"/\"openings\""));
+    }
+  }
+  const int num_components = graphs[0].equivalence.components;
+
+  AutoTopologyResult result;
+  result.target = graphs[0].equivalence;
+  for (int k = 0; k < num_components; ++k) {
+    for (const BoundaryGraph& g : graphs) {
+      result.target.holes_per_component[k] =
+          std::min(result.target.holes_per_component[k], g.equivalence.holes_per_component[k]);
+    }
+  }
+  result.target.holes = std::accumulate(result.target.holes_per_component.begin(),
+                                        result.target.holes_per_component.end(), 0);
+  result.cuts.resize(drawings.size());
+
+  for (size_t d = 0; d < graphs.size(); ++d) {
+    const BoundaryGraph& g = graphs[d];
+    if (g.equivalence == result.target) continue;
+    const Components comps = ComponentsOf(g);
+    std::vector<Segment> obstacles;
+    for (const BoundaryLoop& loop : g.loops) {
+      for (size_t i = 0; i < loop.points.size(); ++i) {
+        obstacles.push_back({loop.points[i], loop.points[(i + 1) % loop.points.size()]});
+      }
+    }
+    for (int k = 0; k < num_components; ++k) {
+      const int c = comps.by_rank[k];
+      std::vector<int> holes = comps.hole_loops[c];
+      const int extra = static_cast<int>(holes.size()) - result.target.holes_per_component[k];
+      if (extra <= 0) continue;
+      // The smallest holes are the ones the other drawings lack most likely (a hole that opens).
+      std::stable_sort(holes.begin(), holes.end(), [&](int a, int b) {
+        return std::abs(PolygonSignedArea(g.loops[a].points)) <
+               std::abs(PolygonSignedArea(g.loops[b].points));
+      });
+      std::vector<const Points*> hole_points;
+      for (int h : comps.hole_loops[c]) hole_points.push_back(&g.loops[h].points);
+      const Points& outer = g.loops[comps.outer_loop[c]].points;
+      for (int i = 0; i < extra; ++i) {
+        const Points& hole = g.loops[holes[i]].points;
+        std::optional<Segment> cut = ShortestCut(hole, outer, obstacles, hole_points, options);
+        if (!cut) {
+          const Point at = hole[0];
+          return absl::FailedPreconditionError(absl::StrFormat(
+              "auto-topology: drawing %d: no straight cut from the hole at (%.6g, %.6g) to the "
+              "outline stays inside the shape; draw one (a polyline) in the project file's "
+              "\"cuts\" of drawing %d",
+              d + 1, at.x(), at.y(), d + 1));
+        }
+        obstacles.push_back(*cut);
+        result.cuts[d].push_back(CrossBothEnds(*cut, hole, outer));
+        result.notes.push_back(absl::StrFormat(
+            "drawing %d: cut from the hole at (%.6g, %.6g) to the outline at (%.6g, %.6g), "
+            "length %.6g",
+            d + 1, cut->a.x(), cut->a.y(), cut->b.x(), cut->b.y(), (cut->b - cut->a).norm()));
+      }
+    }
+    // Check the proposal the way the multimesh builder will read it.
+    Drawing edited = drawings[d];
+    for (const Points& cut : result.cuts[d]) edited.cuts.push_back(cut);
+    absl::StatusOr<BoundaryGraph> rebuilt = BuildBoundaries(edited, static_cast<int>(d) + 1);
+    if (!rebuilt.ok()) {
+      return absl::InternalError(absl::StrCat("auto-topology: the proposed cuts of drawing ", d + 1,
+                                              " do not apply: ", rebuilt.status().message()));
+    }
+    if (!(rebuilt->equivalence == result.target)) {
+      return absl::InternalError(
+          absl::StrCat("auto-topology: drawing ", d + 1, " has ", rebuilt->equivalence.ToString(),
+                       " after the proposed cuts, expected ", result.target.ToString(), " (",
+                       absl::StrJoin(result.notes, "; "), ")"));
+    }
+  }
+  return result;
+}
+
+}  // namespace inbetween::solver
