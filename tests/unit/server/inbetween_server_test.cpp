@@ -132,5 +132,56 @@ TEST_F(InbetweenServerShutdownTest, ShutdownCancelsRunningStreamsAfterTheGracePe
   server_->Wait();
 }
 
+// grpc.health.v1.Health/Watch through the generic async API: the first update is SERVING; once
+// the server starts draining (Shutdown, streams still within their grace period), the open
+// watch reports NOT_SERVING (2).
+TEST_F(InbetweenServerShutdownTest, HealthWatchReportsNotServingWhileDraining) {
+  grpc::CompletionQueue cq;
+  grpc::GenericStub stub(server_->InProcessChannel());
+  grpc::ClientContext context;
+  auto call = stub.PrepareCall(&context, "/grpc.health.v1.Health/Watch", &cq);
+  void* tag = nullptr;
+  bool ok = false;
+  const auto next = [&](intptr_t expected) {
+    EXPECT_TRUE(cq.Next(&tag, &ok));
+    EXPECT_EQ(reinterpret_cast<intptr_t>(tag), expected);
+    return ok;
+  };
+  call->StartCall(reinterpret_cast<void*>(1));
+  ASSERT_TRUE(next(1));
+  const std::string service = "inbetween.v1.Inbetween";
+  std::string request_bytes = {0x0a, static_cast<char>(service.size())};
+  request_bytes += service;
+  grpc::Slice slice(request_bytes);
+  grpc::ByteBuffer request(&slice, 1);
+  call->Write(request, reinterpret_cast<void*>(2));
+  ASSERT_TRUE(next(2));
+  call->WritesDone(reinterpret_cast<void*>(3));
+  ASSERT_TRUE(next(3));
+  const auto read_status = [&](intptr_t t) -> int {
+    grpc::ByteBuffer response;
+    call->Read(&response, reinterpret_cast<void*>(t));
+    if (!next(t)) return -1;
+    std::vector<grpc::Slice> slices;
+    EXPECT_TRUE(response.Dump(&slices).ok());
+    std::string bytes;
+    for (const grpc::Slice& s : slices)
+      bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
+    return bytes.size() == 2 && bytes[0] == 0x08 ? bytes[1] : 0;
+  };
+  EXPECT_EQ(read_status(4), 1);  // SERVING
+  std::thread shutdown([&] { server_->Shutdown(); });
+  EXPECT_EQ(read_status(5), 2);  // NOT_SERVING, while the server drains
+  context.TryCancel();
+  grpc::Status status;
+  call->Finish(&status, reinterpret_cast<void*>(6));
+  next(6);
+  shutdown.join();
+  server_->Wait();
+  cq.Shutdown();
+  while (cq.Next(&tag, &ok)) {
+  }
+}
+
 }  // namespace
 }  // namespace inbetween::server::testing
