@@ -193,13 +193,16 @@ class Client:
         """Yields ("header", InbetweenHeader) then ("frame", InbetweenFrame) in order."""
         parameters = pb.InbetweenParameters(method=METHODS[method], frames=frames)
         request = pb.InbetweenRequest(session_id=session_id, parameters=parameters)
+        call = self._stream("Inbetween", request, session_id)
         try:
-            for response in self._stream("Inbetween", request, session_id):
+            for response in call:
                 event = response.WhichOneof("event")
                 if event in ("header", "frame"):
                     yield event, getattr(response, event)
         except grpc.RpcError as error:
             raise InbetweenError.from_rpc_error(error) from None
+        finally:
+            call.cancel()  # a consumer that stops early ends the stream (no-op when finished)
 
     def stream_frames(self, session, out_dir, frames, method="zhu17"):
         """Streams the inbetween frames into out_dir as they arrive: frame_NNNN.svg (the mesh's

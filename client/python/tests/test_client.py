@@ -18,6 +18,9 @@ from inbetween.v1 import inbetween_pb2 as pb
 EXAMPLES = os.path.join(os.environ.get("INBETWEEN_SRC", "."), "examples", "square_hexagon")
 SQUARE = os.path.join(EXAMPLES, "square.svg")
 HEXAGON = os.path.join(EXAMPLES, "hexagon.svg")
+HARD = os.path.join(os.environ.get("INBETWEEN_SRC", "."), "examples", "pentagon_star", "hard1")
+PENTAGON = os.path.join(HARD, "pentagon.svg")
+STAR = os.path.join(HARD, "star.svg")
 
 
 def start_server(*flags):
@@ -145,8 +148,10 @@ class BusyServerTest(unittest.TestCase):
         server, address = start_server("--max-heavy-jobs", "1", "--heavy-queue", "0")
         try:
             with inbetween.Client(address, timeout=120) as client:
+                # Pentagon -> star with the iteration limits at their maximum optimizes for
+                # minutes: the only slot stays taken until the client cancels.
                 session = client.build(client.upload_svgs(client.create_session("busy"),
-                                                          [SQUARE, HEXAGON]))
+                                                          [PENTAGON, STAR]))
                 started, release = threading.Event(), threading.Event()
 
                 def hold(event):
@@ -154,9 +159,9 @@ class BusyServerTest(unittest.TestCase):
                     release.wait(60)
                     return False  # then cancel
 
-                holder = threading.Thread(
-                    target=lambda: self.assertRaises(inbetween.InbetweenError, client.optimize,
-                                                     session, hold))
+                holder = threading.Thread(target=lambda: self.assertRaises(
+                    inbetween.InbetweenError, client.optimize, session, hold,
+                    max_outer_iterations=1000, max_inner_iterations=100000, tolerance=1e-15))
                 holder.start()
                 self.assertTrue(started.wait(60))
                 with self.assertRaises(inbetween.InbetweenError) as busy:
