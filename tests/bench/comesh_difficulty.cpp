@@ -3,16 +3,12 @@
 // longest) to 0.3 (hard6) of its outer radius; both polygons are generated here and meshed with
 // BuildMultimesh. Prints our row beside the paper's; --json FILE.
 //
-//   comesh_difficulty [--threads T] [--json FILE]
+//   comesh_difficulty [common options: comesh_bench_common.h]
 #include <cstdio>
-#include <cstdlib>
-#include <fstream>
-#include <nlohmann/json.hpp>
 #include <numbers>
 #include <string>
 
-#include "solver/comesh/comesh_optimizer.h"
-#include "solver/mesh/build_multimesh.h"
+#include "tests/bench/comesh_bench_common.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
 
 namespace {
@@ -32,19 +28,10 @@ constexpr double kInnerRatio[] = {0.8, 0.7, 0.6, 0.5, 0.4, 0.3};
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string json_path;
-  sv::ComeshOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else if (a == "--threads" && i + 1 < argc) {
-      options.threads = std::atoi(argv[++i]);
-    } else {
-      std::fprintf(stderr, "usage: %s [--threads T] [--json FILE]\n", argv[0]);
-      return 2;
-    }
-  }
+  inbetween::bench::ComeshBenchArgs args =
+      inbetween::bench::ParseComeshBenchArgs(argc, argv, /*with_max_vertices=*/false);
+  sv::ComeshOptions& options = args.options;
+  const sv::ProgressFn progress = inbetween::bench::VerboseProgress(args.verbose);
   nlohmann::json rows = nlohmann::json::array();
   std::printf("%-7s %6s %13s %11s %11s %11s %9s %9s %7s %7s %7s\n", "case", "inner", "ver ours",
               "ver paper", "inner o/p", "outer o/p", "seconds", "paper_s", "ratio", "map", "mesh");
@@ -67,7 +54,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     sv::ComeshReport r;
-    absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(*mesh, options, nullptr, nullptr, &r);
+    absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(*mesh, options, nullptr, progress, &r);
     if (!out.ok()) {
       std::fprintf(stderr, "%s: %s\n", name.c_str(), out.status().ToString().c_str());
       return 1;
@@ -77,16 +64,8 @@ int main(int argc, char** argv) {
                 paper.after, r.inner, paper.inner, r.outer, paper.outer, r.seconds, paper.seconds,
                 paper.seconds / r.seconds, r.map_energy, r.mesh_energy);
     std::fflush(stdout);
-    rows.push_back({{"case", "pentagon-star-" + name},
-                    {"vertices_before", r.vertices_before},
-                    {"vertices_after", r.vertices_after},
-                    {"inner", r.inner},
-                    {"outer", r.outer},
-                    {"seconds", r.seconds},
-                    {"map_energy", r.map_energy},
-                    {"mesh_energy", r.mesh_energy},
-                    {"paper_seconds", paper.seconds}});
+    rows.push_back(inbetween::bench::ComeshRow("pentagon-star-" + name, r, paper.seconds));
   }
-  if (!json_path.empty()) std::ofstream(json_path) << rows.dump(2) << "\n";
+  inbetween::bench::WriteRows(args.json_path, rows);
   return 0;
 }

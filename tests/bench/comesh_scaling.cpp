@@ -3,17 +3,12 @@
 // BuildMultimesh, sized by MultimeshOptions for each Table 2 row's vertex count. Prints our row
 // beside the paper's and the ratio paper_seconds / seconds; --json FILE writes the rows.
 //
-//   comesh_scaling [--max-vertices N] [--threads T] [--max-outer K] [--weight W] [--blend B]
-//                  [--cure] [--json FILE] [--verbose]
+//   comesh_scaling [--max-vertices N] [common options: comesh_bench_common.h]
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <fstream>
-#include <nlohmann/json.hpp>
 #include <string>
 
-#include "solver/comesh/comesh_optimizer.h"
-#include "solver/mesh/build_multimesh.h"
+#include "tests/bench/comesh_bench_common.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
 
 namespace {
@@ -41,50 +36,18 @@ constexpr PaperRow kPaper[] = {{98, 98, 59, 5, 0.065},
 }  // namespace
 
 int main(int argc, char** argv) {
-  int max_vertices = 40000;
-  std::string json_path;
-  bool verbose = false;
-  sv::ComeshOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&] { return i + 1 < argc ? argv[++i] : (std::exit(2), ""); };
-    if (a == "--max-vertices") {
-      max_vertices = std::atoi(next());
-    } else if (a == "--json") {
-      json_path = next();
-    } else if (a == "--threads") {
-      options.threads = std::atoi(next());
-    } else if (a == "--max-outer") {
-      options.max_outer = std::atoi(next());
-    } else if (a == "--weight") {
-      options.map_weight = std::atof(next());
-    } else if (a == "--blend") {
-      options.blend = std::atof(next());
-    } else if (a == "--cure") {
-      options.cure = true;
-    } else if (a == "--verbose") {
-      verbose = true;
-    } else {
-      std::fprintf(stderr,
-                   "usage: %s [--max-vertices N] [--threads T] [--max-outer K] [--weight W] "
-                   "[--blend B] [--cure] [--json FILE] [--verbose]\n",
-                   argv[0]);
-      return 2;
-    }
-  }
-  sv::ProgressFn progress;
-  if (verbose) {
-    progress = [](const std::string&, double, const std::string& detail) {
-      std::printf("  %s\n", detail.c_str());
-    };
-  }
+  const inbetween::bench::ComeshBenchArgs args =
+      inbetween::bench::ParseComeshBenchArgs(argc, argv, /*with_max_vertices=*/true);
+  const sv::ComeshOptions& options = args.options;
+  const sv::ProgressFn progress = inbetween::bench::VerboseProgress(args.verbose);
   nlohmann::json rows = nlohmann::json::array();
-  std::printf("%-22s %13s %13s %11s %11s %9s %9s %7s %7s %7s\n", "case", "ver ours", "ver paper",
-              "inner o/p", "outer o/p", "seconds", "paper_s", "ratio", "map", "mesh");
+  std::printf("%-22s %13s %13s %11s %11s %6s %9s %9s %7s %7s %7s\n", "case", "ver ours",
+              "ver paper", "inner o/p", "outer o/p", "evals", "seconds", "paper_s", "ratio", "map",
+              "mesh");
   const std::vector<sv::Drawing> drawings = {
       sv::testing::UnitSquare(), sv::testing::RegularPolygon(6, 0.6, sv::Point(0.5, 0.5))};
   for (const PaperRow& paper : kPaper) {
-    if (paper.before > max_vertices) break;
+    if (paper.before > args.max_vertices) break;
     const auto size = sv::testing::SizeFor(paper.before, 4.0, std::sqrt(2.0), 1.0);
     sv::MultimeshOptions mesh_options;
     mesh_options.boundary_vertices = size.boundary_vertices;
@@ -101,21 +64,14 @@ int main(int argc, char** argv) {
       return 1;
     }
     const std::string name = "square-hexagon-" + std::to_string(paper.before);
-    std::printf("%-22s %6d/%-6d %6d/%-6d %5d/%-5d %5d/%-5d %9.3f %9.3f %7.1f %7.4f %7.4f\n",
+    std::printf("%-22s %6d/%-6d %6d/%-6d %5d/%-5d %5d/%-5d %6d %9.3f %9.3f %7.1f %7.4f %7.4f\n",
                 name.c_str(), r.vertices_before, r.vertices_after, paper.before, paper.after,
-                r.inner, paper.inner, r.outer, paper.outer, r.seconds, paper.seconds,
+                r.inner, paper.inner, r.outer, paper.outer, r.energy_evaluations, r.seconds,
+                paper.seconds,
                 paper.seconds / r.seconds, r.map_energy, r.mesh_energy);
     std::fflush(stdout);
-    rows.push_back({{"case", name},
-                    {"vertices_before", r.vertices_before},
-                    {"vertices_after", r.vertices_after},
-                    {"inner", r.inner},
-                    {"outer", r.outer},
-                    {"seconds", r.seconds},
-                    {"map_energy", r.map_energy},
-                    {"mesh_energy", r.mesh_energy},
-                    {"paper_seconds", paper.seconds}});
+    rows.push_back(inbetween::bench::ComeshRow(name, r, paper.seconds));
   }
-  if (!json_path.empty()) std::ofstream(json_path) << rows.dump(2) << "\n";
+  inbetween::bench::WriteRows(args.json_path, rows);
   return 0;
 }

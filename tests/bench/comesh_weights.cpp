@@ -1,15 +1,11 @@
 // Benchmark (S-Table 1): square -> hexagon (467 vertices, as in the paper) optimized with the map
 // weight w swept over the paper's values. Prints our row beside the paper's; --json FILE.
 //
-//   comesh_weights [--threads T] [--json FILE]
+//   comesh_weights [common options: comesh_bench_common.h]
 #include <cstdio>
-#include <cstdlib>
-#include <fstream>
-#include <nlohmann/json.hpp>
 #include <string>
 
-#include "solver/comesh/comesh_optimizer.h"
-#include "solver/mesh/build_multimesh.h"
+#include "tests/bench/comesh_bench_common.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
 
 namespace {
@@ -31,19 +27,10 @@ constexpr PaperRow kPaper[] = {{0.13, 358, 2.329, 2.114, 0.494}, {0.21, 331, 1.8
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string json_path;
-  sv::ComeshOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else if (a == "--threads" && i + 1 < argc) {
-      options.threads = std::atoi(argv[++i]);
-    } else {
-      std::fprintf(stderr, "usage: %s [--threads T] [--json FILE]\n", argv[0]);
-      return 2;
-    }
-  }
+  inbetween::bench::ComeshBenchArgs args =
+      inbetween::bench::ParseComeshBenchArgs(argc, argv, /*with_max_vertices=*/false);
+  sv::ComeshOptions& options = args.options;
+  const sv::ProgressFn progress = inbetween::bench::VerboseProgress(args.verbose);
   const auto size = sv::testing::SizeFor(467, 4.0, std::sqrt(2.0), 1.0);
   sv::MultimeshOptions mesh_options;
   mesh_options.boundary_vertices = size.boundary_vertices;
@@ -61,7 +48,7 @@ int main(int argc, char** argv) {
   for (const PaperRow& paper : kPaper) {
     options.map_weight = paper.weight;
     sv::ComeshReport r;
-    absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(*mesh, options, nullptr, nullptr, &r);
+    absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(*mesh, options, nullptr, progress, &r);
     if (!out.ok()) {
       std::fprintf(stderr, "w = %g: %s\n", paper.weight, out.status().ToString().c_str());
       return 1;
@@ -71,16 +58,8 @@ int main(int argc, char** argv) {
                 r.seconds, paper.seconds, paper.seconds / r.seconds, r.map_energy, paper.map,
                 r.mesh_energy, paper.mesh);
     std::fflush(stdout);
-    rows.push_back({{"case", "square-hexagon-w" + std::to_string(paper.weight).substr(0, 4)},
-                    {"vertices_before", r.vertices_before},
-                    {"vertices_after", r.vertices_after},
-                    {"inner", r.inner},
-                    {"outer", r.outer},
-                    {"seconds", r.seconds},
-                    {"map_energy", r.map_energy},
-                    {"mesh_energy", r.mesh_energy},
-                    {"paper_seconds", paper.seconds}});
+    rows.push_back(inbetween::bench::ComeshRow("square-hexagon-w" + std::to_string(paper.weight).substr(0, 4), r, paper.seconds));
   }
-  if (!json_path.empty()) std::ofstream(json_path) << rows.dump(2) << "\n";
+  inbetween::bench::WriteRows(args.json_path, rows);
   return 0;
 }

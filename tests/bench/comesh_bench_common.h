@@ -1,0 +1,90 @@
+// Shared by the comesh benchmarks (S-Tables 1, 2, 4): command line, the JSON row of one run and
+// building a multimesh sized for a vertex count.
+#pragma once
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "solver/comesh/comesh_optimizer.h"
+#include "solver/mesh/build_multimesh.h"
+
+namespace inbetween::bench {
+
+struct ComeshBenchArgs {
+  int max_vertices = 40000;
+  std::string json_path;
+  bool verbose = false;
+  solver::ComeshOptions options;
+};
+
+// Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure, --tolerance R,
+// --verbose and (when `with_max_vertices`) --max-vertices N; exits 2 with a usage line otherwise.
+inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max_vertices) {
+  ComeshBenchArgs args;
+  auto usage = [&] {
+    std::fprintf(stderr,
+                 "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
+                 "[--tolerance R] [--verbose] [--json FILE]\n",
+                 argv[0], with_max_vertices ? "[--max-vertices N] " : "");
+    std::exit(2);
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : (usage(), ""); };
+    if (a == "--max-vertices" && with_max_vertices) {
+      args.max_vertices = std::atoi(next());
+    } else if (a == "--json") {
+      args.json_path = next();
+    } else if (a == "--threads") {
+      args.options.threads = std::atoi(next());
+    } else if (a == "--max-outer") {
+      args.options.max_outer = std::atoi(next());
+    } else if (a == "--weight") {
+      args.options.map_weight = std::atof(next());
+    } else if (a == "--blend") {
+      args.options.blend = std::atof(next());
+    } else if (a == "--no-cure") {
+      args.options.cure = false;
+    } else if (a == "--tolerance") {
+      args.options.relative_decrease_tolerance = std::atof(next());
+    } else if (a == "--verbose") {
+      args.verbose = true;
+    } else {
+      usage();
+    }
+  }
+  return args;
+}
+
+// Prints every inner iterate's progress line when verbose.
+inline solver::ProgressFn VerboseProgress(bool verbose) {
+  if (!verbose) return nullptr;
+  return [](const std::string&, double, const std::string& detail) {
+    std::printf("  %s\n", detail.c_str());
+  };
+}
+
+// The JSON row, plus energy evaluations (line-search trials included).
+inline nlohmann::json ComeshRow(const std::string& name, const solver::ComeshReport& r,
+                                double paper_seconds) {
+  return {{"case", name},
+          {"vertices_before", r.vertices_before},
+          {"vertices_after", r.vertices_after},
+          {"inner", r.inner},
+          {"outer", r.outer},
+          {"evaluations", r.energy_evaluations},
+          {"seconds", r.seconds},
+          {"map_energy", r.map_energy},
+          {"mesh_energy", r.mesh_energy},
+          {"paper_seconds", paper_seconds}};
+}
+
+inline void WriteRows(const std::string& path, const nlohmann::json& rows) {
+  if (!path.empty()) std::ofstream(path) << rows.dump(2) << "\n";
+}
+
+}  // namespace inbetween::bench
