@@ -15,6 +15,7 @@
 #include "client/render/color.h"
 #include "client/render/export.h"
 #include "client/render/svg_frames.h"
+#include "client/svg_marks.h"
 
 namespace inbetween::client {
 namespace {
@@ -79,6 +80,7 @@ absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::str
                                           const RunContext& ctx) {
   auto session = ctx.client->CreateSession(name, project.parameters);
   if (!session.ok()) return Annotate(session.status(), "create session");
+  std::vector<std::string> svgs;
   for (size_t i = 0; i < project.drawings.size(); ++i) {
     const ProjectDrawing& d = project.drawings[i];
     const std::string where = absl::StrCat("drawing ", i + 1, " (", d.file.string(), ")");
@@ -88,6 +90,7 @@ absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::str
     request.set_session_id(session->id());
     request.set_expected_version(session->version());
     request.mutable_drawing()->set_name(d.file.filename().string());
+    svgs.push_back(*svg);
     request.mutable_drawing()->set_svg(*std::move(svg));
     if (d.key_time) request.mutable_drawing()->set_key_time(*d.key_time);
     for (const auto& [lines, kind] : {std::pair{&d.cuts, v1::ELEMENT_KIND_CUT},
@@ -102,11 +105,19 @@ absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::str
     if (!put.ok()) return Annotate(put.status(), where);
     *session = put->session();
   }
-  if (!project.correspondences.empty()) {
+  // The project's correspondences, else the marks drawn in the SVGs (data-corr), which the
+  // service does not keep with the drawings.
+  std::vector<XYs> marks = project.correspondences;
+  if (marks.empty()) {
+    absl::StatusOr<std::vector<XYs>> drawn = SvgMarkCorrespondences(svgs);
+    if (!drawn.ok()) return drawn.status();
+    marks = *std::move(drawn);
+  }
+  if (!marks.empty()) {
     v1::SetCorrespondencesRequest request;
     request.set_session_id(session->id());
     request.set_expected_version(session->version());
-    for (const XYs& mark : project.correspondences) {
+    for (const XYs& mark : marks) {
       *request.add_correspondences()->mutable_points() = ToPolyline(mark).points();
     }
     auto updated = ctx.client->SetCorrespondences(request);
