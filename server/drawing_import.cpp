@@ -43,7 +43,15 @@ absl::Status CheckOutline(const solver::Points& points, const std::string& where
   if (!(std::abs(area) > 0.0) || !std::isfinite(area)) {
     return absl::InvalidArgumentError(absl::StrCat(where, " has zero area"));
   }
-  if (std::optional<solver::SelfIntersection> x = solver::FindSelfIntersection(points)) {
+  bool gave_up = false;
+  std::optional<solver::SelfIntersection> x =
+      solver::FindSelfIntersection(points, solver::BoundaryOptions().max_pair_checks, &gave_up);
+  if (gave_up) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        where, " has too many long segments side by side to check for crossings (more than ",
+        solver::BoundaryOptions().max_pair_checks, " candidate pairs); simplify it"));
+  }
+  if (x) {
     return absl::InvalidArgumentError(
         absl::StrCat(where, " crosses itself: segments ", x->segment_a, " and ", x->segment_b,
                      " meet at (", x->location.x(), ", ", x->location.y(), ")"));

@@ -190,10 +190,17 @@ absl::StatusOr<BoundaryGraph> BuildBoundaries(const Drawing& drawing, int drawin
   std::iota(order.begin(), order.end(), 0);
   auto min_x = [&](int i) { return std::min(segments[i].a.x(), segments[i].b.x()); };
   std::sort(order.begin(), order.end(), [&](int l, int r) { return min_x(l) < min_x(r); });
+  int64_t pair_checks = 0;
   for (int oi = 0; oi < num_segments; ++oi) {
     RawSegment& s = segments[order[oi]];
     const double max_x = std::max(s.a.x(), s.b.x());
     for (int oj = oi + 1; oj < num_segments && min_x(order[oj]) <= max_x; ++oj) {
+      if (options.max_pair_checks > 0 && ++pair_checks > options.max_pair_checks) {
+        return absl::ResourceExhaustedError(absl::StrCat(
+            what, ": more than ", options.max_pair_checks,
+            " pairs of overlapping segments to intersect (many long segments side by side); "
+            "simplify the drawing"));
+      }
       RawSegment& t = segments[order[oj]];
       if (std::max(s.a.y(), s.b.y()) < std::min(t.a.y(), t.b.y()) ||
           std::max(t.a.y(), t.b.y()) < std::min(s.a.y(), s.b.y())) {

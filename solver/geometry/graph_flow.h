@@ -4,6 +4,7 @@
 // class (components and holes, S-Sec.1 and S-Fig.1).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -79,6 +80,11 @@ struct BoundaryOptions {
   // Cut/opening end points closer than this (relative to the drawing's bounding-box diagonal)
   // to an outline are snapped onto it.
   double snap_relative = 1e-6;
+  // Candidate segment pairs (overlapping in x) the intersection sweep may examine before it
+  // gives up with RESOURCE_EXHAUSTED: the sweep is O(n^2) on combs of long overlapping segments,
+  // so this bounds the time per drawing (about a second); ordinary drawings of a million points
+  // need a few million.
+  int64_t max_pair_checks = 50'000'000;
 };
 
 // Builds the planar straight-line graph of `drawing` (outlines oriented by nesting, cut and

@@ -5,34 +5,12 @@
 #include <cmath>
 #include <numeric>
 
+#include "solver/mesh/cgal_predicates.h"
+
 namespace inbetween::solver {
 namespace {
 
 double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
-double Orient(const Point& a, const Point& b, const Point& c) { return Cross(b - a, c - a); }
-
-// c is known collinear with a-b; is it within the segment's bounding box?
-bool OnSegment(const Point& a, const Point& b, const Point& c) {
-  return std::min(a.x(), b.x()) <= c.x() && c.x() <= std::max(a.x(), b.x()) &&
-         std::min(a.y(), b.y()) <= c.y() && c.y() <= std::max(a.y(), b.y());
-}
-
-// Whether closed segments p1-p2 and q1-q2 share a point; *where receives one such point.
-bool SegmentsMeet(const Point& p1, const Point& p2, const Point& q1, const Point& q2,
-                  Point* where) {
-  const double d1 = Orient(q1, q2, p1), d2 = Orient(q1, q2, p2);
-  const double d3 = Orient(p1, p2, q1), d4 = Orient(p1, p2, q2);
-  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) {
-    const double t = d1 / (d1 - d2);
-    *where = p1 + t * (p2 - p1);
-    return true;
-  }
-  if (d1 == 0 && OnSegment(q1, q2, p1)) return *where = p1, true;
-  if (d2 == 0 && OnSegment(q1, q2, p2)) return *where = p2, true;
-  if (d3 == 0 && OnSegment(p1, p2, q1)) return *where = q1, true;
-  if (d4 == 0 && OnSegment(p1, p2, q2)) return *where = q2, true;
-  return false;
-}
 
 }  // namespace
 
@@ -74,7 +52,9 @@ bool IsConvexPositive(const Points& polygon) {
   return winding < 3.0 * M_PI;
 }
 
-std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon) {
+std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon, int64_t max_pair_checks,
+                                                     bool* gave_up) {
+  if (gave_up != nullptr) *gave_up = false;
   const int n = static_cast<int>(polygon.size());
   if (n < 3) return std::nullopt;
   auto a = [&](int i) -> const Point& { return polygon[i]; };
@@ -83,17 +63,24 @@ std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon) {
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
     const Point u = a(i) - b(i), v = b(j) - a(j);
-    if (Cross(u, v) == 0 && u.dot(v) > 0) return SelfIntersection{i, j, a(j)};
+    if (ExactOrientation(a(i), b(i), b(j)) == 0 && u.dot(v) > 0) {
+      return SelfIntersection{i, j, a(j)};
+    }
   }
   std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);
   auto min_x = [&](int i) { return std::min(a(i).x(), b(i).x()); };
   auto max_x = [&](int i) { return std::max(a(i).x(), b(i).x()); };
   std::sort(order.begin(), order.end(), [&](int l, int r) { return min_x(l) < min_x(r); });
+  int64_t checks = 0;
   for (int oi = 0; oi < n; ++oi) {
     const int i = order[oi];
     const double xi = max_x(i);
     for (int oj = oi + 1; oj < n && min_x(order[oj]) <= xi; ++oj) {
+      if (max_pair_checks > 0 && ++checks > max_pair_checks) {
+        if (gave_up != nullptr) *gave_up = true;
+        return std::nullopt;
+      }
       const int j = order[oj];
       const bool adjacent = (j == (i + 1) % n) || (i == (j + 1) % n);
       if (adjacent) continue;
@@ -101,9 +88,9 @@ std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon) {
           std::max(a(j).y(), b(j).y()) < std::min(a(i).y(), b(i).y())) {
         continue;
       }
-      Point where;
-      if (SegmentsMeet(a(i), b(i), a(j), b(j), &where)) {
-        return SelfIntersection{std::min(i, j), std::max(i, j), where};
+      const SegmentContact contact = ExactSegmentContact(a(i), b(i), a(j), b(j));
+      if (contact.kind != SegmentContact::kNone) {
+        return SelfIntersection{std::min(i, j), std::max(i, j), contact.point};
       }
     }
   }

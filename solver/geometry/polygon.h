@@ -2,6 +2,7 @@
 // the first self-intersection. Shared by SVG import, correspondence and the mesh builder.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 
 #include "solver/core/types.h"
@@ -25,8 +26,13 @@ struct SelfIntersection {
 
 // Returns a pair of segments of the closed polygon that cross, touch or overlap (other than
 // consecutive segments meeting at their shared vertex), or nullopt for a simple polygon.
-// Sweep over x-sorted segment bounding boxes; worst case O(n^2).
-std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon);
+// Decided with exact predicates (solver/mesh/cgal_predicates.h). Sweep over x-sorted segment
+// bounding boxes: worst case O(n^2) (e.g. a comb of long parallel teeth), so `max_pair_checks`
+// (> 0) bounds the candidate pairs examined; when it is reached the search stops, returns
+// nullopt and sets *gave_up (if given). -1 = no bound.
+std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon,
+                                                     int64_t max_pair_checks = -1,
+                                                     bool* gave_up = nullptr);
 
 // Orients non-crossing closed outlines by even-odd nesting (types.h convention): outlines nested
 // inside an even number of others become positive (outer), the rest negative (holes). The first

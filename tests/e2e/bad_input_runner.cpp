@@ -336,6 +336,26 @@ void Runner::ApplyGenerator(const json& gen, const Session& s, v1::PutDrawingReq
     v1::TopologyElement* e = d->mutable_polylines()->add_elements();
     e->set_kind(v1::ELEMENT_KIND_OUTLINE);
     FillCircle(gen.at("points").get<int64_t>(), 1000, e->mutable_polyline());
+  } else if (name == "polyline_comb") {
+    // A simple polygon whose teeth are long parallel segments: the crossing checks' sweep sees
+    // every pair of teeth overlap (O(n^2) without a bound).
+    v1::TopologyElement* e = d->mutable_polylines()->add_elements();
+    e->set_kind(v1::ELEMENT_KIND_OUTLINE);
+    const int teeth = gen.at("teeth");
+    auto add = [&](double x, double y) {
+      v1::Point* p = e->mutable_polyline()->add_points();
+      p->set_x(x);
+      p->set_y(y);
+    };
+    // Walked so that the signed area is positive (y down).
+    add(0, 0);
+    for (int k = 0; k < teeth; ++k) {
+      add(1000, 2.0 * k);
+      add(1000, 2.0 * k + 1);
+      add(1, 2.0 * k + 1);
+      add(1, 2.0 * k + 2);
+    }
+    add(0, 2.0 * teeth);
   } else if (name == "svg_nested_groups") {
     d->set_svg(SvgNestedGroups(gen.at("depth")));
   } else if (name == "svg_huge_attribute") {

@@ -151,6 +151,12 @@ case("svg_flatten_bomb", "400 bytes of SVG (huge circles, tiny tolerance) that w
 case("svg_huge_path", "an SVG path of 2,000,000 commands",
      [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "path.svg"}}, code="RESOURCE_EXHAUSTED", message="drawing.svg: SVG has more than 1000000 points in its path data (limit per drawing, --max-drawing-points)",
            generate={"name": "svg_huge_path", "commands": 2000000})])
+case("outline_comb", "a simple comb outline of 64,002 points whose 32,000 teeth overlap in x: crossing checks bounded, refused in about a second",
+     [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "comb"}}, code="RESOURCE_EXHAUSTED", message="too many long segments side by side",
+           generate={"name": "polyline_comb", "teeth": 16000})])
+case("outline_comb_small", "the same comb with 2,000 teeth (8,002 points): within the bound, accepted",
+     [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "comb"}}, code="OK", note="class 1 components 0 holes",
+           generate={"name": "polyline_comb", "teeth": 2000})])
 case("svg_use_bomb", "<use> fan-out: 10 levels of 10 uses = 10^10 copies of a rect",
      [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "use.svg"}}, code="RESOURCE_EXHAUSTED", message="drawing.svg: SVG element <use> (line 1): <use> expansion makes more than 100000 elements",
            generate={"name": "svg_use_bomb", "levels": 10, "fanout": 10})])
