@@ -1,0 +1,251 @@
+// Service overhead (issue 7): the same Inbetween job (square -> hexagon meshed to ~1.6k vertices,
+// zhu17, N frames) streamed from one InbetweenServer over its in-process channel (what the
+// embedded CLI uses) and over loopback TCP gRPC, alternating runs in one process. Per transport:
+// frames per second (frames / time from the request to the last frame) and per-frame latency
+// (time between consecutive frames at the client, p50/p99). Then the unary latency while every
+// heavy slot runs an Inbetween stream: GetSession p50/p99 over loopback TCP.
+// Usage: service [--json FILE] [--frames N] [--runs R] [--max-edge E] [--boundary B]
+//                [--unary-calls N]
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "inbetween/v1/inbetween.grpc.pb.h"
+#include "nlohmann/json.hpp"
+#include "server/inbetween_server.h"
+
+namespace {
+
+namespace v1 = ::inbetween::v1;
+using Clock = std::chrono::steady_clock;
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+double Percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const size_t i = std::min(values.size() - 1, static_cast<size_t>(p * (values.size() - 1) + 0.5));
+  return values[i];
+}
+
+[[noreturn]] void Fail(const std::string& what, const grpc::Status& status) {
+  std::fprintf(stderr, "bench_service: %s: %s\n", what.c_str(), status.error_message().c_str());
+  std::exit(1);
+}
+
+// Creates the session, uploads the two drawings and builds the multimesh; returns it.
+v1::Session Prepare(v1::Inbetween::Stub& stub, const std::string& examples, double max_edge,
+                    uint32_t boundary) {
+  v1::Session session;
+  {
+    grpc::ClientContext context;
+    v1::CreateSessionRequest request;
+    request.set_display_name("bench-service");
+    request.mutable_parameters()->mutable_meshing()->set_max_edge_relative(max_edge);
+    request.mutable_parameters()->mutable_meshing()->set_boundary_vertices(boundary);
+    v1::CreateSessionResponse response;
+    if (auto s = stub.CreateSession(&context, request, &response); !s.ok()) Fail("create", s);
+    session = response.session();
+  }
+  for (const char* name : {"square.svg", "hexagon.svg"}) {
+    grpc::ClientContext context;
+    v1::PutDrawingRequest request;
+    request.set_session_id(session.id());
+    request.set_expected_version(session.version());
+    request.mutable_drawing()->set_name(name);
+    request.mutable_drawing()->set_svg(ReadFile(examples + "/" + name));
+    v1::PutDrawingResponse response;
+    if (auto s = stub.PutDrawing(&context, request, &response); !s.ok()) Fail(name, s);
+    session = response.session();
+  }
+  grpc::ClientContext context;
+  v1::BuildMultimeshRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  auto reader = stub.BuildMultimesh(&context, request);
+  v1::BuildMultimeshResponse response;
+  while (reader->Read(&response)) {
+    if (response.has_result()) session = response.result().session();
+  }
+  if (auto s = reader->Finish(); !s.ok()) Fail("build", s);
+  return session;
+}
+
+struct Run {
+  double seconds = 0;
+  std::vector<double> gaps_ms;  // between consecutive frames (the first: request -> frame 0)
+  int frames = 0;
+};
+
+Run StreamFrames(v1::Inbetween::Stub& stub, const std::string& id, int frames) {
+  grpc::ClientContext context;
+  v1::InbetweenRequest request;
+  request.set_session_id(id);
+  request.mutable_parameters()->set_frames(static_cast<uint32_t>(frames));
+  Run run;
+  const Clock::time_point start = Clock::now();
+  Clock::time_point last = start;
+  auto reader = stub.Inbetween(&context, request);
+  v1::InbetweenResponse response;
+  while (reader->Read(&response)) {
+    if (!response.has_frame()) continue;
+    const Clock::time_point now = Clock::now();
+    run.gaps_ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
+    last = now;
+    ++run.frames;
+  }
+  if (auto s = reader->Finish(); !s.ok()) Fail("inbetween", s);
+  run.seconds = std::chrono::duration<double>(last - start).count();
+  return run;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string json_path;
+  int frames = 120;
+  int runs = 5;
+  double max_edge = 0.028;
+  uint32_t boundary = 160;
+  int unary_calls = 400;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const char* value = i + 1 < argc ? argv[i + 1] : nullptr;
+    if (arg == "--json" && value) {
+      json_path = argv[++i];
+    } else if (arg == "--frames" && value) {
+      frames = std::atoi(argv[++i]);
+    } else if (arg == "--runs" && value) {
+      runs = std::atoi(argv[++i]);
+    } else if (arg == "--max-edge" && value) {
+      max_edge = std::atof(argv[++i]);
+    } else if (arg == "--boundary" && value) {
+      boundary = static_cast<uint32_t>(std::atoi(argv[++i]));
+    } else if (arg == "--unary-calls" && value) {
+      unary_calls = std::atoi(argv[++i]);
+    } else {
+      std::fprintf(stderr,
+                   "usage: service [--json FILE] [--frames N] [--runs R] [--max-edge E] "
+                   "[--boundary B] [--unary-calls N]\n");
+      return 2;
+    }
+  }
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  inbetween::server::ServerOptions options;
+  options.listen = "127.0.0.1:0";
+  options.service.heavy.max_running = static_cast<int>(cores);
+  options.shutdown_grace = std::chrono::milliseconds(100);
+  auto server = inbetween::server::InbetweenServer::Start(options);
+  if (!server.ok()) {
+    std::fprintf(stderr, "bench_service: %s\n", std::string(server.status().message()).c_str());
+    return 1;
+  }
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(inbetween::server::kMaxMessageBytes);
+  auto tcp_channel = grpc::CreateCustomChannel("127.0.0.1:" + std::to_string((*server)->port()),
+                                               grpc::InsecureChannelCredentials(), args);
+  auto inprocess = v1::Inbetween::NewStub((*server)->InProcessChannel());
+  auto tcp = v1::Inbetween::NewStub(tcp_channel);
+
+  const v1::Session session =
+      Prepare(*inprocess, std::string(INBETWEEN_SOURCE_DIR) + "/examples/square_hexagon", max_edge,
+              boundary);
+  const uint32_t vertices = session.multimesh_stats().vertices();
+  std::printf("multimesh: %u vertices, %u triangles; %d frames (zhu17), %d runs per transport\n",
+              vertices, session.multimesh_stats().triangles(), frames, runs);
+
+  // Warm-up (first factorization caches, connection set-up), then alternate the transports so
+  // both see the same machine load.
+  StreamFrames(*inprocess, session.id(), frames);
+  StreamFrames(*tcp, session.id(), frames);
+  struct Totals {
+    const char* name;
+    v1::Inbetween::Stub* stub;
+    double seconds = 0;
+    int frames = 0;
+    std::vector<double> gaps_ms;
+  };
+  Totals totals[] = {{"inprocess", inprocess.get()}, {"grpc", tcp.get()}};
+  for (int r = 0; r < runs; ++r) {
+    for (Totals& t : totals) {
+      Run run = StreamFrames(*t.stub, session.id(), frames);
+      t.seconds += run.seconds;
+      t.frames += run.frames;
+      t.gaps_ms.insert(t.gaps_ms.end(), run.gaps_ms.begin(), run.gaps_ms.end());
+    }
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  std::printf("\n%-10s %9s %12s %9s %9s\n", "transport", "vertices", "frames/s", "p50 ms",
+              "p99 ms");
+  for (const Totals& t : totals) {
+    const double fps = t.frames / t.seconds;
+    const double p50 = Percentile(t.gaps_ms, 0.50);
+    const double p99 = Percentile(t.gaps_ms, 0.99);
+    std::printf("%-10s %9u %12.1f %9.3f %9.3f\n", t.name, vertices, fps, p50, p99);
+    rows.push_back({{"transport", t.name},
+                    {"vertices", vertices},
+                    {"frames_per_second", fps},
+                    {"p50_ms", p50},
+                    {"p99_ms", p99}});
+  }
+  const double fps_in = rows[0]["frames_per_second"].get<double>();
+  const double fps_grpc = rows[1]["frames_per_second"].get<double>();
+  std::printf("gRPC loopback throughput vs in-process: %+.1f%% (target: no worse than -10%%)\n",
+              100.0 * (fps_grpc / fps_in - 1.0));
+
+  // Unary latency while every heavy slot (one per core) streams frames over TCP.
+  std::atomic<bool> stop{false};
+  std::atomic<int> heavy_streams{0};
+  std::vector<std::thread> heavy;
+  for (unsigned c = 0; c < cores; ++c) {
+    heavy.emplace_back([&] {
+      auto stub = v1::Inbetween::NewStub(tcp_channel);
+      while (!stop) {
+        StreamFrames(*stub, session.id(), frames);
+        ++heavy_streams;
+      }
+    });
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // let the streams start
+  std::vector<double> unary_ms;
+  for (int i = 0; i < unary_calls; ++i) {
+    grpc::ClientContext context;
+    v1::GetSessionRequest request;
+    request.set_session_id(session.id());
+    v1::GetSessionResponse response;
+    const Clock::time_point start = Clock::now();
+    if (auto s = tcp->GetSession(&context, request, &response); !s.ok()) Fail("get", s);
+    unary_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  stop = true;
+  for (std::thread& t : heavy) t.join();
+  const double unary_p50 = Percentile(unary_ms, 0.50);
+  const double unary_p99 = Percentile(unary_ms, 0.99);
+  std::printf(
+      "\nunary GetSession over loopback while %u heavy Inbetween streams run (%d streams "
+      "finished meanwhile): p50 %.3f ms, p99 %.3f ms, max %.3f ms (%d calls)\n",
+      cores, heavy_streams.load(), unary_p50, unary_p99,
+      *std::max_element(unary_ms.begin(), unary_ms.end()), unary_calls);
+
+  if (!json_path.empty()) {
+    std::ofstream out(json_path);
+    out << rows.dump(2) << "\n";
+    std::printf("wrote %s\n", json_path.c_str());
+  }
+  (*server)->Shutdown();
+  (*server)->Wait();
+  return 0;
+}
