@@ -333,6 +333,10 @@ try {
     assert.equal(await text(page, "#error-build"), "");
     assert.match(await text(page, "#mesh-stats"), /^\d+ vertices · \d+ triangles · 2 shapes/);
     await page.fill("#frames", "6");
+    await page.selectOption("#timing", "3"); // ease in/out: the timeline gets an ease slider
+    const ease = page.locator('#timeline input[aria-label="ease of segment 1"]');
+    await ease.fill("0.5");
+    assert.equal(await page.locator("#timeline .track output").last().textContent(), "0.50");
     await page.click("#inbetween");
     await page.waitForFunction(() => !document.getElementById("inbetween").disabled);
     assert.equal(await text(page, "#error-inbetween"), "");

@@ -724,6 +724,7 @@ function renderTimeline() {
       input.max = "1";
       input.step = "0.05";
       input.value = String(state.ease[s] ?? 1);
+      input.setAttribute("aria-label", `ease of segment ${s + 1}`);
       const out = document.createElement("output");
       out.textContent = Number(input.value).toFixed(2);
       input.addEventListener("input", () => {
