@@ -64,22 +64,24 @@ except inbetween.InbetweenError as e:
     assert "--max-heavy-jobs" in e.details or "heavy" in e.details, e.details
 
 cancel.set()
+cancelled_at = time.monotonic()
 worker.join(30)
 assert outcome.get("code") == "CANCELLED", outcome
 # Idle again within a second (bounded poll).
-deadline, idle = time.monotonic() + 1.0, False
+deadline, idle_after = cancelled_at + 1.0, None
 while time.monotonic() < deadline:
     if gauge("inbetween_heavy_jobs_running") == 0 and gauge("inbetween_heavy_queue_depth") == 0:
-        idle = True
+        idle_after = time.monotonic() - cancelled_at
         break
-    time.sleep(0.02)
-assert idle, "a heavy job was still running 1 s after the client cancelled"
+    time.sleep(0.01)
+assert idle_after is not None, "a heavy job was still running 1 s after the client cancelled"
 # The slot is free: a heavy call is admitted and completes.
 assert len(list(client.frames(other.id, frames=3))) == 4  # header + 3 frames
 after = client.get_session(session.id)
 assert after.version == session.version and after.stage == pb.STAGE_MULTIMESH, after
 client.close()
-print(f"cancelled after {iterations[0]} iterations; idle within 1 s")
+print(f"cancelled after {iterations[0]} iterations; idle {idle_after * 1000:.0f} ms after the "
+      "cancel (polled, upper bound)")
 PYEOF
 grep -q "rpc=OptimizeComesh.*status=CANCELLED" "$WORK/server.log" || { cat "$WORK/server.log"; exit 1; }
 echo "ok"

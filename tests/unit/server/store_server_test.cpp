@@ -63,6 +63,8 @@ TEST(StoreServerTest, IdleSessionsAreEvictedFromMemoryAndReloadOnTheNextCall) {
     }
     ASSERT_EQ(server->store().CachedCount(), 0u) << "the idle session stayed in memory";
     EXPECT_EQ(server->store().Count(), 1u);
+    EXPECT_NE(server->RenderMetrics().find("\ninbetween_cached_sessions 0\n"), std::string::npos)
+        << server->RenderMetrics();
     grpc::ClientContext context;
     v1::GetSessionRequest request;
     request.set_session_id(session.id());
