@@ -541,7 +541,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     bool accepted = false;
     double f_new = f;
     VectorXd z_new;
-    for (int b = 0; b <= options.max_backtracks; ++b, step *= 0.5) {
+    for (int b = 0; b <= options.max_backtracks; ++b) {
       z_new = z + step * d;
       layout.Scatter(z_new, &trial);
       f_new = objective->Evaluate(trial, &trial_grad, &trial_energies);
@@ -550,6 +550,15 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
         accepted = true;
         break;
       }
+      // Next trial: the minimizer of the quadratic through f, slope and f_new, kept within
+      // [0.1, 0.5] of the failed step (plain halving when f_new is not finite).
+      double next = 0.5 * step;
+      if (std::isfinite(f_new)) {
+        const double curvature = f_new - f - slope * step;
+        if (curvature > 0.0) next = -slope * step * step / (2.0 * curvature);
+        next = std::clamp(next, 0.1 * step, 0.5 * step);
+      }
+      step = next;
     }
     if (!accepted) {
       stats->stop_reason = "line_search";

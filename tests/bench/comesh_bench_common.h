@@ -21,14 +21,15 @@ struct ComeshBenchArgs {
   solver::ComeshOptions options;
 };
 
-// Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure, --tolerance R,
+// Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
+// --scale-by-inverse, --history M, --tolerance R,
 // --verbose and (when `with_max_vertices`) --max-vertices N; exits 2 with a usage line otherwise.
 inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max_vertices) {
   ComeshBenchArgs args;
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
-                 "[--tolerance R] [--verbose] [--json FILE]\n",
+                 "[--scale-by-inverse] [--history M] [--tolerance R] [--verbose] [--json FILE]\n",
                  argv[0], with_max_vertices ? "[--max-vertices N] " : "");
     std::exit(2);
   };
@@ -47,6 +48,10 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.map_weight = std::atof(next());
     } else if (a == "--blend") {
       args.options.blend = std::atof(next());
+    } else if (a == "--scale-by-inverse") {
+      args.options.scaling_by_inverse = true;
+    } else if (a == "--history") {
+      args.options.history = std::atoi(next());
     } else if (a == "--no-cure") {
       args.options.cure = false;
     } else if (a == "--tolerance") {
