@@ -20,7 +20,9 @@ for _ in 1 2 3 4 5; do
     kill -0 "$REDIS_PID" 2>/dev/null || break
     sleep 0.05
   done
-  redis-cli -h 127.0.0.1 -p "$port" ping 2>/dev/null | grep -q PONG && break
+  # Ours only (another test's redis-server may have taken the port first; ours then exits).
+  redis-cli -h 127.0.0.1 -p "$port" info server 2>/dev/null | tr -d '\r' |
+    grep -qx "process_id:$REDIS_PID" && break
   kill -9 "$REDIS_PID" 2>/dev/null || true
   port=""
 done

@@ -2,6 +2,7 @@
 // the object goes away. Tests skip (GTEST_SKIP) only when the redis-server binary is absent.
 #pragma once
 
+#include <hiredis/hiredis.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
@@ -64,7 +65,8 @@ class RedisProcess {
       // Up to ~5 s for the server to accept connections.
       for (int i = 0; i < 100; ++i) {
         if (RedisSessionStore::Open(url).ok()) {
-          url_ = url;
+          // Another test's redis-server may hold the port (ours then exits): only ours counts.
+          if (ServerPid(port) == pid_) url_ = url;
           break;
         }
         int status = 0;
@@ -82,6 +84,23 @@ class RedisProcess {
   RedisProcess& operator=(const RedisProcess&) = delete;
 
   const std::string& url() const { return url_; }
+
+  // The process id the redis-server on `port` reports (INFO server), -1 if none answers.
+  static pid_t ServerPid(int port) {
+    redisContext* c = redisConnect("127.0.0.1", port);
+    pid_t pid = -1;
+    if (c != nullptr && c->err == 0) {
+      auto* reply = static_cast<redisReply*>(redisCommand(c, "INFO server"));
+      if (reply != nullptr && reply->type == REDIS_REPLY_STRING) {
+        const std::string info(reply->str, reply->len);
+        const size_t at = info.find("process_id:");
+        if (at != std::string::npos) pid = static_cast<pid_t>(std::atol(info.c_str() + at + 11));
+      }
+      if (reply != nullptr) freeReplyObject(reply);
+    }
+    if (c != nullptr) redisFree(c);
+    return pid;
+  }
 
   void Stop() {
     if (pid_ > 0) {
