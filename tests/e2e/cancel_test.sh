@@ -3,7 +3,8 @@
 # OptimizeComesh (pentagon -> star, iteration limits at their maximum) holds the slot; a second
 # heavy call is RESOURCE_EXHAUSTED with retry-after-ms; the client cancels the optimization and
 # the server is idle again within a second (metrics: no heavy job running, queue empty), a new
-# heavy call is admitted, and the cancelled optimization stored nothing.
+# heavy call is admitted, and the cancelled optimization stored nothing. A 1 s deadline on the
+# same optimization ends it with DEADLINE_EXCEEDED and the server is idle again within a second.
 source "$(dirname "$0")/lib/common.sh"
 PY=/usr/bin/python3
 "$INBETWEEN_SRC/client/python/generate_stubs.sh" "$WORK/stubs"
@@ -79,9 +80,26 @@ assert idle_after is not None, "a heavy job was still running 1 s after the clie
 assert len(list(client.frames(other.id, frames=3))) == 4  # header + 3 frames
 after = client.get_session(session.id)
 assert after.version == session.version and after.stage == pb.STAGE_MULTIMESH, after
+
+# A deadline stops the work the same way: DEADLINE_EXCEEDED, then idle within a second.
+with inbetween.Client(address, timeout=1.0) as hurried:
+    try:
+        hurried.optimize(session, max_outer_iterations=1000, max_inner_iterations=100000,
+                         tolerance=1e-15)
+        raise SystemExit("a minutes-long optimization finished within its 1 s deadline")
+    except inbetween.InbetweenError as e:
+        assert e.code == "DEADLINE_EXCEEDED", e
+expired_at = time.monotonic()
+deadline, idle_after_deadline = expired_at + 1.0, None
+while time.monotonic() < deadline:
+    if gauge("inbetween_heavy_jobs_running") == 0:
+        idle_after_deadline = time.monotonic() - expired_at
+        break
+    time.sleep(0.01)
+assert idle_after_deadline is not None, "still running 1 s after the deadline"
 client.close()
 print(f"cancelled after {iterations[0]} iterations; idle {idle_after * 1000:.0f} ms after the "
-      "cancel (polled, upper bound)")
+      f"cancel, {idle_after_deadline * 1000:.0f} ms after the deadline (polled, upper bounds)")
 PYEOF
 grep -q "rpc=OptimizeComesh.*status=CANCELLED" "$WORK/server.log" || { cat "$WORK/server.log"; exit 1; }
 echo "ok"
