@@ -135,22 +135,82 @@ std::optional<Segment> ShortestCut(const Points& hole, const Points& outer,
 // builder clips the overhang), so an end point that rounding put a hair inside the shape still
 // reaches the boundary. The overhang is 1% of the cut, less if that would leave the hole or
 // re-enter the shape; an end whose overhang cannot be placed (a slit hole) stays on the boundary.
+template <class OutsideShape>
+Point Overhang(const Point& end, const Point& direction, double length, OutsideShape outside) {
+  for (double step = 0.01 * length, i = 0; i < 8; ++i, step /= 4) {
+    if (outside(end + step * direction)) return end + step * direction;
+  }
+  return end;
+}
+
 Points CrossBothEnds(const Segment& cut, const Points& hole, const Points& outer) {
   const Point u = (cut.b - cut.a).normalized();
-  Point a = cut.a, b = cut.b;
-  for (double step = 0.01 * (cut.b - cut.a).norm(), i = 0; i < 8; ++i, step /= 4) {
-    if (PolygonContains(hole, cut.a - step * u)) {
-      a = cut.a - step * u;
-      break;
+  const double length = (cut.b - cut.a).norm();
+  return {Overhang(cut.a, -u, length, [&](const Point& p) { return PolygonContains(hole, p); }),
+          Overhang(cut.b, u, length, [&](const Point& p) { return !PolygonContains(outer, p); })};
+}
+
+// A chord of a component's outer loop: both ends overhang outwards.
+Points CrossOutline(const Segment& cut, const Points& outer) {
+  const Point u = (cut.b - cut.a).normalized();
+  const double length = (cut.b - cut.a).norm();
+  const auto outside = [&](const Point& p) { return !PolygonContains(outer, p); };
+  return {Overhang(cut.a, -u, length, outside), Overhang(cut.b, u, length, outside)};
+}
+
+// The shortest straight chord across component `c` of `g` (its largest by outer area) that stays
+// inside and leaves at least `min_part` of the component's outer area on each side: the
+// narrowest neck, where a shape that becomes two pieces in another drawing most likely parts.
+std::optional<Segment> SplitCut(const BoundaryGraph& g, int outer_loop,
+                                const std::vector<const Points*>& holes,
+                                const std::vector<Segment>& obstacles, double min_part,
+                                const AutoTopologyOptions& options) {
+  const Points& loop = g.loops[outer_loop].points;
+  Points q;  // vertices and edge midpoints, thinned to at most kMaxPoints
+  for (size_t i = 0; i < loop.size(); ++i) {
+    q.push_back(loop[i]);
+    q.push_back(0.5 * (loop[i] + loop[(i + 1) % loop.size()]));
+  }
+  constexpr size_t kMaxPoints = 400;
+  if (q.size() > kMaxPoints) {
+    const size_t stride = (q.size() + kMaxPoints - 1) / kMaxPoints;
+    Points thin;
+    for (size_t i = 0; i < q.size(); i += stride) thin.push_back(q[i]);
+    q = std::move(thin);
+  }
+  const size_t m = q.size();
+  const auto cross = [](const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); };
+  std::vector<double> prefix(m + 1, 0.0);  // prefix[k] = sum of cross(q_i, q_i+1), i < k
+  for (size_t i = 0; i < m; ++i) prefix[i + 1] = prefix[i] + cross(q[i], q[(i + 1) % m]);
+  const double total = 0.5 * prefix[m];
+  if (!(total > 0)) return std::nullopt;
+  std::vector<std::pair<double, std::pair<int, int>>> chords;
+  for (size_t i = 0; i < m; ++i) {
+    for (size_t j = i + 2; j < m; ++j) {
+      const double part = 0.5 * (prefix[j] - prefix[i] + cross(q[j], q[i]));
+      if (std::min(part, total - part) < min_part * total) continue;
+      chords.push_back({(q[j] - q[i]).squaredNorm(), {static_cast<int>(i), static_cast<int>(j)}});
     }
   }
-  for (double step = 0.01 * (cut.b - cut.a).norm(), i = 0; i < 8; ++i, step /= 4) {
-    if (!PolygonContains(outer, cut.b + step * u)) {
-      b = cut.b + step * u;
-      break;
+  const size_t keep = std::min(chords.size(), static_cast<size_t>(options.max_pair_candidates));
+  std::partial_sort(chords.begin(), chords.begin() + keep, chords.end(),
+                    [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (size_t k = 0; k < keep; ++k) {
+    const Point& a = q[chords[k].second.first];
+    const Point& b = q[chords[k].second.second];
+    if (CutStaysInside(a, b, obstacles, loop, holes)) return Segment{a, b};
+  }
+  return std::nullopt;
+}
+
+std::vector<Segment> LoopSegments(const BoundaryGraph& g) {
+  std::vector<Segment> out;
+  for (const BoundaryLoop& loop : g.loops) {
+    for (size_t i = 0; i < loop.points.size(); ++i) {
+      out.push_back({loop.points[i], loop.points[(i + 1) % loop.points.size()]});
     }
   }
-  return {a, b};
+  return out;
 }
 
 }  // namespace
@@ -164,19 +224,62 @@ absl::StatusOr<AutoTopologyResult> ProposeTopology(const std::vector<Drawing>& d
     if (!g.ok()) return g.status();
     graphs.push_back(*std::move(g));
   }
-  for (size_t d = 1; d < graphs.size(); ++d) {
-    if (graphs[d].equivalence.components != graphs[0].equivalence.components) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "auto-topology: drawing 1 has ", graphs[0].equivalence.ToString(), ", drawing ", d + 1,
-          " has ", graphs[d].equivalence.ToString(),
-          "; it only cuts extra holes: draw a cut that splits a component (or an opening) in "
-          "the drawing with fewer components, in the project file's \"cuts\"/\"openings\""));
+  AutoTopologyResult result;
+  result.cuts.resize(drawings.size());
+
+  // 1. Components: a drawing with fewer pieces than another is split at its narrowest necks.
+  int num_components = 0;
+  size_t most = 0;
+  for (size_t d = 0; d < graphs.size(); ++d) {
+    if (graphs[d].equivalence.components > num_components) {
+      num_components = graphs[d].equivalence.components, most = d;
     }
   }
-  const int num_components = graphs[0].equivalence.components;
+  for (size_t d = 0; d < graphs.size(); ++d) {
+    Drawing edited = drawings[d];
+    while (graphs[d].equivalence.components < num_components) {
+      const Components comps = ComponentsOf(graphs[d]);
+      int largest = -1;
+      double largest_area = 0;
+      for (int c = 0; c < graphs[d].equivalence.components; ++c) {
+        if (comps.outer_loop[c] < 0) continue;
+        const double area = PolygonSignedArea(graphs[d].loops[comps.outer_loop[c]].points);
+        if (largest < 0 || area > largest_area) largest = c, largest_area = area;
+      }
+      std::vector<const Points*> holes;
+      std::optional<Segment> cut;
+      if (largest >= 0) {
+        for (int h : comps.hole_loops[largest]) holes.push_back(&graphs[d].loops[h].points);
+        cut = SplitCut(graphs[d], comps.outer_loop[largest], holes, LoopSegments(graphs[d]),
+                       options.min_split_part, options);
+      }
+      if (!cut) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "auto-topology: drawing ", d + 1, " has ", graphs[d].equivalence.ToString(),
+            ", drawing ", most + 1, " has ", graphs[most].equivalence.ToString(),
+            "; no straight cut splits a piece of drawing ", d + 1,
+            " into two parts: draw a cut (a polyline across it) in its \"cuts\" in the project "
+            "file"));
+      }
+      Points drawn = CrossOutline(*cut, graphs[d].loops[comps.outer_loop[largest]].points);
+      edited.cuts.push_back(drawn);
+      result.cuts[d].push_back(std::move(drawn));
+      result.notes.push_back(absl::StrFormat(
+          "drawing %d: cut across the piece from (%.6g, %.6g) to (%.6g, %.6g), length %.6g", d + 1,
+          cut->a.x(), cut->a.y(), cut->b.x(), cut->b.y(), (cut->b - cut->a).norm()));
+      const int before = graphs[d].equivalence.components;
+      absl::StatusOr<BoundaryGraph> rebuilt = BuildBoundaries(edited, static_cast<int>(d) + 1);
+      if (!rebuilt.ok() || rebuilt->equivalence.components <= before) {
+        return absl::InternalError(absl::StrCat(
+            "auto-topology: the cut proposed to split drawing ", d + 1, " does not split it (",
+            rebuilt.ok() ? rebuilt->equivalence.ToString() : rebuilt.status().message(), ")"));
+      }
+      graphs[d] = *std::move(rebuilt);
+    }
+  }
 
-  AutoTopologyResult result;
-  result.target = graphs[0].equivalence;
+  // 2. Holes, per component rank.
+  result.target = graphs[most].equivalence;
   for (int k = 0; k < num_components; ++k) {
     for (const BoundaryGraph& g : graphs) {
       result.target.holes_per_component[k] =
@@ -185,18 +288,12 @@ absl::StatusOr<AutoTopologyResult> ProposeTopology(const std::vector<Drawing>& d
   }
   result.target.holes = std::accumulate(result.target.holes_per_component.begin(),
                                         result.target.holes_per_component.end(), 0);
-  result.cuts.resize(drawings.size());
 
   for (size_t d = 0; d < graphs.size(); ++d) {
     const BoundaryGraph& g = graphs[d];
     if (g.equivalence == result.target) continue;
     const Components comps = ComponentsOf(g);
-    std::vector<Segment> obstacles;
-    for (const BoundaryLoop& loop : g.loops) {
-      for (size_t i = 0; i < loop.points.size(); ++i) {
-        obstacles.push_back({loop.points[i], loop.points[(i + 1) % loop.points.size()]});
-      }
-    }
+    std::vector<Segment> obstacles = LoopSegments(g);
     for (int k = 0; k < num_components; ++k) {
       const int c = comps.by_rank[k];
       std::vector<int> holes = comps.hole_loops[c];

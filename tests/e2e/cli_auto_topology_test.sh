@@ -53,12 +53,26 @@ assert 80 <= x0 <= 90 and y1 > 60, p["drawings"][1]["cuts"]  # small hole -> bot
 PY
 [[ ! -e holes_mesh/project.json ]]
 
-# Different component counts are refused with advice (exit 3), nothing written.
-printf '<svg xmlns="http://www.w3.org/2000/svg"><rect x="0" y="0" width="10" height="10"/><rect x="20" y="0" width="10" height="10"/></svg>\n' > two.svg
+# One piece vs two: the dumbbell is cut across its bar (4 high) and animates into two squares.
+svg "M0 0H20V8H30V0H50V20H30V12H20V20H0Z" dumbbell.svg
+svg "M0 0H20V20H0Z M30 0H50V20H30Z" apart.svg
+"$CLI_BIN" animate dumbbell.svg apart.svg --auto-topology --frames 5 --format json --out split \
+  > /dev/null 2> split.err
+grep -q "auto-topology: drawing 1: cut across the piece" split.err
+python3 "$lib/check_frames.py" split/frames.json 5 0,4
+python3 - <<'PY'
+import json
+(x0, y0), (x1, y1) = json.load(open("split/project.json"))["drawings"][0]["cuts"][0]
+assert abs(x0 - x1) < 1e-9 and 20 <= x0 <= 30 and abs(abs(y1 - y0) - 4.08) < 1e-6, (x0, y0, x1, y1)
+PY
+
+# A thin ring cannot be split by a straight cut: refused with advice (exit 3), nothing written.
+svg "M10 50A40 40 0 1 0 90 50A40 40 0 1 0 10 50Z M12 50A38 38 0 1 0 88 50A38 38 0 1 0 12 50Z" thin_ring.svg
+svg "M0 0H10V10H0Z M2 2H4V4H2Z M20 0H30V10H20Z M22 2H24V4H22Z" two_rings.svg
 set +e
-"$CLI_BIN" animate disc.svg two.svg --auto-topology --out never2 -q 2> comp.err; code=$?
+"$CLI_BIN" animate thin_ring.svg two_rings.svg --auto-topology --out never2 -q 2> comp.err; code=$?
 set -e
-[[ $code -eq 3 ]] || { echo "exit $code for differing components"; cat comp.err; exit 1; }
-grep -q "drawing 2 has 2 components" comp.err
+[[ $code -eq 3 ]] || { echo "exit $code for an unsplittable ring"; cat comp.err; exit 1; }
+grep -q "no straight cut splits a piece of drawing 1" comp.err
 [[ ! -e never2 ]]
 echo ok

@@ -140,14 +140,71 @@ TEST(AutoTopologyTest, ExistingCutsCountAlready) {
   EXPECT_TRUE(r->cuts[0].empty());
 }
 
-TEST(AutoTopologyTest, DifferentComponentCountsAreRefusedWithAdvice) {
-  const Drawing one{{Rect(0, 0, 10, 10)}};
-  const Drawing two{{Rect(0, 0, 10, 10), Rect(20, 0, 30, 10)}};
-  absl::StatusOr<AutoTopologyResult> r = ProposeTopology({one, two});
+TEST(AutoTopologyTest, OnePieceIsSplitAtItsNeckToMatchTwo) {
+  // A dumbbell: two 20x20 squares joined by a bar 4 high and 10 long; the other drawing has the
+  // two squares apart. The cut goes across the bar (4 long), not across a square.
+  const Drawing dumbbell{{Outline{{{0, 0},
+                                   {20, 0},
+                                   {20, 8},
+                                   {30, 8},
+                                   {30, 0},
+                                   {50, 0},
+                                   {50, 20},
+                                   {30, 20},
+                                   {30, 12},
+                                   {20, 12},
+                                   {20, 20},
+                                   {0, 20}}}}};
+  const Drawing apart{{Rect(0, 0, 20, 20), Rect(30, 0, 50, 20)}};
+  ASSERT_GT(PolygonSignedArea(dumbbell.outlines[0].points), 0);
+  absl::StatusOr<AutoTopologyResult> r = ProposeTopology({apart, dumbbell});
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->target.components, 2);
+  EXPECT_TRUE(r->cuts[0].empty());
+  ASSERT_EQ(r->cuts[1].size(), 1u);
+  const Points& cut = r->cuts[1][0];
+  EXPECT_NEAR(cut[0].x(), cut[1].x(), 1e-9);  // vertical, across the bar
+  EXPECT_GE(cut[0].x(), 20.0);
+  EXPECT_LE(cut[0].x(), 30.0);
+  EXPECT_NEAR(std::abs(cut[1].y() - cut[0].y()), 4.0 * 1.02, 1e-9);
+  EXPECT_THAT(r->notes[0], HasSubstr("drawing 2: cut across the piece"));
+  ExpectOneClass({apart, dumbbell}, *r);
+}
+
+TEST(AutoTopologyTest, SplitThenHoles) {
+  // Drawing 1: one ring-shaped piece with a neck; drawing 2: two plain squares. After the split
+  // drawing 1 has a hole in one piece that drawing 2 lacks, which the hole step then cuts.
+  Drawing ringbell{{Outline{{{0, 0},
+                             {20, 0},
+                             {20, 8},
+                             {30, 8},
+                             {30, 0},
+                             {50, 0},
+                             {50, 20},
+                             {30, 20},
+                             {30, 12},
+                             {20, 12},
+                             {20, 20},
+                             {0, 20}}},
+                    Rect(5, 5, 15, 15, true)}};
+  const Drawing apart{{Rect(0, 0, 20, 20), Rect(30, 0, 50, 20)}};
+  absl::StatusOr<AutoTopologyResult> r = ProposeTopology({ringbell, apart});
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->target.components, 2);
+  EXPECT_EQ(r->target.holes, 0);
+  EXPECT_EQ(r->cuts[0].size(), 2u);
+  ExpectOneClass({ringbell, apart}, *r);
+}
+
+TEST(AutoTopologyTest, NoNeckToSplitIsRefusedWithAdvice) {
+  // A thin ring has no chord inside it that splits it (every chord crosses the hole).
+  const Drawing ring{{Circle(50, 50, 40, 64), Circle(50, 50, 38, 64, true)}};
+  const Drawing two{{Rect(0, 0, 10, 10, false), Rect(20, 0, 30, 10, false), Rect(2, 2, 4, 4, true),
+                     Rect(22, 2, 24, 4, true)}};
+  absl::StatusOr<AutoTopologyResult> r = ProposeTopology({ring, two});
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_THAT(r.status().message(), HasSubstr("drawing 1 has 1 component, 0 holes"));
-  EXPECT_THAT(r.status().message(), HasSubstr("drawing 2 has 2 components"));
+  EXPECT_THAT(r.status().message(), HasSubstr("drawing 1 has 1 component, 1 hole"));
   EXPECT_THAT(r.status().message(), HasSubstr("\"cuts\""));
 }
 
