@@ -12,6 +12,11 @@ timeout 240 "$RUNNER" --server "$SERVER_ADDR" --token tok-main --other-token tok
   --healthy-token tok-healthy --cases "$INBETWEEN_SRC/tests/data/bad" \
   --examples "$INBETWEEN_SRC/examples" "$@"
 kill -0 "$SERVER_PID" || { cat "$WORK/server.log"; echo "server died"; exit 1; }
+# Memory stays bounded by the limits: the peak resident set over the whole catalogue (largest
+# allowed drawing, 10M-vertex message refused, bombs refused) stays under MAX_RSS_MB.
+peak_kb=$(awk '/^VmHWM:/{print $2}' "/proc/$SERVER_PID/status")
+echo "server peak RSS: $((peak_kb / 1024)) MB"
+(( peak_kb / 1024 < ${MAX_RSS_MB:-2048} )) || { echo "server peak RSS above ${MAX_RSS_MB:-2048} MB"; exit 1; }
 kill -TERM "$SERVER_PID"
 for _ in $(seq 1 200); do kill -0 "$SERVER_PID" 2>/dev/null || break; sleep 0.05; done
 if kill -0 "$SERVER_PID" 2>/dev/null; then echo "server did not stop on SIGTERM"; exit 1; fi

@@ -145,6 +145,9 @@ case("drawing_10m_vertices", "a 10,000,000-vertex polyline drawing (200 MB seria
 case("drawing_points_limit", "1,000,001 points: one over --max-drawing-points",
      [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "big"}}, code="RESOURCE_EXHAUSTED", message="--max-drawing-points",
            generate={"name": "polyline_circle", "points": 1000001})])
+case("drawing_max_points", "a 1,000,000-point circle: exactly the --max-drawing-points limit, accepted (the server's peak memory is checked by bad_input_test.sh)",
+     [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "max"}}, code="OK", note="class 1 components 0 holes",
+           generate={"name": "polyline_circle", "points": 1000000})])
 case("svg_flatten_bomb", "400 bytes of SVG (huge circles, tiny tolerance) that would flatten to over 10M points",
      [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "bomb.svg"}, "flatten_tolerance": 1e-6}, code="RESOURCE_EXHAUSTED", message="drawing.svg: SVG has more than 1000000 points once its curves are flattened",
            generate={"name": "svg_flatten_bomb", "circles": 10, "radius": 1e8})])
