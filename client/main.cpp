@@ -166,6 +166,8 @@ int main(int argc, char** argv) {
       "  inbetween animate --project walk.json --out out/ --format gif,webp,lottie --size 640\n"
       "  inbetween --server 127.0.0.1:50051 animate a.svg b.svg c.svg --out out/ --method alexa\n"
       "  inbetween animate a.svg b.svg c.svg --out out/ --key-times 0,0.3,1 --tau 0.05\n"
+      "  inbetween animate disc.svg ring.svg --out out/ --auto-topology   (cuts -> "
+      "out/project.json)\n"
       "Writes OUT/frames.json, OUT/frame_NNNN.svg, OUT/animation.gif ...; prints the path of "
       "frames.json (and the session id when --server is used).");
 
