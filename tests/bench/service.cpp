@@ -3,7 +3,8 @@
 // embedded CLI uses) and over loopback TCP gRPC, alternating runs in one process. Per transport:
 // frames per second (frames / time from the request to the last frame) and per-frame latency
 // (time between consecutive frames at the client, p50/p99). Then the unary latency while every
-// heavy slot runs an Inbetween stream: GetSession p50/p99 over loopback TCP.
+// heavy slot runs an Inbetween stream: GetSession p50/p99 over loopback TCP. The solver alone
+// (the handler's work without RPC) is printed for reference.
 // Usage: service [--json FILE] [--frames N] [--runs R] [--max-edge E] [--boundary B]
 //                [--unary-calls N]
 #include <grpcpp/grpcpp.h>
@@ -22,6 +23,11 @@
 #include "inbetween/v1/inbetween.grpc.pb.h"
 #include "nlohmann/json.hpp"
 #include "server/inbetween_server.h"
+#include "server/parameters.h"
+#include "server/stiffness_field.h"
+#include "solver/core/cancel.h"
+#include "solver/interp/inbetweener.h"
+#include "solver/interp/timing.h"
 
 namespace {
 
@@ -111,12 +117,44 @@ Run StreamFrames(v1::Inbetween::Stub& stub, const std::string& id, int frames) {
   return run;
 }
 
+// The same job without any RPC: what the Inbetween handler runs (plan, schedule, Inbetweener on
+// the stored multimesh, one Solve per frame), timed the same way.
+Run SolveDirect(const inbetween::solver::Multimesh& mesh, int num_drawings, int frames) {
+  namespace solver = ::inbetween::solver;
+  v1::InbetweenParameters parameters;
+  parameters.set_frames(static_cast<uint32_t>(frames));
+  Run run;
+  const Clock::time_point start = Clock::now();
+  Clock::time_point last = start;
+  auto plan = inbetween::server::ToInbetweenPlan(parameters, "parameters");
+  auto timing = inbetween::server::ToTimingOptions(parameters, num_drawings, "parameters");
+  if (!plan.ok() || !timing.ok()) std::exit(1);
+  plan->options.stiffness = inbetween::server::StiffnessPerTriangle(mesh, parameters.stiffness());
+  auto schedule = solver::MakeSchedule(num_drawings, plan->frames, {}, *timing);
+  auto inbetweener = solver::Inbetweener::Create(mesh, plan->options);
+  if (!schedule.ok() || !inbetweener.ok()) std::exit(1);
+  solver::CancelToken token;
+  solver::Frame previous;
+  for (int i = 0; i < plan->frames; ++i) {
+    solver::FrameReport report;
+    auto frame = inbetweener->Solve(schedule->frames[i].weights, previous, &token, &report);
+    if (!frame.ok()) std::exit(1);
+    previous = *std::move(frame);
+    const Clock::time_point now = Clock::now();
+    run.gaps_ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
+    last = now;
+    ++run.frames;
+  }
+  run.seconds = std::chrono::duration<double>(last - start).count();
+  return run;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string json_path;
-  int frames = 120;
-  int runs = 5;
+  int frames = 240;
+  int runs = 15;
   double max_edge = 0.028;
   uint32_t boundary = 160;
   int unary_calls = 400;
@@ -177,10 +215,16 @@ int main(int argc, char** argv) {
     int frames = 0;
     std::vector<double> gaps_ms;
   };
-  Totals totals[] = {{"inprocess", inprocess.get()}, {"grpc", tcp.get()}};
+  // Plus the solver alone (no RPC; printed, not a JSON row) on the multimesh the server stored.
+  auto stored = (*server)->store().Get(session.id());
+  if (!stored.ok() || !stored->multimesh) return 1;
+  const int num_drawings = session.drawings_size();
+  SolveDirect(*stored->multimesh, num_drawings, frames);
+  Totals totals[] = {{"inprocess", inprocess.get()}, {"grpc", tcp.get()}, {"solver", nullptr}};
   for (int r = 0; r < runs; ++r) {
     for (Totals& t : totals) {
-      Run run = StreamFrames(*t.stub, session.id(), frames);
+      Run run = t.stub ? StreamFrames(*t.stub, session.id(), frames)
+                       : SolveDirect(*stored->multimesh, num_drawings, frames);
       t.seconds += run.seconds;
       t.frames += run.frames;
       t.gaps_ms.insert(t.gaps_ms.end(), run.gaps_ms.begin(), run.gaps_ms.end());
@@ -194,6 +238,7 @@ int main(int argc, char** argv) {
     const double p50 = Percentile(t.gaps_ms, 0.50);
     const double p99 = Percentile(t.gaps_ms, 0.99);
     std::printf("%-10s %9u %12.1f %9.3f %9.3f\n", t.name, vertices, fps, p50, p99);
+    if (t.stub == nullptr) continue;  // the JSON rows are the two transports
     rows.push_back({{"transport", t.name},
                     {"vertices", vertices},
                     {"frames_per_second", fps},
@@ -202,8 +247,11 @@ int main(int argc, char** argv) {
   }
   const double fps_in = rows[0]["frames_per_second"].get<double>();
   const double fps_grpc = rows[1]["frames_per_second"].get<double>();
+  const double fps_solver = totals[2].frames / totals[2].seconds;
   std::printf("gRPC loopback throughput vs in-process: %+.1f%% (target: no worse than -10%%)\n",
               100.0 * (fps_grpc / fps_in - 1.0));
+  std::printf("vs the solver alone: in-process %+.1f%%, gRPC loopback %+.1f%%\n",
+              100.0 * (fps_in / fps_solver - 1.0), 100.0 * (fps_grpc / fps_solver - 1.0));
 
   // Unary latency while every heavy slot (one per core) streams frames over TCP.
   std::atomic<bool> stop{false};
