@@ -155,6 +155,9 @@ int main(int argc, char** argv) {
   animate_cmd->add_option("--fill", fill,
                           "Fill colour (#rrggbb) instead of the drawings' own fill colours");
   animate_cmd->add_flag("--mesh", overlay, "Draw the triangle mesh over every frame");
+  std::string animate_overlay;
+  animate_cmd->add_option("--overlay", animate_overlay, "mesh: same as --mesh; none: no overlay")
+      ->check(CLI::IsMember({"mesh", "none"}));
   animate_cmd->add_flag("--transparent", animate.transparent, "Transparent background");
   animate_cmd->add_flag("--optimize", animate.optimize, "Optimize the comesh before inbetweening");
   animate_cmd->add_flag("--auto-topology", animate.auto_topology,
@@ -213,6 +216,9 @@ int main(int argc, char** argv) {
                          "Fill colour (#rrggbb); default: the drawings' fills in frames.json, else "
                          "#3b7dd8");
   render_cmd->add_flag("--mesh", render.mesh_overlay, "Draw the triangle mesh");
+  std::string render_overlay;
+  render_cmd->add_option("--overlay", render_overlay, "mesh: same as --mesh; none: no overlay")
+      ->check(CLI::IsMember({"mesh", "none"}));
   render_cmd->add_flag("--transparent", render.transparent, "Transparent background");
   render_cmd->footer("Examples:\n  inbetween render out/frames.json --out out/ --format png,gif");
 
@@ -277,6 +283,7 @@ int main(int argc, char** argv) {
   };
   if (*render_cmd) {
     if (render_cmd->count("--fill")) render.fill = render_fill;
+    if (render_overlay == "mesh") render.mesh_overlay = true;
     return report(inbetween::client::RunRender(render, bar));
   }
   if (*init_cmd) {
@@ -313,7 +320,8 @@ int main(int argc, char** argv) {
       if (!formats.empty()) animate.formats = formats;
       if (width != 0) animate.width = width;
       if (fps != 0) animate.fps = fps;
-      if (overlay) animate.mesh_overlay = true;
+      if (overlay || animate_overlay == "mesh") animate.mesh_overlay = true;
+      if (animate_overlay == "none") animate.mesh_overlay = false;
     }
     status = inbetween::client::RunAnimate(animate, ctx);
   } else if (*mesh_cmd) {

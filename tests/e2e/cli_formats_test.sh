@@ -19,6 +19,10 @@ grep -q "fill=\"$fill\"" "$ex/1_round.svg" || { echo "fill $fill is not the draw
 "$CLI_BIN" render all/frames.json --out over --format svg --fill '#00ff00' -q > /dev/null
 grep -q 'fill="#00ff00"' over/frame_0000.svg
 ! grep -q "fill=\"$fill\"" over/frame_0000.svg
+# --overlay mesh draws the triangle edges (as --mesh), the default does not.
+"$CLI_BIN" render all/frames.json --out overlay --format svg --overlay mesh -q > /dev/null
+grep -q 'stroke="#222"' overlay/frame_0003.svg
+! grep -q 'stroke="#222"' over/frame_0003.svg
 
 # Key times from the command line: 3 drawings, 13 frames, keys at t = 0, 0.25, 1.
 "$CLI_BIN" animate --project "$ex/project.json" --frames 13 --key-times 0,0.25,1 \
