@@ -186,43 +186,55 @@ absl::StatusOr<redisContext*> RedisSessionStore::Connect() const {
 }
 
 absl::StatusOr<RedisSessionStore::Reply> RedisSessionStore::Command(
-    const std::vector<std::string>& args) const {
-  redisContext* c = nullptr;
-  {
-    std::lock_guard lock(pool_mutex_);
-    if (!idle_.empty()) {
-      c = idle_.back();
-      idle_.pop_back();
-    }
-  }
-  if (c == nullptr) {
-    absl::StatusOr<redisContext*> fresh = Connect();
-    if (!fresh.ok()) return fresh.status();
-    c = *fresh;
-  }
+    const std::vector<std::string>& args, bool idempotent) const {
   std::vector<const char*> argv;
   std::vector<size_t> lengths;
   for (const std::string& a : args) {
     argv.push_back(a.data());
     lengths.push_back(a.size());
   }
-  Reply reply(static_cast<redisReply*>(
-      redisCommandArgv(c, static_cast<int>(args.size()), argv.data(), lengths.data())));
-  if (reply.null()) {
-    // The connection is broken (or timed out mid-reply): never reuse it.
-    absl::Status error = absl::UnavailableError(
-        absl::StrCat("session store: redis ", address_.host, ":", address_.port, ": ", c->errstr));
-    redisFree(c);
-    return error;
+  for (int attempt = 0;; ++attempt) {
+    redisContext* c = nullptr;
+    {
+      std::lock_guard lock(pool_mutex_);
+      if (!idle_.empty()) {
+        c = idle_.back();
+        idle_.pop_back();
+      }
+    }
+    const bool pooled = c != nullptr;
+    if (!pooled) {
+      absl::StatusOr<redisContext*> fresh = Connect();
+      if (!fresh.ok()) return fresh.status();
+      c = *fresh;
+    }
+    Reply reply(static_cast<redisReply*>(
+        redisCommandArgv(c, static_cast<int>(args.size()), argv.data(), lengths.data())));
+    if (reply.null()) {
+      // The connection is broken (Redis restarted, or a timeout mid-reply): never reuse it, nor
+      // the other idle ones (they most likely broke the same way). A read that failed on a
+      // pooled connection is tried once more on a fresh one; a write is not (it may have run).
+      absl::Status error = absl::UnavailableError(absl::StrCat(
+          "session store: redis ", address_.host, ":", address_.port, ": ", c->errstr));
+      redisFree(c);
+      std::vector<redisContext*> stale;
+      {
+        std::lock_guard lock(pool_mutex_);
+        stale.swap(idle_);
+      }
+      for (redisContext* s : stale) redisFree(s);
+      if (pooled && idempotent && attempt == 0) continue;
+      return error;
+    }
+    {
+      std::lock_guard lock(pool_mutex_);
+      idle_.push_back(c);
+    }
+    if (reply->type == REDIS_REPLY_ERROR) {
+      return absl::InternalError(absl::StrCat("session store: redis ", args[0], ": ", Str(*reply)));
+    }
+    return reply;
   }
-  {
-    std::lock_guard lock(pool_mutex_);
-    idle_.push_back(c);
-  }
-  if (reply->type == REDIS_REPLY_ERROR) {
-    return absl::InternalError(absl::StrCat("session store: redis ", args[0], ": ", Str(*reply)));
-  }
-  return reply;
 }
 
 void RedisSessionStore::Remember(const SessionState& state) const {
@@ -288,7 +300,8 @@ absl::StatusOr<SessionState> RedisSessionStore::Create(SessionState state) {
                  SequenceKey(), id, absl::StrCat(options_.max_sessions),
                  absl::StrCat(stamped.session.version()), stamped.owner,
                  absl::StrCat(stamped.session.created_unix_ms()),
-                 SessionSummary(stamped.session).SerializeAsString(), EncodeSnapshot(stamped)});
+                 SessionSummary(stamped.session).SerializeAsString(), EncodeSnapshot(stamped)},
+                /*idempotent=*/false);
     if (!reply.ok()) return reply.status();
     const absl::string_view verdict = Verdict(**reply);
     if (verdict == "ok") {
@@ -322,7 +335,8 @@ absl::StatusOr<SessionState> RedisSessionStore::Put(SessionState state, uint64_t
   absl::StatusOr<Reply> reply =
       Command({"EVAL", kPutScript, "1", key, absl::StrCat(expected_version),
                absl::StrCat(state.session.version()),
-               SessionSummary(state.session).SerializeAsString(), EncodeSnapshot(state)});
+               SessionSummary(state.session).SerializeAsString(), EncodeSnapshot(state)},
+              /*idempotent=*/false);
   if (!reply.ok()) return reply.status();
   const absl::string_view verdict = Verdict(**reply);
   if (verdict == "missing") return SessionNotFoundError(id);
@@ -386,7 +400,8 @@ absl::Status RedisSessionStore::Delete(absl::string_view id, uint64_t expected_v
   if ((*owner)->type != REDIS_REPLY_STRING) return SessionNotFoundError(id);
   absl::StatusOr<Reply> reply =
       Command({"EVAL", kDeleteScript, "3", key, AllKey(), OwnerKey(Str(**owner)),
-               absl::StrCat(expected_version), std::string(id)});
+               absl::StrCat(expected_version), std::string(id)},
+              /*idempotent=*/false);
   if (!reply.ok()) return reply.status();
   const absl::string_view verdict = Verdict(**reply);
   if (verdict == "missing") return SessionNotFoundError(id);

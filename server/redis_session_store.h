@@ -69,8 +69,9 @@ class RedisSessionStore final : public SessionStore {
 
   RedisSessionStore(RedisAddress address, RedisStoreOptions options);
   // Runs one command on a pooled connection (binary-safe arguments). UNAVAILABLE on connection
-  // errors (the connection is dropped), INTERNAL on a Redis error reply.
-  absl::StatusOr<Reply> Command(const std::vector<std::string>& args) const;
+  // errors (the pool is dropped; an idempotent command is tried once more on a new connection),
+  // INTERNAL on a Redis error reply.
+  absl::StatusOr<Reply> Command(const std::vector<std::string>& args, bool idempotent = true) const;
   absl::StatusOr<redisContext*> Connect() const;
   void Remember(const SessionState& state) const;
 

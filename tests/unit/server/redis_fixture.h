@@ -2,6 +2,7 @@
 // the object goes away. Tests skip (GTEST_SKIP) only when the redis-server binary is absent.
 #pragma once
 
+#include <fcntl.h>
 #include <hiredis/hiredis.h>
 #include <netinet/in.h>
 #include <signal.h>
@@ -56,6 +57,8 @@ class RedisProcess {
       const std::string port_text = std::to_string(port);
       pid_ = fork();
       if (pid_ == 0) {
+        const int null_fd = open("/dev/null", O_WRONLY);  // keep the test output clean
+        if (null_fd >= 0) dup2(null_fd, STDOUT_FILENO);
         execl(binary.c_str(), binary.c_str(), "--port", port_text.c_str(), "--bind", "127.0.0.1",
               "--save", "", "--appendonly", "no", "--loglevel", "warning", "--protected-mode",
               "yes", static_cast<char*>(nullptr));
@@ -66,7 +69,10 @@ class RedisProcess {
       for (int i = 0; i < 100; ++i) {
         if (RedisSessionStore::Open(url).ok()) {
           // Another test's redis-server may hold the port (ours then exits): only ours counts.
-          if (ServerPid(port) == pid_) url_ = url;
+          if (ServerPid(port) == pid_) {
+            url_ = url;
+            port_ = port;
+          }
           break;
         }
         int status = 0;
@@ -84,6 +90,17 @@ class RedisProcess {
   RedisProcess& operator=(const RedisProcess&) = delete;
 
   const std::string& url() const { return url_; }
+  int port() const { return port_; }
+
+  // Closes every other client's connection (as a Redis restart or a proxy reset would).
+  void KillClients() const {
+    redisContext* c = redisConnect("127.0.0.1", port_);
+    if (c != nullptr && c->err == 0) {
+      auto* reply = static_cast<redisReply*>(redisCommand(c, "CLIENT KILL TYPE normal SKIPME yes"));
+      if (reply != nullptr) freeReplyObject(reply);
+    }
+    if (c != nullptr) redisFree(c);
+  }
 
   // The process id the redis-server on `port` reports (INFO server), -1 if none answers.
   static pid_t ServerPid(int port) {
@@ -112,6 +129,7 @@ class RedisProcess {
 
  private:
   pid_t pid_ = -1;
+  int port_ = 0;
   std::string url_;
 };
 

@@ -225,6 +225,23 @@ TEST_F(RedisSessionStoreTest, ChosenIdsMaxSessionsAndIdleEviction) {
   EXPECT_EQ(a->CachedCount(), 1u);
 }
 
+TEST_F(RedisSessionStoreTest, BrokenPooledConnectionsAreReplaced) {
+  auto a = Open();
+  auto created = a->Create(StoredSessionState(""));
+  ASSERT_TRUE(created.ok()) << created.status();
+  ASSERT_TRUE(a->Get(created->session.id()).ok());  // the pool holds a connection now
+  redis_->KillClients();
+  // A read on the dead pooled connection is retried on a new one.
+  auto got = a->Get(created->session.id());
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(a->Count(), 1u);
+  redis_->KillClients();
+  // A write starts with a read (owner, created), which replaces the pool; the write then runs.
+  auto put = a->Put(*got, 1);
+  ASSERT_TRUE(put.ok()) << put.status();
+  EXPECT_EQ(put->session.version(), 2u);
+}
+
 TEST_F(RedisSessionStoreTest, RedisGoingAwayIsUnavailableNotACrash) {
   auto a = Open();
   auto created = a->Create(StoredSessionState(""));
