@@ -405,6 +405,25 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       map_options.tutte_when_convex = loops.size() == 1;
       absl::StatusOr<Points> mapped =
           MapToBoundary(source, triangles, boundary, target_boundary, map_options, cancel);
+      // A pose far from the reference drawing may not be reachable by pulling the reference's
+      // boundary directly; start instead from the map into an already mapped drawing, nearest
+      // in key order first (neighbouring keys are usually similar poses).
+      std::vector<int> mapped_before;
+      for (int e = d - 1; e >= 0; --e) {
+        if (e != ref && !mesh.shapes[e].empty()) mapped_before.push_back(e);
+      }
+      for (size_t k = 0; k < mapped_before.size() && k < 3 && !mapped.ok() &&
+                         !absl::IsCancelled(mapped.status());
+           ++k) {
+        Points start;
+        for (int v : global) start.push_back(mesh.shapes[mapped_before[k]][v]);
+        MapToBoundaryOptions chained = map_options;
+        chained.tutte_when_convex = chained.tutte_first_always = false;
+        chained.start = &start;
+        absl::StatusOr<Points> retry =
+            MapToBoundary(source, triangles, boundary, target_boundary, chained, cancel);
+        if (retry.ok() || absl::IsCancelled(retry.status())) mapped = std::move(retry);
+      }
       if (!mapped.ok()) {
         if (absl::IsCancelled(mapped.status())) return mapped.status();
         return absl::FailedPreconditionError(absl::StrCat("cannot map drawing ", ref + 1,

@@ -353,9 +353,18 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
     rep.tutte = placed = sound;
   }
 
+  if (!placed && options.start != nullptr) {
+    if (options.start->size() != source.size()) {
+      return absl::InvalidArgumentError(absl::StrCat("start has ", options.start->size(),
+                                                     " points, the mesh has ", source.size()));
+    }
+    if (CountInverted(triangles, *options.start) != 0) {
+      return absl::InvalidArgumentError("start folds a triangle");
+    }
+  }
   if (!placed) {
-    // Progressive boundary pull from the identity.
-    x = source;
+    // Progressive boundary pull from the identity (or the given start).
+    x = options.start != nullptr ? *options.start : source;
     Constraints pull;
     pull.free_index.resize(n);
     for (int v = 0; v < n; ++v) pull.free_index[v] = v;
@@ -373,10 +382,10 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
         if (cancelled()) return absl::CancelledError("map: cancelled");
         ++rep.iterations;
         const double progress = mapper.Iterate(&x, pull);
-        if (progress < 0) return absl::FailedPreconditionError("map: linear solve failed");
+        if (progress < 0) break;  // the penalty outgrew the factorization: the pull is stuck
         if (progress < 1e-7) break;
       }
-      if (rep.stages > 40) break;
+      if (rep.stages > 40 || !(pull.penalty < 1e20)) break;
     }
     const double distance = mapper.MaxBoundaryDistance(x);
     if (distance > tolerance) {

@@ -27,6 +27,10 @@ struct MapToBoundaryOptions {
   // triangle folds (then only the polish runs): much cheaper than the progressive pull, which
   // remains the fallback.
   bool tutte_first_always = true;
+  // Optional start of the boundary pull instead of the identity: positions of the source's
+  // vertices (same order) with every triangle positive, typically the map into a similar
+  // drawing (a neighbouring key). Null = start from `source`.
+  const Points* start = nullptr;
 };
 
 struct MapToBoundaryReport {

@@ -1,0 +1,89 @@
+// Generated key drawings of a walking character for tests and benchmarks: the side-view
+// silhouette of examples/walk (head, torso, arm, two legs apart) at 16 phases of a stride, all of
+// one topology, each with a correspondence mark (id 1) at the crotch.
+#pragma once
+
+#include <cmath>
+#include <numbers>
+
+#include "solver/core/types.h"
+
+namespace inbetween::solver::testing {
+
+// Direction of a limb at `degrees` from straight down (y-down coordinates), as in
+// examples/make_examples.py.
+inline Point LimbDirection(double degrees) {
+  const double a = degrees * std::numbers::pi / 180.0;
+  return {std::sin(a), std::cos(a)};
+}
+// Normal of a leg at `degrees` (points to the front of the leg).
+inline Point LimbNormal(double degrees) {
+  const double a = degrees * std::numbers::pi / 180.0;
+  return {std::cos(a), -std::sin(a)};
+}
+// p + s d where the line p + s d meets q + t e.
+inline Point LineIntersection(const Point& p, const Point& d, const Point& q, const Point& e) {
+  const double den = d.x() * e.y() - d.y() * e.x();
+  const double s = ((q.x() - p.x()) * e.y() - (q.y() - p.y()) * e.x()) / den;
+  return p + s * d;
+}
+
+// The walker with its front leg at `front` degrees, back leg at `back` (negative: behind) and
+// arm at `arm`, and the crotch point (its correspondence mark).
+inline Drawing Walker(double front, double back, double arm) {
+  const Point hip(0, -6);
+  const double w = 9, leg = 54;
+  Points pts;
+  // Head: the long arc of a circle of radius 11 from (-3, -66) over the top to (5, -66).
+  const Point centre(1, -66 - std::sqrt(121.0 - 16.0));
+  const double a0 = std::atan2(-66 - centre.y(), -3 - centre.x());
+  const double a1 = std::atan2(-66 - centre.y(), 5 - centre.x()) + 2 * std::numbers::pi;
+  constexpr int kArc = 24;
+  for (int k = 0; k <= kArc; ++k) {
+    const double a = a0 + (a1 - a0) * k / kArc;
+    pts.push_back(centre + 11.0 * Point(std::cos(a), std::sin(a)));
+  }
+  pts.emplace_back(5, -62);
+  pts.emplace_back(9, -60);
+  // Arm on the torso front from the shoulder.
+  const Point shoulder(9, -60);
+  const Point d = LimbDirection(arm);
+  const Point n(-std::cos(arm * std::numbers::pi / 180.0), std::sin(arm * std::numbers::pi / 180.0));
+  const Point hand = shoulder + 34.0 * d;
+  pts.push_back(hand);
+  pts.push_back(hand + 7.0 * n + 2.0 * d);
+  pts.push_back(LineIntersection(shoulder + 7.0 * n, d, shoulder, Point(0, 1)));
+  pts.emplace_back(9, -10);
+  // Legs apart.
+  const Point df = LimbDirection(front), nf = LimbNormal(front);
+  const Point db = LimbDirection(back), nb = LimbNormal(back);
+  const Point ff = hip + (w / 2) * nf, fb = hip - (w / 2) * nf;
+  const Point bf = hip + (w / 2) * nb, bb = hip - (w / 2) * nb;
+  auto toe = [](const Point& e, const Point& dir, const Point& nor) {
+    return e + 8.0 * nor + 2.0 * dir;
+  };
+  const Point crotch = LineIntersection(fb, df, bf, db);
+  Point ef = ff + leg * df, eb = fb + leg * df;
+  pts.insert(pts.end(), {ff, ef, toe(ef, df, nf), eb + 2.0 * df, eb, crotch});
+  ef = bf + leg * db;
+  eb = bb + leg * db;
+  pts.insert(pts.end(), {ef, toe(ef, db, nb), eb + 2.0 * db, eb, bb});
+  pts.emplace_back(-9, -10);
+  pts.emplace_back(-10, -56);
+  pts.emplace_back(-3, -62);
+  Drawing drawing;
+  drawing.outlines.push_back({pts});
+  drawing.marks.push_back({1, crotch});
+  return drawing;
+}
+
+// Pose k of 16 along a stride: legs swing between 14 and 30 degrees apart, the arm counters.
+inline Drawing WalkerPose(int k) {
+  const double phase = 2.0 * std::numbers::pi * k / 16.0;
+  const double front = 22.0 + 8.0 * std::sin(phase);
+  const double back = -22.0 + 8.0 * std::cos(phase);
+  const double arm = 40.0 - 10.0 * std::sin(phase);
+  return Walker(front, back, arm);
+}
+
+}  // namespace inbetween::solver::testing
