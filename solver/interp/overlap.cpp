@@ -229,7 +229,8 @@ int OverlapChecker::Crossings(const Coords& x) const {
   const Bvh& bvh = Tree(std::move(boxes), &segment_tree_);
   int crossings = 0;
   for (int s = 0; s < static_cast<int>(segments_.size()); ++s) {
-    const auto [a, b] = segments_[s];
+    // Not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda.
+    const int a = segments_[s][0], b = segments_[s][1];
     bvh.Query(bvh.box(s), [&](int r) {
       if (r <= s) return;
       const auto [c, d] = segments_[r];

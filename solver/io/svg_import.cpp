@@ -16,6 +16,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <utility>
@@ -212,6 +213,66 @@ class Context {
     Add(x1, y1, true);
     Add(x2, y2, true);
     Add(x, y, false);
+  }
+  // Elliptical arc (SVG 1.1 F.6.5, endpoint to centre parameterization), as cubic Beziers of at
+  // most a quarter turn each. Done here rather than by SVG++ (policy ArcsOurs below): its
+  // converter turns some valid arcs (a zero radius, which SVG draws as a straight line) into NaN.
+  void path_elliptical_arc_to(double rx, double ry, double rotation_degrees, bool large_arc,
+                              bool sweep, double x, double y, sv::tag::coordinate::absolute) {
+    for (double v : {rx, ry, rotation_degrees, x, y}) CheckFinite(v, "path data");
+    StartIfNeeded();
+    const Point p1 = pen_, p2(x, y);
+    if (p1 == p2) return;  // F.6.2: an arc to the current point is omitted
+    rx = std::abs(rx), ry = std::abs(ry);
+    if (rx == 0 || ry == 0) {  // F.6.2: a zero radius is a straight line
+      Add(x, y, false);
+      return;
+    }
+    const double phi = rotation_degrees * std::numbers::pi / 180.0;
+    const double c = std::cos(phi), s = std::sin(phi);
+    const Point h = 0.5 * (p1 - p2);
+    const Point q(c * h.x() + s * h.y(), -s * h.x() + c * h.y());  // (x1', y1')
+    const double lambda = (q.x() * q.x()) / (rx * rx) + (q.y() * q.y()) / (ry * ry);
+    if (lambda > 1) rx *= std::sqrt(lambda), ry *= std::sqrt(lambda);  // F.6.6: scale up
+    const double num = rx * rx * ry * ry - rx * rx * q.y() * q.y() - ry * ry * q.x() * q.x();
+    const double den = rx * rx * q.y() * q.y() + ry * ry * q.x() * q.x();
+    double coef = den > 0 ? std::sqrt(std::max(0.0, num / den)) : 0.0;
+    if (large_arc == sweep) coef = -coef;
+    const Point cq(coef * rx * q.y() / ry, -coef * ry * q.x() / rx);  // (cx', cy')
+    const Point center(c * cq.x() - s * cq.y() + 0.5 * (p1.x() + p2.x()),
+                       s * cq.x() + c * cq.y() + 0.5 * (p1.y() + p2.y()));
+    auto angle = [](const Point& u, const Point& v) {
+      return std::atan2(u.x() * v.y() - u.y() * v.x(), u.dot(v));
+    };
+    const Point u((q.x() - cq.x()) / rx, (q.y() - cq.y()) / ry);
+    const Point v((-q.x() - cq.x()) / rx, (-q.y() - cq.y()) / ry);
+    const double theta1 = angle(Point(1, 0), u);
+    double delta = angle(u, v);
+    if (!sweep && delta > 0) delta -= 2 * std::numbers::pi;
+    if (sweep && delta < 0) delta += 2 * std::numbers::pi;
+    if (!std::isfinite(theta1) || !std::isfinite(delta)) {
+      throw ImportError("path data has an arc that cannot be evaluated");
+    }
+    auto at = [&](double t) {  // point and derivative of the ellipse at angle t
+      const Point e(rx * std::cos(t), ry * std::sin(t)), d(-rx * std::sin(t), ry * std::cos(t));
+      return std::pair<Point, Point>{Point(c * e.x() - s * e.y(), s * e.x() + c * e.y()) + center,
+                                     Point(c * d.x() - s * d.y(), s * d.x() + c * d.y())};
+    };
+    const int n =
+        std::max(1, static_cast<int>(std::ceil(std::abs(delta) / (std::numbers::pi / 2))));
+    const double step = delta / n, k = 4.0 / 3.0 * std::tan(step / 4);
+    for (int i = 0; i < n; ++i) {
+      const auto [a, da] = at(theta1 + i * step);
+      auto [b, db] = at(theta1 + (i + 1) * step);
+      if (i + 1 == n) b = p2;  // land exactly on the end point
+      const Point c1 = a + k * da, c2 = b - k * db;
+      for (double w : {c1.x(), c1.y(), c2.x(), c2.y(), b.x(), b.y()}) {
+        CheckFinite(w, "path data");
+      }
+      Add(c1.x(), c1.y(), true);
+      Add(c2.x(), c2.y(), true);
+      Add(b.x(), b.y(), false);
+    }
   }
   void path_close_subpath() {
     // The pen returns to the subpath start; a further drawing command starts a new subpath.
@@ -412,11 +473,17 @@ using ProcessedAttributes =
 using ProcessedAttributesWithFillRule =
     boost::mpl::insert<ProcessedAttributes, sv::tag::attribute::fill_rule>::type;
 
-using Traversal = sv::document_traversal<
-    sv::processed_elements<ProcessedElements>,
-    sv::processed_attributes<ProcessedAttributesWithFillRule>,
-    sv::context_factories<ContextFactories>, sv::path_policy<sv::policy::path::minimal>,
-    sv::basic_shapes_policy<sv::policy::basic_shapes::all_to_path>, sv::error_policy<ErrorPolicy>>;
+// SVG++'s minimal path policy, except that arcs come to Context::path_elliptical_arc_to.
+struct PathPolicy : sv::policy::path::minimal {
+  static const bool arc_as_cubic_bezier = false;
+};
+
+using Traversal =
+    sv::document_traversal<sv::processed_elements<ProcessedElements>,
+                           sv::processed_attributes<ProcessedAttributesWithFillRule>,
+                           sv::context_factories<ContextFactories>, sv::path_policy<PathPolicy>,
+                           sv::basic_shapes_policy<sv::policy::basic_shapes::all_to_path>,
+                           sv::error_policy<ErrorPolicy>>;
 
 struct DocDeleter {
   void operator()(xmlDoc* doc) const { xmlFreeDoc(doc); }
