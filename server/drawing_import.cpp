@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <set>
 #include <string>
@@ -167,6 +168,19 @@ absl::Status CheckDrawingFields(const v1::Drawing& drawing, absl::string_view fi
     return absl::InvalidArgumentError(absl::StrCat(field, ".name is ", drawing.name().size(),
                                                    " bytes, the limit is ", kMaxNameBytes));
   }
+  for (int i = 0; i < drawing.marks_size(); ++i) {
+    const v1::DrawingMark& mark = drawing.marks(i);
+    if (!std::isfinite(mark.point().x()) || !std::isfinite(mark.point().y()) ||
+        std::abs(mark.point().x()) > 1e9 || std::abs(mark.point().y()) > 1e9) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".marks[", i, "].point = (", mark.point().x(), ", ",
+                       mark.point().y(), ") is not finite or beyond 1e9"));
+    }
+    if (mark.id() > static_cast<uint32_t>(std::numeric_limits<int>::max())) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".marks[", i, "].id = ", mark.id(), " is too large"));
+    }
+  }
   if (drawing.has_key_time() &&
       !(std::isfinite(drawing.key_time()) && drawing.key_time() >= 0 && drawing.key_time() <= 1)) {
     return absl::InvalidArgumentError(
@@ -213,6 +227,7 @@ absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing, double
     }
   }
   TopologyElements elements;
+  std::vector<solver::CorrespondenceMark> svg_marks;
   std::string element_field;
   switch (drawing.source_case()) {
     case v1::Drawing::kSvg: {
@@ -234,6 +249,7 @@ absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing, double
       if (parsed->outlines.empty()) {
         return absl::InvalidArgumentError(absl::StrCat(field, ".svg has no filled shapes"));
       }
+      svg_marks = parsed->marks;
       for (const solver::Outline& o : parsed->outlines) {
         AddElement(v1::ELEMENT_KIND_OUTLINE, o.points, &elements);
       }
@@ -266,7 +282,12 @@ absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing, double
     *element = topology[i];
     element->set_id(static_cast<uint32_t>(elements.size()));
   }
-  return Analyze(std::move(elements), field, element_field, false, drawing_number, max_points);
+  absl::StatusOr<ImportedDrawing> out =
+      Analyze(std::move(elements), field, element_field, false, drawing_number, max_points);
+  if (out.ok()) {
+    out->parsed.marks = drawing.has_svg() ? svg_marks : MarksOf(drawing);
+  }
+  return out;
 }
 
 absl::StatusOr<ImportedDrawing> ImportDrawingElements(const v1::Drawing& drawing,
@@ -288,8 +309,28 @@ absl::StatusOr<ImportedDrawing> ImportDrawingElements(const v1::Drawing& drawing
   for (v1::TopologyElement& element : elements) {
     if (element.id() == 0) element.set_id(++max_id);
   }
-  return Analyze(std::move(elements), field, absl::StrCat(field, ".elements"), true, drawing_number,
-                 max_points);
+  absl::StatusOr<ImportedDrawing> out = Analyze(
+      std::move(elements), field, absl::StrCat(field, ".elements"), true, drawing_number, max_points);
+  if (out.ok()) out->parsed.marks = MarksOf(drawing);
+  return out;
+}
+
+std::vector<solver::CorrespondenceMark> MarksOf(const v1::Drawing& drawing) {
+  std::vector<solver::CorrespondenceMark> marks;
+  for (const v1::DrawingMark& mark : drawing.marks()) {
+    marks.push_back({static_cast<int>(mark.id()), solver::Point(mark.point().x(), mark.point().y())});
+  }
+  return marks;
+}
+
+void SetMarks(const std::vector<solver::CorrespondenceMark>& marks, v1::Drawing* drawing) {
+  drawing->clear_marks();
+  for (const solver::CorrespondenceMark& mark : marks) {
+    v1::DrawingMark* out = drawing->add_marks();
+    out->set_id(static_cast<uint32_t>(mark.id));
+    out->mutable_point()->set_x(mark.point.x());
+    out->mutable_point()->set_y(mark.point.y());
+  }
 }
 
 }  // namespace inbetween::server

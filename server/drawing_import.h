@@ -51,6 +51,10 @@ absl::StatusOr<ImportedDrawing> ImportDrawingElements(const inbetween::v1::Drawi
                                                       absl::string_view field, int drawing_number,
                                                       int max_points = kMaxPointsPerDrawing);
 
+// A drawing's correspondence marks (Drawing.marks) for the solver, and back.
+std::vector<solver::CorrespondenceMark> MarksOf(const inbetween::v1::Drawing& drawing);
+void SetMarks(const std::vector<solver::CorrespondenceMark>& marks, inbetween::v1::Drawing* drawing);
+
 // The equivalence class as the API reports it.
 inbetween::v1::EquivalenceClass ToProto(const solver::EquivalenceClass& equivalence);
 

@@ -559,6 +559,7 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext* context,
               : ImportDrawingElements(drawing, field, i + 1, options_.limits.max_drawing_points);
       if (!imported.ok()) return imported.status();
       *drawing.mutable_elements() = imported->elements;
+      SetMarks(imported->parsed.marks, &drawing);
       state.parsed.push_back(std::move(imported->parsed));
     }
     state.next_drawing_id = max_id + 1;
@@ -633,6 +634,7 @@ grpc::Status InbetweenService::PutDrawing(grpc::ServerContext* context,
 
         v1::Drawing drawing = request->drawing();
         *drawing.mutable_elements() = imported->elements;
+        SetMarks(imported->parsed.marks, &drawing);
         if (add) {
           drawing.set_id(state->next_drawing_id++);
           *session.add_drawings() = drawing;

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "server/drawing_import.h"
 #include "server/proto_convert.h"
 
 namespace inbetween::server {
@@ -157,6 +158,7 @@ absl::StatusOr<SessionState> DecodeSnapshot(absl::string_view bytes, absl::strin
   state.session = std::move(*archive.mutable_session());
   for (const v1::Drawing& drawing : state.session.drawings()) {
     state.parsed.push_back(SolverDrawing(drawing.elements()));
+    state.parsed.back().marks = MarksOf(drawing);
   }
   if (archive.has_multimesh() && archive.multimesh().shapes_size() > 0) {
     absl::StatusOr<solver::Multimesh> mesh = MultimeshFromProto(archive.multimesh(), where);

@@ -1,0 +1,116 @@
+// Correspondence marks drawn with the drawings (SVG data-corr elements, Drawing.marks): kept by
+// PutDrawing, used by BuildMultimesh while the session has no correspondences, carried through
+// export and import, and checked.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+
+#include "tests/unit/server/test_server.h"
+
+namespace inbetween::server::testing {
+namespace {
+
+using ::testing::HasSubstr;
+
+class DrawingMarksTest : public ServerTest {
+ protected:
+  // The walk example: four SVGs with a data-corr="1" mark each (the passing pose has a cut).
+  v1::Session WalkSession() {
+    v1::Session session = CreateSession("walk");
+    for (const char* name : {"1_contact", "2_passing", "3_up", "4_contact2"}) {
+      v1::PutDrawingResponse response;
+      grpc::Status status = PutSvg(
+          session, name, ReadExample(std::string("examples/walk/") + name + ".svg"), &response);
+      EXPECT_TRUE(status.ok()) << name << ": " << status.error_message();
+      EXPECT_EQ(response.drawing().marks_size(), 1) << name;
+      session = response.session();
+    }
+    return session;
+  }
+
+  grpc::Status Build(const v1::Session& session) {
+    grpc::ClientContext context;
+    v1::BuildMultimeshRequest request;
+    request.set_session_id(session.id());
+    request.set_expected_version(session.version());
+    auto reader = stub_->BuildMultimesh(&context, request);
+    v1::BuildMultimeshResponse message;
+    while (reader->Read(&message)) {
+    }
+    return reader->Finish();
+  }
+
+  v1::Session Get(const std::string& id) {
+    grpc::ClientContext context;
+    v1::GetSessionRequest request;
+    request.set_session_id(id);
+    v1::GetSessionResponse response;
+    EXPECT_TRUE(stub_->GetSession(&context, request, &response).ok());
+    return response.session();
+  }
+};
+
+TEST_F(DrawingMarksTest, SvgMarksAreKeptAndPinTheMultimesh) {
+  const v1::Session session = WalkSession();
+  const v1::Session stored = Get(session.id());
+  ASSERT_EQ(stored.drawings_size(), 4);
+  for (const v1::Drawing& drawing : stored.drawings()) {
+    ASSERT_EQ(drawing.marks_size(), 1) << drawing.name();
+    EXPECT_EQ(drawing.marks(0).id(), 1u);
+  }
+  EXPECT_EQ(stored.correspondences_size(), 0);
+  // Without the marks the poses' boundaries are matched by shape alone and the reference mesh
+  // cannot be mapped into every pose; with them it builds.
+  const grpc::Status status = Build(stored);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
+TEST_F(DrawingMarksTest, MarksSurviveExportAndImport) {
+  const v1::Session session = WalkSession();
+  grpc::ClientContext context;
+  v1::ExportSessionRequest request;
+  request.set_session_id(session.id());
+  v1::ExportSessionResponse exported;
+  ASSERT_TRUE(stub_->ExportSession(&context, request, &exported).ok());
+  grpc::ClientContext context2;
+  v1::ImportSessionRequest import;
+  import.set_data(exported.data());
+  v1::ImportSessionResponse imported;
+  grpc::Status status = stub_->ImportSession(&context2, import, &imported);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  const v1::Session copy = Get(imported.session().id());
+  ASSERT_EQ(copy.drawings_size(), 4);
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_EQ(copy.drawings(i).marks_size(), 1);
+    EXPECT_EQ(copy.drawings(i).marks(0).point().x(), Get(session.id()).drawings(i).marks(0).point().x());
+  }
+}
+
+TEST_F(DrawingMarksTest, BadMarksAreInvalidArgument) {
+  v1::Session session = CreateSession();
+  grpc::ClientContext context;
+  v1::PutDrawingRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  *request.mutable_drawing()->mutable_polylines()->add_elements() = SquareOutline(0, 0, 1);
+  v1::DrawingMark* mark = request.mutable_drawing()->add_marks();
+  mark->set_id(2);
+  mark->mutable_point()->set_y(std::numeric_limits<double>::quiet_NaN());
+  v1::PutDrawingResponse response;
+  grpc::Status status = stub_->PutDrawing(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("drawing.marks[0].point"));
+
+  mark->mutable_point()->set_y(0.0);
+  mark->mutable_point()->set_x(1.0);
+  grpc::ClientContext context2;
+  status = stub_->PutDrawing(&context2, request, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(response.drawing().marks_size(), 1);  // given with polylines: kept as given
+  EXPECT_EQ(response.drawing().marks(0).id(), 2u);
+}
+
+}  // namespace
+}  // namespace inbetween::server::testing
