@@ -389,10 +389,19 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
     }
     const double distance = mapper.MaxBoundaryDistance(x);
     if (distance > tolerance) {
-      return absl::FailedPreconditionError(
-          absl::StrCat("the boundary could not be pulled onto the target without folding triangles "
-                       "(a boundary vertex stays ",
-                       distance, " away after ", rep.iterations, " iterations)"));
+      size_t worst = 0;  // the boundary vertex furthest from its target: where the map is stuck
+      for (size_t k = 0; k < boundary.size(); ++k) {
+        if ((x[boundary[k]] - target_boundary[k]).norm() >
+            (x[boundary[worst]] - target_boundary[worst]).norm()) {
+          worst = k;
+        }
+      }
+      return absl::FailedPreconditionError(absl::StrCat(
+          "the boundary could not be pulled onto the target without folding triangles (the "
+          "boundary point that belongs at (",
+          target_boundary[worst].x(), ", ", target_boundary[worst].y(), ") stays ", distance,
+          " away, near (", source[boundary[worst]].x(), ", ", source[boundary[worst]].y(),
+          ") of the reference drawing, after ", rep.iterations, " iterations)"));
     }
     // Exact placement: the proxy step with the boundary pinned; it must not fold anything.
     Points proxy;
