@@ -1,10 +1,13 @@
 // Benchmark (S-Table 3): comesh optimization of a walking character with 2, 3, ..., 16 shapes at
 // the paper's 1639 vertices. The poses are generated here: the side-view silhouette of
 // examples/walk (head, torso, arm, two legs apart) at 16 phases of a stride, all of one topology,
-// with a correspondence mark at the crotch; the first n poses are meshed with BuildMultimesh and
-// optimized. Prints our row beside the paper's and the ratio paper_seconds / seconds.
+// with correspondence marks at the crotch, the toe tips, the fingertip, the top of the head, the
+// armpit and the hips (tests/unit/solver/mesh/walker_poses.h); the first n poses are meshed with
+// BuildMultimesh and optimized. Prints our row beside the paper's and the ratio
+// paper_seconds / seconds; a row whose multimesh cannot be built is printed as failed (exit 1).
 //
-//   comesh_shapes [--max-shapes N] [common options: comesh_bench_common.h]
+//   comesh_shapes [--max-shapes N] [--pair K [--pair2 L]] [common options: comesh_bench_common.h]
+//   (--pair: mesh poses 0 and K (and L) only, for investigating a failed row)
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
@@ -58,7 +61,7 @@ int main(int argc, char** argv) {
   const sv::ProgressFn progress = inbetween::bench::VerboseProgress(args.verbose);
 
   std::vector<sv::Drawing> poses;
-  for (int k = 0; k < 16; ++k) poses.push_back(sv::testing::WalkerPose(k));
+  for (int k = 0; k < 16; ++k) poses.push_back(sv::testing::WalkerPose(k, /*feature_marks=*/true));
   const sv::Points& outline = poses[0].outlines[0].points;
   double perimeter = 0.0;
   Eigen::AlignedBox2d box;

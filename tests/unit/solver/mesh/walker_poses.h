@@ -1,6 +1,7 @@
 // Generated key drawings of a walking character for tests and benchmarks: the side-view
 // silhouette of examples/walk (head, torso, arm, two legs apart) at 16 phases of a stride, all of
-// one topology, each with a correspondence mark (id 1) at the crotch.
+// one topology, each with a correspondence mark (id 1) at the crotch and, with feature_marks,
+// marks 2-8 at the toe tips, the fingertip, the top of the head, the armpit and the hips.
 #pragma once
 
 #include <cmath>
@@ -29,8 +30,8 @@ inline Point LineIntersection(const Point& p, const Point& d, const Point& q, co
 }
 
 // The walker with its front leg at `front` degrees, back leg at `back` (negative: behind) and
-// arm at `arm`, and the crotch point (its correspondence mark).
-inline Drawing Walker(double front, double back, double arm) {
+// arm at `arm`, with its correspondence marks.
+inline Drawing Walker(double front, double back, double arm, bool feature_marks = false) {
   const Point hip(0, -6);
   const double w = 9, leg = 54;
   Points pts;
@@ -52,7 +53,8 @@ inline Drawing Walker(double front, double back, double arm) {
   const Point hand = shoulder + 34.0 * d;
   pts.push_back(hand);
   pts.push_back(hand + 7.0 * n + 2.0 * d);
-  pts.push_back(LineIntersection(shoulder + 7.0 * n, d, shoulder, Point(0, 1)));
+  const Point armpit = LineIntersection(shoulder + 7.0 * n, d, shoulder, Point(0, 1));
+  pts.push_back(armpit);
   pts.emplace_back(9, -10);
   // Legs apart.
   const Point df = LimbDirection(front), nf = LimbNormal(front);
@@ -74,16 +76,25 @@ inline Drawing Walker(double front, double back, double arm) {
   Drawing drawing;
   drawing.outlines.push_back({pts});
   drawing.marks.push_back({1, crotch});
+  if (feature_marks) {  // what an animator would pin as well: tips and the armpit
+    drawing.marks.push_back({2, toe(ff + leg * df, df, nf)});
+    drawing.marks.push_back({3, toe(bf + leg * db, db, nb)});
+    drawing.marks.push_back({4, hand + 7.0 * n + 2.0 * d});
+    drawing.marks.push_back({5, centre + Point(0, -11)});
+    drawing.marks.push_back({6, armpit});
+    drawing.marks.push_back({7, ff});  // where the legs meet the torso
+    drawing.marks.push_back({8, bb});
+  }
   return drawing;
 }
 
 // Pose k of 16 along a stride: legs swing between 14 and 30 degrees apart, the arm counters.
-inline Drawing WalkerPose(int k) {
+inline Drawing WalkerPose(int k, bool feature_marks = false) {
   const double phase = 2.0 * std::numbers::pi * k / 16.0;
   const double front = 22.0 + 8.0 * std::sin(phase);
   const double back = -22.0 + 8.0 * std::cos(phase);
   const double arm = 40.0 - 10.0 * std::sin(phase);
-  return Walker(front, back, arm);
+  return Walker(front, back, arm, feature_marks);
 }
 
 }  // namespace inbetween::solver::testing
