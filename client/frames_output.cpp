@@ -16,6 +16,14 @@ render::FrameSet ToFrameSet(const FramesResult& frames) {
     data.time = f.time();
     data.weights.assign(f.weights().begin(), f.weights().end());
     for (const auto& p : f.vertices()) data.vertices.push_back({p.x(), p.y()});
+    if (f.has_stats()) {
+      render::FrameValidity valid;
+      valid.inverted_triangles = static_cast<int>(f.stats().inverted_triangles());
+      valid.boundary_overlaps = static_cast<int>(f.stats().boundary_overlaps());
+      valid.min_area_ratio = f.stats().min_area_ratio();
+      valid.max_area_ratio = f.stats().max_area_ratio();
+      data.valid = valid;
+    }
     out.frames.push_back(std::move(data));
   }
   return out;

@@ -109,6 +109,26 @@ absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc) {
         data.weights.push_back(fr["weights"][w].get<double>());
       }
     }
+    if (fr.contains("valid")) {
+      const auto& v = fr["valid"];
+      if (!v.is_object()) return PathError(fp + ".valid", "expected an object");
+      FrameValidity validity;
+      for (const char* key : {"inverted_triangles", "boundary_overlaps"}) {
+        if (!v.contains(key) || !v[key].is_number_integer() || v[key].get<int64_t>() < 0) {
+          return PathError(absl::StrCat(fp, ".valid.", key), "expected a count >= 0");
+        }
+      }
+      for (const char* key : {"min_area_ratio", "max_area_ratio"}) {
+        if (!v.contains(key) || !v[key].is_number()) {
+          return PathError(absl::StrCat(fp, ".valid.", key), "expected a number");
+        }
+      }
+      validity.inverted_triangles = v["inverted_triangles"].get<int>();
+      validity.boundary_overlaps = v["boundary_overlaps"].get<int>();
+      validity.min_area_ratio = v["min_area_ratio"].get<double>();
+      validity.max_area_ratio = v["max_area_ratio"].get<double>();
+      data.valid = validity;
+    }
     const auto& verts = fr["vertices"];
     for (size_t v = 0; v < verts.size(); ++v) {
       const auto& p = verts[v];
@@ -152,8 +172,15 @@ absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc) {
 nlohmann::json FrameSetToJson(const FrameSet& frames) {
   nlohmann::json out_frames = nlohmann::json::array();
   for (const auto& f : frames.frames) {
-    out_frames.push_back(
-        {{"index", f.index}, {"time", f.time}, {"weights", f.weights}, {"vertices", f.vertices}});
+    nlohmann::json frame = {
+        {"index", f.index}, {"time", f.time}, {"weights", f.weights}, {"vertices", f.vertices}};
+    if (f.valid) {
+      frame["valid"] = {{"inverted_triangles", f.valid->inverted_triangles},
+                        {"boundary_overlaps", f.valid->boundary_overlaps},
+                        {"min_area_ratio", f.valid->min_area_ratio},
+                        {"max_area_ratio", f.valid->max_area_ratio}};
+    }
+    out_frames.push_back(std::move(frame));
   }
   nlohmann::json doc = {
       {"triangles", frames.triangles}, {"keys", frames.keys}, {"frames", out_frames}};

@@ -15,11 +15,20 @@ namespace inbetween::render {
 
 using Vertex = std::array<double, 2>;
 
+// What the service measured on a frame (frames.json "valid"; docs/file-formats.md).
+struct FrameValidity {
+  int inverted_triangles = 0;  // signed area <= 0
+  int boundary_overlaps = 0;   // boundary vertices inside the shape + crossing boundary segments
+  double min_area_ratio = 1.0;  // triangle area / its area blended over the drawings
+  double max_area_ratio = 1.0;
+};
+
 struct FrameData {
   int index = 0;
   double time = 0.0;             // normalized [0, 1]
   std::vector<double> weights;   // example weights
   std::vector<Vertex> vertices;  // one per mesh vertex, user units (y down)
+  std::optional<FrameValidity> valid;  // absent in frames.json written before this field
 };
 
 struct FrameSet {

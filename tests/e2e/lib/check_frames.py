@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
 """Checks a frames.json written by `inbetween animate`.
 
-Usage: check_frames.py FRAMES_JSON EXPECTED_FRAMES EXPECTED_KEYS(comma-separated)
+Usage: check_frames.py FRAMES_JSON EXPECTED_FRAMES EXPECTED_KEYS(comma-separated) [MAX_OVERLAPS]
 Asserts: frame count and order, keys, one vertex per mesh vertex in every frame, finite
-coordinates, and zero inverted (non-positive signed area) triangles in every frame.
+coordinates, and zero inverted (non-positive signed area) triangles in every frame; each frame's
+"valid" stats (written by the service) report no inverted triangle, no boundary overlap and a
+positive smallest area ratio. MAX_OVERLAPS (default 0) is the most boundary overlaps a frame
+may report (only for the known cases the caller names).
 """
 import json
 import math
@@ -17,6 +20,7 @@ def fail(msg):
 
 def main():
     path, n_frames, keys = sys.argv[1], int(sys.argv[2]), [int(k) for k in sys.argv[3].split(",")]
+    max_overlaps = int(sys.argv[4]) if len(sys.argv) > 4 else 0
     with open(path) as f:
         doc = json.load(f)
     tris, frames = doc["triangles"], doc["frames"]
@@ -39,6 +43,14 @@ def main():
             area2 = (v[b][0] - v[a][0]) * (v[c][1] - v[a][1]) - (v[b][1] - v[a][1]) * (v[c][0] - v[a][0])
             if not area2 > 0:
                 fail(f"frame {i}: triangle {t} is inverted or degenerate (2*area={area2})")
+        valid = fr.get("valid")
+        if valid is None:
+            fail(f"frame {i} has no 'valid' stats")
+        if valid["inverted_triangles"] != 0 or valid["boundary_overlaps"] > max_overlaps:
+            fail(f"frame {i}: valid reports {valid['inverted_triangles']} inverted triangles, "
+                 f"{valid['boundary_overlaps']} boundary overlaps")
+        if not 0.0 < valid["min_area_ratio"] <= valid["max_area_ratio"]:
+            fail(f"frame {i}: area ratios {valid['min_area_ratio']} .. {valid['max_area_ratio']}")
     if not 0.0 <= frames[0]["time"] < frames[-1]["time"] <= 1.0:
         fail("frame times are not increasing within [0, 1]")
     print(f"check_frames: ok: {len(frames)} frames, {len(tris)} triangles, {n_vertices} vertices")

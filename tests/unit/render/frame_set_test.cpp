@@ -26,6 +26,29 @@ TEST(FrameSetTest, JsonRoundTripKeepsEverything) {
   EXPECT_TRUE(CheckFrameSet(*back).ok());
 }
 
+TEST(FrameSetTest, ValidStatsRoundTripAndAreChecked) {
+  FrameSet set = testing::MorphingRing(3);
+  set.frames[1].valid = FrameValidity{2, 1, -0.5, 1.75};
+  const nlohmann::json doc = FrameSetToJson(set);
+  EXPECT_FALSE(doc["frames"][0].contains("valid"));  // frames without stats stay as before
+  absl::StatusOr<FrameSet> back = FrameSetFromJson(nlohmann::json::parse(doc.dump()));
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_FALSE(back->frames[0].valid.has_value());
+  ASSERT_TRUE(back->frames[1].valid.has_value());
+  EXPECT_EQ(back->frames[1].valid->inverted_triangles, 2);
+  EXPECT_EQ(back->frames[1].valid->boundary_overlaps, 1);
+  EXPECT_EQ(back->frames[1].valid->min_area_ratio, -0.5);
+  EXPECT_EQ(back->frames[1].valid->max_area_ratio, 1.75);
+
+  nlohmann::json bad = doc;
+  bad["frames"][1]["valid"]["boundary_overlaps"] = -1;
+  absl::StatusOr<FrameSet> rejected = FrameSetFromJson(bad);
+  ASSERT_FALSE(rejected.ok());
+  EXPECT_NE(rejected.status().message().find("frames[1].valid.boundary_overlaps"),
+            std::string::npos)
+      << rejected.status();
+}
+
 // Parses `text` and expects an InvalidArgument error mentioning `path`.
 void ExpectErrorAt(const std::string& text, const std::string& path) {
   absl::StatusOr<FrameSet> set = FrameSetFromJson(nlohmann::json::parse(text));
