@@ -1,8 +1,11 @@
 // Thin gRPC client for inbetween.v1.Inbetween (see inbetween_client.h).
 #include "client/inbetween_client.h"
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 
 namespace inbetween::client {
@@ -10,6 +13,14 @@ namespace inbetween::client {
 absl::Status FromGrpcStatus(const grpc::Status& status) {
   if (status.ok()) return absl::OkStatus();
   return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+}
+
+bool IsTransient(const grpc::Status& status) {
+  if (status.error_code() == grpc::StatusCode::UNAVAILABLE) return true;
+  // nginx answers a replica that vanished mid-stream with RST_STREAM(INTERNAL_ERROR), which
+  // gRPC turns into this status; a server's own INTERNAL never has this message.
+  return status.error_code() == grpc::StatusCode::INTERNAL &&
+         absl::StartsWith(status.error_message(), "Received RST_STREAM");
 }
 
 class InbetweenClient::Call {
@@ -40,6 +51,39 @@ void InbetweenClient::CancelInFlight() {
   std::lock_guard<std::mutex> lock(mu_);
   cancelled_ = true;
   if (in_flight_ != nullptr) in_flight_->TryCancel();
+  cancel_cv_.notify_all();
+}
+
+bool InbetweenClient::PrepareRetry(const std::string& method, int failed_attempt,
+                                   const grpc::Status& status, uint32_t resume_frame) {
+  const RetryOptions& retry = options_.retry;
+  if (!IsTransient(status) || failed_attempt >= retry.max_attempts) return false;
+  const double ms =
+      std::min(static_cast<double>(retry.max_backoff.count()),
+               retry.initial_backoff.count() * std::pow(retry.multiplier, failed_attempt - 1));
+  const std::chrono::milliseconds backoff(static_cast<int64_t>(ms));
+  if (options_.on_retry) {
+    options_.on_retry(RetryEvent{.method = method,
+                                 .failed_attempt = failed_attempt,
+                                 .status = FromGrpcStatus(status),
+                                 .backoff = backoff,
+                                 .resume_frame = resume_frame});
+  }
+  std::unique_lock<std::mutex> lock(mu_);
+  return !cancel_cv_.wait_for(lock, backoff, [this] { return cancelled_; });
+}
+
+grpc::Status InbetweenClient::CallWithRetry(
+    const std::string& method, const std::string& session_id,
+    const std::function<grpc::Status(grpc::ClientContext*)>& rpc) {
+  for (int attempt = 1;; ++attempt) {
+    grpc::Status status;
+    {
+      Call call(this, session_id);
+      status = rpc(&call.context);
+    }
+    if (status.ok() || !PrepareRetry(method, attempt, status)) return status;
+  }
 }
 
 absl::StatusOr<v1::Session> InbetweenClient::CreateSession(const std::string& display_name,
@@ -56,12 +100,14 @@ absl::StatusOr<v1::Session> InbetweenClient::CreateSession(const std::string& di
 
 absl::StatusOr<v1::GetSessionResponse> InbetweenClient::GetSession(const std::string& session_id,
                                                                    bool full) {
-  Call call(this, session_id);
   v1::GetSessionRequest request;
   request.set_session_id(session_id);
   request.set_full(full);
   v1::GetSessionResponse response;
-  grpc::Status status = stub_->GetSession(&call.context, request, &response);
+  grpc::Status status = CallWithRetry("GetSession", session_id, [&](grpc::ClientContext* context) {
+    response.Clear();
+    return stub_->GetSession(context, request, &response);
+  });
   if (!status.ok()) return FromGrpcStatus(status);
   return response;
 }
@@ -71,9 +117,11 @@ absl::StatusOr<std::vector<v1::Session>> InbetweenClient::ListSessions() {
   v1::ListSessionsRequest request;
   request.set_page_size(1000);
   do {
-    Call call(this, "");
     v1::ListSessionsResponse response;
-    grpc::Status status = stub_->ListSessions(&call.context, request, &response);
+    grpc::Status status = CallWithRetry("ListSessions", "", [&](grpc::ClientContext* context) {
+      response.Clear();
+      return stub_->ListSessions(context, request, &response);
+    });
     if (!status.ok()) return FromGrpcStatus(status);
     for (auto& s : *response.mutable_sessions()) sessions.push_back(std::move(s));
     request.set_page_token(response.next_page_token());
@@ -142,30 +190,61 @@ absl::StatusOr<v1::OptimizeComeshResult> InbetweenClient::OptimizeComesh(
 absl::StatusOr<FramesResult> InbetweenClient::Inbetween(
     const std::string& session_id, const v1::InbetweenParameters& parameters,
     const std::function<void(const v1::InbetweenFrame&, uint32_t total)>& on_frame) {
-  Call call(this, session_id);
   v1::InbetweenRequest request;
   request.set_session_id(session_id);
   *request.mutable_parameters() = parameters;
-  auto reader = stub_->Inbetween(&call.context, request);
   FramesResult result;
   bool have_header = false;
-  v1::InbetweenResponse response;
-  while (reader->Read(&response)) {
-    if (response.has_header()) {
-      result.header = response.header();
-      have_header = true;
-    } else if (response.has_frame()) {
-      if (on_frame) on_frame(response.frame(), result.header.frames());
-      result.frames.push_back(std::move(*response.mutable_frame()));
+  for (int attempt = 1;; ++attempt) {
+    // Resume: the next attempt starts at the first frame not received yet.
+    const uint32_t next = static_cast<uint32_t>(result.frames.size());
+    request.set_start_frame(next);
+    Call call(this, session_id);
+    auto reader = stub_->Inbetween(&call.context, request);
+    absl::Status mismatch;
+    v1::InbetweenResponse response;
+    while (mismatch.ok() && reader->Read(&response)) {
+      if (response.has_header()) {
+        if (!have_header) {
+          result.header = response.header();
+          have_header = true;
+        } else if (response.header().session_version() != result.header.session_version() ||
+                   response.header().frames() != result.header.frames() ||
+                   response.header().triangles_size() != result.header.triangles_size()) {
+          // Another version would give other frames: a mix of two runs is never returned.
+          mismatch = absl::AbortedError(absl::StrCat(
+              "session ", session_id, " changed from version ", result.header.session_version(),
+              " to ", response.header().session_version(), " while its frames were streamed (",
+              result.frames.size(), " of ", result.header.frames(), " received); start again"));
+        }
+      } else if (response.has_frame()) {
+        if (response.frame().index() != result.frames.size()) {
+          mismatch = absl::InternalError(absl::StrCat("Inbetween stream sent frame ",
+                                                      response.frame().index(), ", expected ",
+                                                      result.frames.size()));
+          break;
+        }
+        if (on_frame) on_frame(response.frame(), result.header.frames());
+        result.frames.push_back(std::move(*response.mutable_frame()));
+      }
+    }
+    if (!mismatch.ok()) {
+      call.context.TryCancel();
+      reader->Finish();
+      return mismatch;
+    }
+    grpc::Status status = reader->Finish();
+    if (status.ok()) break;
+    // Every frame arrived before the connection broke: nothing to resume.
+    if (have_header && result.frames.size() == result.header.frames()) break;
+    if (!PrepareRetry("Inbetween", attempt, status, static_cast<uint32_t>(result.frames.size()))) {
+      return FromGrpcStatus(status);
     }
   }
-  grpc::Status status = reader->Finish();
-  if (!status.ok()) return FromGrpcStatus(status);
   if (!have_header) return absl::InternalError("Inbetween stream ended without a header");
   if (result.frames.size() != result.header.frames()) {
     return absl::InternalError(absl::StrCat("Inbetween stream sent ", result.frames.size(),
-                                            " frames, header announced ",
-                                            result.header.frames()));
+                                            " frames, header announced ", result.header.frames()));
   }
   return result;
 }

@@ -1,9 +1,18 @@
 // A thin C++ client for the Inbetween gRPC API, shared by the CLI and tests. Each call is one RPC
 // (or one whole stream) and returns absl::Status so callers map errors once.
+//
+// Failover (docs/scale-out.md): behind a proxy in front of replicas, a replica may die in the
+// middle of a call. `Inbetween` then resumes on another replica from the next frame not yet
+// received (`start_frame`; the solver is deterministic, so the frames equal an uninterrupted
+// run), and the read-only unary calls (GetSession, ListSessions) are sent again; both with
+// exponential backoff and a bounded number of attempts (RetryOptions).
 #pragma once
 
 #include <grpcpp/grpcpp.h>
 
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -26,9 +35,33 @@ struct FramesResult {
 
 using ProgressCallback = std::function<void(const v1::Progress&)>;
 
+// Retries of calls that are safe to repeat, after a transient failure (IsTransient).
+struct RetryOptions {
+  int max_attempts = 5;  // per call, the first one included; 1 = never retry
+  std::chrono::milliseconds initial_backoff{100};  // wait before the 2nd attempt
+  double multiplier = 2.0;                         // each later wait is this much longer
+  std::chrono::milliseconds max_backoff{5000};     // cap of one wait
+};
+
+// One retry about to happen, for logging (ClientOptions::on_retry).
+struct RetryEvent {
+  std::string method;                 // "Inbetween", "GetSession", "ListSessions"
+  int failed_attempt = 0;             // 1 = the first attempt failed
+  absl::Status status;                // why it failed
+  std::chrono::milliseconds backoff;  // wait before the next attempt
+  uint32_t resume_frame = 0;          // Inbetween: start_frame of the next attempt
+};
+
 struct ClientOptions {
   std::string token;  // bearer token sent as "authorization: Bearer <token>"; empty = none
+  RetryOptions retry;
+  std::function<void(const RetryEvent&)> on_retry;  // optional; called before each wait
 };
+
+// Whether a failed call may be repeated on another replica: UNAVAILABLE (replica unreachable,
+// draining, connection lost), or a stream reset by a proxy whose replica died mid-call (gRPC
+// reports INTERNAL "Received RST_STREAM ..."; no server handler sends that message).
+bool IsTransient(const grpc::Status& status);
 
 class InbetweenClient {
  public:
@@ -46,7 +79,9 @@ class InbetweenClient {
   absl::StatusOr<v1::OptimizeComeshResult> OptimizeComesh(
       const v1::Session& session, const std::function<void(const v1::ComeshIteration&)>& on_iter,
       const ProgressCallback& progress);
-  // Streams all frames; `on_frame` (optional) sees each frame as it arrives.
+  // Streams all frames; `on_frame` (optional) sees each frame as it arrives, once, in order.
+  // A transient failure resumes at the next frame; a resumed stream computed from another
+  // session version (the session changed meanwhile) is ABORTED.
   absl::StatusOr<FramesResult> Inbetween(
       const std::string& session_id, const v1::InbetweenParameters& parameters,
       const std::function<void(const v1::InbetweenFrame&, uint32_t total)>& on_frame);
@@ -59,9 +94,19 @@ class InbetweenClient {
   // as the in-flight call for CancelInFlight() until it is destroyed.
   class Call;
 
+  // Runs `rpc` (one attempt in the given context) until it succeeds, fails for good or the
+  // attempts run out; for idempotent unary calls only.
+  grpc::Status CallWithRetry(const std::string& method, const std::string& session_id,
+                             const std::function<grpc::Status(grpc::ClientContext*)>& rpc);
+  // Reports the retry and waits the backoff before attempt `failed_attempt + 1`; false when the
+  // attempts are used up, the failure is not transient, or CancelInFlight() came.
+  bool PrepareRetry(const std::string& method, int failed_attempt, const grpc::Status& status,
+                    uint32_t resume_frame = 0);
+
   std::unique_ptr<v1::Inbetween::Stub> stub_;
   ClientOptions options_;
   std::mutex mu_;
+  std::condition_variable cancel_cv_;  // wakes a backoff wait on CancelInFlight()
   grpc::ClientContext* in_flight_ = nullptr;
   bool cancelled_ = false;
 };

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "client/commands.h"
 #include "client/inbetween_client.h"
 #include "server/inbetween_server.h"
@@ -307,7 +308,19 @@ int main(int argc, char** argv) {
     channel = grpc::CreateChannel(server, Credentials(tls_ca));
   }
 
-  inbetween::client::InbetweenClient client(channel, {.token = token});
+  inbetween::client::ClientOptions client_options;
+  client_options.token = token;
+  if (!quiet) {
+    // A replica went away mid-call (docs/scale-out.md): say what is retried and from where.
+    client_options.on_retry = [](const inbetween::client::RetryEvent& e) {
+      const std::string from =
+          e.method == "Inbetween" ? absl::StrCat(", resuming at frame ", e.resume_frame) : "";
+      std::fprintf(stderr, "retry: %s attempt %d failed (%s); attempt %d in %lld ms%s\n",
+                   e.method.c_str(), e.failed_attempt, e.status.ToString().c_str(),
+                   e.failed_attempt + 1, static_cast<long long>(e.backoff.count()), from.c_str());
+    };
+  }
+  inbetween::client::InbetweenClient client(channel, std::move(client_options));
   StartSignalThread(&client);
   const inbetween::client::RunContext ctx{
       .client = &client, .progress = &bar, .remote = !server.empty(), .quiet = quiet};

@@ -1,0 +1,280 @@
+// Tests InbetweenClient's failover (client/inbetween_client.cpp): a fake front service forwards
+// calls to a real in-process InbetweenServer and breaks them as scripted (a replica dying
+// mid-stream behind a proxy). The client must resume Inbetween at the next frame not received,
+// deliver exactly the frames of an uninterrupted run, retry GetSession/ListSessions, stop after
+// the attempts run out, never retry a non-transient error, and refuse to splice frames of two
+// session versions.
+#include "client/inbetween_client.h"
+
+#include <gmock/gmock.h>
+#include <google/protobuf/util/message_differencer.h>
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include <deque>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "server/inbetween_server.h"
+
+namespace inbetween::client {
+namespace {
+
+using ::testing::Each;
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+// How the front breaks one call: forward `after_frames` frames (Inbetween; the header always
+// goes through), then end the call with `status` instead of the rest.
+struct Fault {
+  grpc::Status status;
+  int after_frames = 0;
+};
+
+const grpc::Status kUnavailable(grpc::StatusCode::UNAVAILABLE, "Socket closed");
+// What gRPC reports when nginx resets a stream whose replica died.
+const grpc::Status kProxyReset(grpc::StatusCode::INTERNAL, "Received RST_STREAM with error code 2");
+
+// Forwards GetSession, ListSessions and Inbetween to `backend`, failing calls per `faults`
+// (consumed in call order, shared by all methods) and recording what the client sent.
+class FlakyFront final : public v1::Inbetween::Service {
+ public:
+  explicit FlakyFront(std::shared_ptr<grpc::Channel> backend)
+      : backend_(v1::Inbetween::NewStub(std::move(backend))) {}
+
+  std::deque<Fault> faults;
+  std::vector<uint32_t> start_frames;    // of every Inbetween call
+  std::vector<std::string> session_ids;  // x-session-id of every call ("" when absent)
+  int unary_calls = 0;
+
+  grpc::Status GetSession(grpc::ServerContext* context, const v1::GetSessionRequest* request,
+                          v1::GetSessionResponse* response) override {
+    Record(*context);
+    ++unary_calls;
+    if (auto fault = NextFault()) return fault->status;
+    grpc::ClientContext upstream;
+    return backend_->GetSession(&upstream, *request, response);
+  }
+
+  grpc::Status ListSessions(grpc::ServerContext* context, const v1::ListSessionsRequest* request,
+                            v1::ListSessionsResponse* response) override {
+    Record(*context);
+    ++unary_calls;
+    if (auto fault = NextFault()) return fault->status;
+    grpc::ClientContext upstream;
+    return backend_->ListSessions(&upstream, *request, response);
+  }
+
+  grpc::Status Inbetween(grpc::ServerContext* context, const v1::InbetweenRequest* request,
+                         grpc::ServerWriter<v1::InbetweenResponse>* writer) override {
+    Record(*context);
+    start_frames.push_back(request->start_frame());
+    std::optional<Fault> fault = NextFault();
+    grpc::ClientContext upstream;
+    auto reader = backend_->Inbetween(&upstream, *request);
+    v1::InbetweenResponse response;
+    int frames = 0;
+    while (reader->Read(&response)) {
+      if (response.has_frame() && fault && frames++ == fault->after_frames) {
+        upstream.TryCancel();
+        reader->Finish();
+        return fault->status;
+      }
+      writer->Write(response);
+    }
+    grpc::Status status = reader->Finish();
+    return fault && status.ok() ? fault->status : status;
+  }
+
+ private:
+  std::optional<Fault> NextFault() {
+    if (faults.empty()) return std::nullopt;
+    Fault f = faults.front();
+    faults.pop_front();
+    return f;
+  }
+  void Record(const grpc::ServerContext& context) {
+    auto it = context.client_metadata().find("x-session-id");
+    session_ids.push_back(it == context.client_metadata().end()
+                              ? std::string()
+                              : std::string(it->second.data(), it->second.size()));
+  }
+
+  std::unique_ptr<v1::Inbetween::Stub> backend_;
+};
+
+std::string ReadExample(const std::string& relative) {
+  std::ifstream in(std::string(INBETWEEN_SOURCE_DIR) + "/" + relative);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Frames without their wall-clock seconds (the only field that may differ between two runs).
+std::vector<v1::InbetweenFrame> WithoutSeconds(std::vector<v1::InbetweenFrame> frames) {
+  for (v1::InbetweenFrame& f : frames) f.mutable_stats()->clear_seconds();
+  return frames;
+}
+
+class InbetweenClientFailoverTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto started = server::InbetweenServer::Start(server::ServerOptions{});
+    ASSERT_TRUE(started.ok()) << started.status();
+    backend_ = *std::move(started);
+    direct_ = std::make_unique<InbetweenClient>(backend_->InProcessChannel());
+
+    // A built square -> hexagon session on the real server.
+    auto session = direct_->CreateSession("failover");
+    ASSERT_TRUE(session.ok()) << session.status();
+    for (const char* name : {"square", "hexagon"}) {
+      v1::PutDrawingRequest request;
+      request.set_session_id(session->id());
+      request.set_expected_version(session->version());
+      request.mutable_drawing()->set_name(name);
+      request.mutable_drawing()->set_svg(
+          ReadExample(std::string("examples/square_hexagon/") + name + ".svg"));
+      auto put = direct_->PutDrawing(request);
+      ASSERT_TRUE(put.ok()) << put.status();
+      *session = put->session();
+    }
+    auto built = direct_->BuildMultimesh(*session, nullptr);
+    ASSERT_TRUE(built.ok()) << built.status();
+    session_ = built->session();
+    parameters_.set_frames(40);
+    parameters_.set_method(v1::METHOD_ZHU17);
+
+    front_ = std::make_unique<FlakyFront>(backend_->InProcessChannel());
+    grpc::ServerBuilder builder;
+    builder.RegisterService(front_.get());
+    front_server_ = builder.BuildAndStart();
+    ASSERT_NE(front_server_, nullptr);
+  }
+
+  void TearDown() override {
+    if (front_server_) front_server_->Shutdown();
+  }
+
+  // A client through the flaky front; backoff of 1, 2, 4 ... ms so the test stays short.
+  std::unique_ptr<InbetweenClient> FrontClient(int max_attempts = 5) {
+    ClientOptions options;
+    options.retry.max_attempts = max_attempts;
+    options.retry.initial_backoff = std::chrono::milliseconds(1);
+    options.on_retry = [this](const RetryEvent& e) { retries_.push_back(e); };
+    return std::make_unique<InbetweenClient>(front_server_->InProcessChannel({}), options);
+  }
+
+  std::unique_ptr<server::InbetweenServer> backend_;
+  std::unique_ptr<InbetweenClient> direct_;
+  v1::Session session_;
+  v1::InbetweenParameters parameters_;
+  std::unique_ptr<FlakyFront> front_;
+  std::unique_ptr<grpc::Server> front_server_;
+  std::vector<RetryEvent> retries_;
+};
+
+TEST_F(InbetweenClientFailoverTest, ResumedStreamDeliversTheFramesOfAnUninterruptedRun) {
+  auto uninterrupted = direct_->Inbetween(session_.id(), parameters_, nullptr);
+  ASSERT_TRUE(uninterrupted.ok()) << uninterrupted.status();
+  ASSERT_EQ(uninterrupted->frames.size(), 40u);
+
+  // Three failures: after 7 frames, after the header only, after 13 more frames.
+  front_->faults = {{kUnavailable, 7}, {kProxyReset, 0}, {kUnavailable, 13}};
+  auto client = FrontClient();
+  std::vector<uint32_t> seen;
+  auto resumed = client->Inbetween(session_.id(), parameters_,
+                                   [&](const v1::InbetweenFrame& f, uint32_t total) {
+                                     EXPECT_EQ(total, 40u);
+                                     seen.push_back(f.index());
+                                   });
+  ASSERT_TRUE(resumed.ok()) << resumed.status();
+
+  EXPECT_THAT(front_->start_frames, ElementsAre(0u, 7u, 7u, 20u));
+  ASSERT_EQ(seen.size(), 40u);  // each frame once, in order
+  for (uint32_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], i);
+  EXPECT_TRUE(
+      google::protobuf::util::MessageDifferencer::Equals(resumed->header, uninterrupted->header));
+  const auto expected = WithoutSeconds(uninterrupted->frames);
+  const auto got = WithoutSeconds(resumed->frames);
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < got.size(); ++i) {
+    EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(got[i], expected[i]))
+        << "frame " << i;
+  }
+  // Exponential backoff, the resume point reported with each retry.
+  ASSERT_EQ(retries_.size(), 3u);
+  EXPECT_EQ(retries_[0].backoff.count(), 1);
+  EXPECT_EQ(retries_[1].backoff.count(), 2);
+  EXPECT_EQ(retries_[2].backoff.count(), 4);
+  EXPECT_EQ(retries_[0].resume_frame, 7u);
+  EXPECT_EQ(retries_[1].resume_frame, 7u);
+  EXPECT_EQ(retries_[2].resume_frame, 20u);
+  EXPECT_EQ(retries_[1].status.code(), absl::StatusCode::kInternal);
+  // Every attempt carried the session id for the proxy's affinity.
+  EXPECT_THAT(front_->session_ids, Each(session_.id()));
+}
+
+TEST_F(InbetweenClientFailoverTest, GivesUpAfterTheLastAttempt) {
+  front_->faults = {{kUnavailable, 1}, {kUnavailable, 1}, {kUnavailable, 1}, {kUnavailable, 1}};
+  auto client = FrontClient(/*max_attempts=*/3);
+  auto frames = client->Inbetween(session_.id(), parameters_, nullptr);
+  EXPECT_EQ(frames.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_THAT(front_->start_frames, ElementsAre(0u, 1u, 2u));
+  EXPECT_EQ(retries_.size(), 2u);
+}
+
+TEST_F(InbetweenClientFailoverTest, NonTransientErrorsAreNotRetried) {
+  front_->faults = {{grpc::Status(grpc::StatusCode::FAILED_PRECONDITION, "no multimesh"), 3},
+                    {grpc::Status(grpc::StatusCode::INTERNAL, "frame 3: solver bug"), 0}};
+  auto client = FrontClient();
+  auto first = client->Inbetween(session_.id(), parameters_, nullptr);
+  EXPECT_EQ(first.status().code(), absl::StatusCode::kFailedPrecondition);
+  auto second = client->Inbetween(session_.id(), parameters_, nullptr);
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kInternal);
+  EXPECT_THAT(front_->start_frames, ElementsAre(0u, 0u));
+  EXPECT_TRUE(retries_.empty());
+}
+
+TEST_F(InbetweenClientFailoverTest, FramesOfAnotherSessionVersionAreNotSpliced) {
+  front_->faults = {{kUnavailable, 5}};
+  ClientOptions options;
+  options.retry.initial_backoff = std::chrono::milliseconds(1);
+  // While the client waits to resume, someone rebuilds the session (a new version).
+  options.on_retry = [this](const RetryEvent&) {
+    auto rebuilt = direct_->BuildMultimesh(session_, nullptr);
+    ASSERT_TRUE(rebuilt.ok()) << rebuilt.status();
+  };
+  InbetweenClient client(front_server_->InProcessChannel({}), options);
+  auto frames = client.Inbetween(session_.id(), parameters_, nullptr);
+  EXPECT_EQ(frames.status().code(), absl::StatusCode::kAborted);
+  EXPECT_THAT(frames.status().message(), HasSubstr("changed from version"));
+  EXPECT_THAT(front_->start_frames, ElementsAre(0u, 5u));
+}
+
+TEST_F(InbetweenClientFailoverTest, GetSessionAndListSessionsAreRetried) {
+  auto client = FrontClient();
+  front_->faults = {{kUnavailable, 0}, {kProxyReset, 0}};
+  auto got = client->GetSession(session_.id(), /*full=*/false);
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->session().version(), session_.version());
+  EXPECT_EQ(front_->unary_calls, 3);
+  EXPECT_THAT(front_->session_ids, Each(session_.id()));
+
+  front_->faults = {{kUnavailable, 0}};
+  auto listed = client->ListSessions();
+  ASSERT_TRUE(listed.ok()) << listed.status();
+  ASSERT_EQ(listed->size(), 1u);
+  EXPECT_EQ((*listed)[0].id(), session_.id());
+  EXPECT_EQ(front_->unary_calls, 5);
+
+  front_->faults = {{grpc::Status(grpc::StatusCode::NOT_FOUND, "no such session"), 0}};
+  EXPECT_EQ(client->GetSession("nope", false).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(front_->unary_calls, 6);
+  EXPECT_EQ(retries_.size(), 3u);
+}
+
+}  // namespace
+}  // namespace inbetween::client
