@@ -18,6 +18,7 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -509,6 +510,34 @@ const xmlNode* FindEntityReference(const xmlNode* node) {
   return nullptr;
 }
 
+// The first element with a non-ASCII byte in an attribute SVG++ parses (Boost.Spirit asserts on
+// such characters in its case-insensitive keyword matching: svg_import_fuzz finding), with the
+// attribute's name.
+std::optional<std::pair<const xmlNode*, std::string>> FindNonAsciiParsedAttribute(
+    const xmlNode* root) {
+  static const std::set<std::string> kParsed = {
+      "d",  "points", "transform", "style", "fill", "fill-rule", "x",  "y",  "width", "height",
+      "cx", "cy",     "r",         "rx",    "ry",   "x1",        "y1", "x2", "y2",    "stroke"};
+  std::vector<const xmlNode*> stack = {root};
+  while (!stack.empty()) {
+    const xmlNode* node = stack.back();
+    stack.pop_back();
+    if (node->type != XML_ELEMENT_NODE) continue;
+    for (const xmlAttr* attr = node->properties; attr != nullptr; attr = attr->next) {
+      const std::string name = reinterpret_cast<const char*>(attr->name);
+      if (!kParsed.count(name)) continue;
+      for (const xmlNode* child = attr->children; child; child = child->next) {
+        if (child->content == nullptr) continue;
+        for (const xmlChar* c = child->content; *c; ++c) {
+          if (*c >= 0x80) return std::make_pair(node, name);
+        }
+      }
+    }
+    for (const xmlNode* child = node->children; child; child = child->next) stack.push_back(child);
+  }
+  return std::nullopt;
+}
+
 // Documents written without xmlns still mean SVG; SVG++ only reads elements in its namespace.
 void AdoptSvgNamespace(xmlNode* root) {
   if (root->ns != nullptr) return;
@@ -667,6 +696,11 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
     return absl::InvalidArgumentError(
         absl::StrCat("SVG element ", Describe(element),
                      ": entity references are not supported (never expanded)"));
+  }
+  if (auto bad = FindNonAsciiParsedAttribute(root)) {
+    return absl::InvalidArgumentError(absl::StrCat("SVG element ", Describe(bad->first),
+                                                   ": attribute \"", bad->second,
+                                                   "\" has a non-ASCII character"));
   }
   AdoptSvgNamespace(root);
   if (auto bad = ExpandUses(doc.get(), root)) {

@@ -266,6 +266,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
          absl::StrCat("drawing ", ref + 1, ", ", num_edges, " boundary vertices"));
   TriangulateOptions triangulate_options;
   triangulate_options.shape_bound = options.shape_bound;
+  triangulate_options.max_vertices = options.max_mesh_vertices;
   {
     Point lo = bc->shapes[ref][0][0], hi = lo;
     double perimeter = 0.0;

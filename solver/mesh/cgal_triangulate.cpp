@@ -32,6 +32,22 @@ using Fb = CGAL::Delaunay_mesh_face_base_2<K>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
 using Cdt = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
 using Criteria = CGAL::Delaunay_mesh_size_criteria_2<Cdt>;
+
+// CGAL::refine_Delaunay_mesh_2, one step at a time so that it can stop at `max_vertices`.
+absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices) {
+  CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, criteria);
+  mesher.init();
+  while (!mesher.is_refinement_done()) {
+    mesher.try_one_step_refine_mesh();
+    if (max_vertices > 0 && cdt.number_of_vertices() > static_cast<size_t>(max_vertices)) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "triangulate: refinement needs more than ", max_vertices,
+          " vertices (a part of the drawing is far thinner than the rest: a sliver, a spike or "
+          "boundaries that nearly touch)"));
+    }
+  }
+  return absl::OkStatus();
+}
 using CgalPoint = K::Point_2;
 using VertexHandle = Cdt::Vertex_handle;
 
@@ -69,7 +85,11 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
     }
 
     const double size = options.max_edge > 0 ? options.max_edge : 0.0;
-    CGAL::refine_Delaunay_mesh_2(cdt, Criteria(options.shape_bound, size));
+    if (absl::Status s =
+            RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices);
+        !s.ok()) {
+      return s;
+    }
 
     std::map<VertexHandle, int> index;
     for (int i = 0; i < n; ++i) index[handles[i]] = i;
@@ -163,7 +183,11 @@ absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Poin
     // fills holes: marking the domain ourselves made the 5.5 mesher loop on concave shapes),
     // then faces kept by the even-odd rule at their centroid.
     const double size = options.max_edge > 0 ? options.max_edge : 0.0;
-    CGAL::refine_Delaunay_mesh_2(cdt, Criteria(options.shape_bound, size));
+    if (absl::Status s =
+            RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices);
+        !s.ok()) {
+      return s;
+    }
     auto in_domain = [&](const Point& q) {
       bool in = false;
       for (const Points& loop : loops) in ^= PolygonContains(loop, q);

@@ -15,6 +15,10 @@ struct TriangulateOptions {
   // Delaunay_mesh_size_criteria_2 shape bound B = 1 / (4 sin^2(min angle)); 0.125 ~ 20.7 deg,
   // the smallest value for which refinement is guaranteed to terminate.
   double shape_bound = 0.125;
+  // Refinement stops with RESOURCE_EXHAUSTED above this many vertices (<= 0: no bound). A
+  // sliver or spike far thinner than the rest of the drawing needs elements at its own scale
+  // all along it: millions of points, i.e. no answer in practice (mesh_fuzz finding).
+  int max_vertices = 2'000'000;
 };
 
 // A Steiner vertex the mesher put on the polygon boundary, on segment `segment` (from

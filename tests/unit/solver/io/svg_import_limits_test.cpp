@@ -83,6 +83,22 @@ TEST(SvgImportLimitsTest, ModestUseFanOutStillExpands) {
   EXPECT_EQ(d->outlines.size(), 3u);
 }
 
+// svg_import_fuzz finding (build/fuzz/artifacts/svg_import_fuzz/crash-328c010a…): a non-ASCII
+// colour made Boost.Spirit (inside SVG++) fail an assertion, i.e. abort the process in builds
+// with assertions on. Such attributes are refused before SVG++ reads them.
+TEST(SvgImportLimitsTest, NonAsciiParsedAttributeIsInvalidNotAnAbort) {
+  absl::StatusOr<Drawing> d =
+      ImportSvg(Svg("<path id=\"face\" fill=\"\xdd\x9a\xc7\x98"
+                    "040\" d=\"M 0 0 H 10 V 10 H 0 Z\"/>"));
+  EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(d.status().message(), HasSubstr("<path id=\"face\"> (line 1): attribute \"fill\" "
+                                              "has a non-ASCII character"));
+  // Non-ASCII text where SVG++ does not parse it (ids, titles) is fine.
+  EXPECT_TRUE(ImportSvg(Svg("<title>\xc3\xa9t\xc3\xa9</title><rect id=\"\xc3\xa9\" "
+                            "width=\"1\" height=\"1\"/>"))
+                  .ok());
+}
+
 TEST(SvgImportLimitsTest, NonPositiveMaxPointsIsInvalid) {
   SvgImportOptions options;
   options.max_points = 0;
