@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# Scale-out, short form (docs/scale-out.md): a real redis-server, three inbetween-server replicas
+# on it (--store redis://) and a real nginx from deploy/nginx/inbetween.conf, all on loopback.
+# Through nginx, the CLI creates sessions, builds and streams frames. Chaos: twice, the replica
+# serving a long Inbetween stream is killed with SIGKILL mid-stream (the CLI is paused after its
+# first frame, so the replica still has frames to send) and restarted; the CLI must resume on
+# another replica from the next frame and write a frames.json identical to an uninterrupted run.
+# Then a replica is killed while idle: every session still answers through nginx (nothing lost),
+# and again after its restart.
+source "$(dirname "$0")/lib/common.sh"
+source "$(dirname "$0")/lib/cluster.sh"
+
+FLAGS=(--solver-threads 1 --log-format text)
+start_redis
+store="redis://127.0.0.1:$REDIS_PORT"
+for n in 1 2 3; do start_replica "$n" 0 --store "$store" "${FLAGS[@]}"; done
+start_nginx "${REPLICA_PORT[1]}" "${REPLICA_PORT[2]}" "${REPLICA_PORT[3]}"
+echo "redis :$REDIS_PORT, replicas :${REPLICA_PORT[1]} :${REPLICA_PORT[2]} :${REPLICA_PORT[3]}, nginx $NGINX_ADDR"
+
+cli() { "$CLI_BIN" --server "$NGINX_ADDR" "$@"; }
+SESSIONS=()
+session_of() { grep -oE '^session [0-9a-f]+' "$1" | awk '{print $2}'; }
+
+# A few small sessions (spread over the replicas by their ids).
+sq="$INBETWEEN_SRC/examples/square_hexagon"
+for i in 1 2 3 4; do
+  cli -q animate "$sq/square.svg" "$sq/hexagon.svg" --frames 12 --format json --out "$WORK/small-$i" \
+    >"$WORK/small-$i.out"
+  SESSIONS+=("$(session_of "$WORK/small-$i.out")")
+done
+
+# The long stream: walk, 1200 frames (~20 MB of frames, far more than the buffers between the
+# replica and a paused CLI hold).
+WALK=("$INBETWEEN_SRC"/examples/walk/[1-4]_*.svg)
+LONG=(animate "${WALK[@]}" --frames 1200 --format json)
+cli -q "${LONG[@]}" --out "$WORK/reference" >"$WORK/reference.out"
+SESSIONS+=("$(session_of "$WORK/reference.out")")
+
+# chaos_round R: a long stream; after the CLI's first frame, pause the CLI, SIGKILL the replica
+# serving its session (nginx's access log names it), resume the CLI, restart the replica.
+KILLS=0
+chaos_round() {
+  local r=$1 out="$WORK/chaos-$1" err="$WORK/chaos-$1.err" cli_pid line sid up victim=""
+  cli "${LONG[@]}" --out "$out" >"$WORK/chaos-$r.out" 2>"$err" &
+  cli_pid=$!
+  for _ in $(seq 1 1200); do
+    grep -q '^frames' "$err" && break
+    kill -0 "$cli_pid" 2>/dev/null || break
+    sleep 0.05
+  done
+  grep -q '^frames' "$err" || { cat "$err"; echo "round $r: no frame arrived"; return 1; }
+  kill -STOP "$cli_pid"
+  # The CLI's session: the last one built (calls are sequential in this test).
+  line=$(grep '|/inbetween.v1.Inbetween/BuildMultimesh|' "$WORK/nginx/access.log" | tail -1)
+  sid=$(cut -d'|' -f1 <<<"$line")
+  up=$(cut -d'|' -f2 <<<"$line" | awk -F', ' '{print $NF}')  # the one that answered
+  for n in 1 2 3; do [[ "$up" == "127.0.0.1:${REPLICA_PORT[$n]}" ]] && victim=$n; done
+  [[ -n "$victim" ]] || { echo "round $r: no replica for upstream '$up'"; return 1; }
+  echo "round $r: session $sid streams from replica $victim ($up): SIGKILL"
+  kill_replica "$victim"
+  KILLS=$((KILLS + 1))
+  kill -CONT "$cli_pid"
+  wait "$cli_pid" || { cat "$err"; echo "round $r: the CLI failed after the failover"; return 1; }
+  start_replica "$victim" "${REPLICA_PORT[$victim]}" --store "$store" "${FLAGS[@]}"
+  [[ "$(session_of "$WORK/chaos-$r.out")" == "$sid" ]] || { echo "round $r: other session"; return 1; }
+  SESSIONS+=("$sid")
+  # Resumed mid-stream (not from the start, not after the end), and identical to the reference.
+  local resume
+  resume=$(grep -oE 'retry: Inbetween attempt 1 failed .*resuming at frame [0-9]+' "$err" |
+           grep -oE '[0-9]+$' | head -1 || true)
+  [[ -n "$resume" && "$resume" -gt 0 && "$resume" -lt 1200 ]] ||
+    { cat "$err"; echo "round $r: no mid-stream resume reported"; return 1; }
+  cmp "$WORK/reference/frames.json" "$out/frames.json" ||
+    { echo "round $r: frames differ from the uninterrupted run"; return 1; }
+  echo "round $r: resumed at frame $resume on another replica; 1200 frames identical"
+  rm -rf "$out"
+}
+chaos_round 1
+chaos_round 2
+
+# Every session answers through nginx: with a replica down (idle kill: nginx moves its calls to
+# another replica), then after it is back.
+check_sessions() {
+  for sid in "${SESSIONS[@]}"; do
+    [[ -n "$sid" ]] || { echo "a run printed no session id"; return 1; }
+    cli inspect "$sid" >"$WORK/inspect.out" 2>&1 || { cat "$WORK/inspect.out"; echo "session $sid lost ($1)"; return 1; }
+    grep -q "$sid" "$WORK/inspect.out" || { cat "$WORK/inspect.out"; echo "inspect $sid: no id"; return 1; }
+  done
+}
+kill_replica 2
+KILLS=$((KILLS + 1))
+check_sessions "replica 2 down"
+start_replica 2 "${REPLICA_PORT[2]}" --store "$store" "${FLAGS[@]}"
+check_sessions "replica 2 restarted"
+listed=$(cli inspect | grep -cE '[0-9a-f]{16}' || true)
+[[ "$listed" -ge "${#SESSIONS[@]}" ]] || { cli inspect; echo "ListSessions: $listed < ${#SESSIONS[@]}"; exit 1; }
+
+# Each replica served calls (affinity spreads sessions), and the multimesh of a session was
+# never rebuilt by a failover (one BuildMultimesh per session, in nginx's log).
+for n in 1 2 3; do
+  grep -q 'rpc=' "$WORK/replica-$n.log" || { echo "replica $n served nothing"; exit 1; }
+done
+builds=$(grep -c '|/inbetween.v1.Inbetween/BuildMultimesh|' "$WORK/nginx/access.log")
+[[ "$builds" -eq "${#SESSIONS[@]}" ]] || { echo "$builds builds for ${#SESSIONS[@]} sessions"; exit 1; }
+echo "ok: ${#SESSIONS[@]} sessions, $KILLS replica kills, 0 sessions lost, frames identical"
