@@ -612,9 +612,13 @@ std::optional<UseError> ExpandUses(xmlDoc* doc, xmlNode* root) {
     std::map<const xmlNode*, size_t> sizes;
     for (xmlNode* use : uses) {
       std::optional<std::string> href = UseHref(use);
-      if (!href || href->size() < 2) continue;  // reported below
+      if (!href || href->size() < 2 || (*href)[0] != '#') {
+        return UseError{use, "<use> needs href=\"#id\" of an element in the document"};
+      }
       auto it = by_id.find(href->substr(1));
-      if (it == by_id.end()) continue;
+      if (it == by_id.end()) {
+        return UseError{use, absl::StrCat("<use> references unknown id \"", *href, "\"")};
+      }
       auto [size, inserted] = sizes.emplace(it->second, 0);
       if (inserted) size->second = CountElements(it->second);
       elements += size->second;
@@ -624,15 +628,15 @@ std::optional<UseError> ExpandUses(xmlDoc* doc, xmlNode* root) {
                         absl::StatusCode::kResourceExhausted};
       }
     }
+    // Copies are taken from the round's starting state: copying a node that an earlier use of
+    // the same round already grew would double it per use (2^uses in one round; fuzzer OOM).
+    std::map<const xmlNode*, xmlNode*> snapshot;
+    for (const auto& [node, size] : sizes) {
+      snapshot[node] = xmlDocCopyNode(const_cast<xmlNode*>(node), doc, 1);
+    }
     for (xmlNode* use : uses) {
-      std::optional<std::string> href = UseHref(use);
-      if (!href || href->size() < 2 || (*href)[0] != '#') {
-        return UseError{use, "<use> needs href=\"#id\" of an element in the document"};
-      }
-      auto it = by_id.find(href->substr(1));
-      if (it == by_id.end()) {
-        return UseError{use, absl::StrCat("<use> references unknown id \"", *href, "\"")};
-      }
+      const std::string href = *UseHref(use);  // checked above
+      auto it = by_id.find(href.substr(1));
       std::string transform = Attribute(use, "transform").value_or("");
       const std::string x = Attribute(use, "x").value_or("0"),
                         y = Attribute(use, "y").value_or("0");
@@ -646,7 +650,7 @@ std::optional<UseError> ExpandUses(xmlDoc* doc, xmlNode* root) {
                      reinterpret_cast<const xmlChar*>(v->c_str()));
         }
       }
-      xmlNode* copy = xmlDocCopyNode(it->second, doc, 1);
+      xmlNode* copy = xmlDocCopyNode(snapshot.at(it->second), doc, 1);
       std::vector<xmlNode*> strip = {copy};
       while (!strip.empty()) {
         xmlNode* node = strip.back();
@@ -659,6 +663,7 @@ std::optional<UseError> ExpandUses(xmlDoc* doc, xmlNode* root) {
       xmlReplaceNode(use, group);
       xmlFreeNode(use);
     }
+    for (const auto& [node, copy] : snapshot) xmlFreeNode(copy);
   }
 }
 
