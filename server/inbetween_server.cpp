@@ -19,7 +19,6 @@
 #include "server/inbetween_service.h"
 #include "server/metrics.h"
 #include "server/request_parse_errors.h"
-#include "server/request_parse_errors.h"
 #include "server/redis_session_store.h"
 #include "server/session_store.h"
 
@@ -130,7 +129,6 @@ absl::StatusOr<std::unique_ptr<InbetweenServer>> InbetweenServer::Start(
   builder.SetMaxReceiveMessageSize(options.max_message_bytes);
   builder.SetMaxSendMessageSize(options.max_message_bytes);
   builder.RegisterService(server->service_.get());
-  builder.experimental().SetInterceptorCreators(RequestParseErrorInterceptors());
   builder.experimental().SetInterceptorCreators(RequestParseErrorInterceptors());
   server->server_ = builder.BuildAndStart();
   if (!server->server_) {
