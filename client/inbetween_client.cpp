@@ -129,6 +129,15 @@ absl::StatusOr<std::vector<v1::Session>> InbetweenClient::ListSessions() {
   return sessions;
 }
 
+absl::Status InbetweenClient::DeleteSession(const v1::Session& session) {
+  Call call(this, session.id());
+  v1::DeleteSessionRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  v1::DeleteSessionResponse response;
+  return FromGrpcStatus(stub_->DeleteSession(&call.context, request, &response));
+}
+
 absl::StatusOr<v1::PutDrawingResponse> InbetweenClient::PutDrawing(
     const v1::PutDrawingRequest& request) {
   Call call(this, request.session_id());

@@ -72,6 +72,8 @@ class InbetweenClient {
   absl::StatusOr<v1::GetSessionResponse> GetSession(const std::string& session_id, bool full);
   // Every session of the caller (all pages).
   absl::StatusOr<std::vector<v1::Session>> ListSessions();
+  // Deletes the session at `session.version()` (0 = any version); not retried.
+  absl::Status DeleteSession(const v1::Session& session);
   absl::StatusOr<v1::PutDrawingResponse> PutDrawing(const v1::PutDrawingRequest& request);
   absl::StatusOr<v1::Session> SetCorrespondences(const v1::SetCorrespondencesRequest& request);
   absl::StatusOr<v1::BuildMultimeshResult> BuildMultimesh(const v1::Session& session,

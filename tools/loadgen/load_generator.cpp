@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "absl/strings/match.h"
@@ -57,9 +58,32 @@ class Run {
     return status;
   }
 
+  // A heavy call (a slot of the server's bounded pool): RESOURCE_EXHAUSTED is the server's
+  // documented back-pressure, so the studio waits (100 ms, doubling up to 1.6 s) and asks again,
+  // up to 6 times; every attempt is a request in the report.
+  absl::Status MeasureHeavy(const std::string& rpc, const std::function<absl::Status()>& call) {
+    std::chrono::milliseconds wait(100);
+    for (int attempt = 1;; ++attempt) {
+      absl::Status status = Measure(rpc, call);
+      if (!absl::IsResourceExhausted(status) || attempt == 6) return status;
+      std::this_thread::sleep_for(wait);
+      wait = std::min(wait * 2, std::chrono::milliseconds(1600));
+    }
+  }
+
+  // Sessions created and not deleted by the studio that made them.
   void AddSession(const std::string& id) {
     std::lock_guard<std::mutex> lock(mu_);
-    sessions_.push_back(id);
+    ++sessions_created_;
+    alive_.insert(id);
+  }
+  void DeletedSession(const std::string& id) {
+    std::lock_guard<std::mutex> lock(mu_);
+    alive_.erase(id);
+  }
+  void LostSession() {
+    std::lock_guard<std::mutex> lock(mu_);
+    ++lost_;
   }
   void AddFrames(const std::string& digest) {
     std::lock_guard<std::mutex> lock(mu_);
@@ -68,9 +92,9 @@ class Run {
     if (digest != first_frames_) frames_identical_ = false;
   }
   void AddRetry() { retries_.fetch_add(1); }
-  std::vector<std::string> sessions() {
+  std::vector<std::string> alive_sessions() {
     std::lock_guard<std::mutex> lock(mu_);
-    return sessions_;
+    return {alive_.begin(), alive_.end()};
   }
 
   LoadReport Report(double seconds) {
@@ -94,7 +118,8 @@ class Run {
     }
     r.unary_p99_ms = Percentile(unary, 99);
     r.retries = retries_.load();
-    r.sessions = static_cast<int64_t>(sessions_.size());
+    r.sessions = sessions_created_;
+    r.lost_sessions = lost_;
     r.streams_completed = streams_completed_;
     r.frames_identical = frames_identical_;
     return r;
@@ -113,7 +138,9 @@ class Run {
   int64_t requests_ = 0;
   std::map<std::string, Samples> samples_;
   std::map<std::string, int64_t> errors_by_code_;
-  std::vector<std::string> sessions_;
+  int64_t sessions_created_ = 0;
+  int64_t lost_ = 0;
+  std::set<std::string> alive_;
   int64_t streams_completed_ = 0;
   std::string first_frames_;
   bool frames_identical_ = true;
@@ -129,8 +156,9 @@ std::string FramesDigest(client::FramesResult frames) {
   return bytes;
 }
 
-// One studio: the animator's loop until the budget or the time runs out. A failed call ends the
-// current project (after a short pause) and the studio starts a new one.
+// One studio: the animator's loop until the budget or the time runs out; a project ends with
+// DeleteSession. A failed call ends the current project (after a short pause; its session is
+// kept and checked at the end) and the studio starts a new one.
 void Studio(int index, client::InbetweenClient& api, const LoadGenOptions& options, Run& run) {
   // The optimization's bound lives in the session's parameters.
   v1::Parameters parameters;
@@ -162,21 +190,21 @@ void Studio(int index, client::InbetweenClient& api, const LoadGenOptions& optio
       });
     }
     if (status.ok()) {
-      status = run.Measure("BuildMultimesh", [&] {
+      status = run.MeasureHeavy("BuildMultimesh", [&] {
         auto built = api.BuildMultimesh(session, nullptr);
         if (built.ok()) session = built->session();
         return built.status();
       });
     }
     if (status.ok() && options.optimize_outer_iterations > 0) {
-      status = run.Measure("OptimizeComesh", [&] {
+      status = run.MeasureHeavy("OptimizeComesh", [&] {
         auto optimized = api.OptimizeComesh(session, nullptr, nullptr);
         if (optimized.ok()) session = optimized->session();
         return optimized.status();
       });
     }
     if (status.ok()) {
-      status = run.Measure("Inbetween", [&] {
+      status = run.MeasureHeavy("Inbetween", [&] {
         v1::InbetweenParameters parameters;
         parameters.set_frames(options.frames);
         auto frames = api.Inbetween(session.id(), parameters, nullptr);
@@ -188,6 +216,7 @@ void Studio(int index, client::InbetweenClient& api, const LoadGenOptions& optio
       status = run.Measure("GetSession", [&] {
         auto got = api.GetSession(session.id(), /*full=*/false);
         if (got.ok()) session = got->session();
+        if (absl::IsNotFound(got.status())) run.LostSession();
         return got.status();
       });
     }
@@ -200,11 +229,16 @@ void Studio(int index, client::InbetweenClient& api, const LoadGenOptions& optio
         request.mutable_drawing()->set_name("key1-edited.svg");
         request.mutable_drawing()->set_svg(options.drawings_svg[0]);
         auto put = api.PutDrawing(request);
+        if (put.ok()) session = put->session();
         return put.status();
       });
     }
     if (status.ok()) {
       status = run.Measure("ListSessions", [&] { return api.ListSessions().status(); });
+    }
+    if (status.ok()) {
+      status = run.Measure("DeleteSession", [&] { return api.DeleteSession(session); });
+      if (status.ok()) run.DeletedSession(session.id());
     }
     if (absl::IsCancelled(status) && status.message() == "budget") return;
     if (!status.ok()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -275,9 +309,9 @@ absl::StatusOr<LoadReport> RunLoad(std::shared_ptr<grpc::Channel> channel,
   for (std::thread& t : studios) t.join();
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   LoadReport report = run.Report(seconds);
-  // Every session created must still be there (e.g. after replicas were killed).
+  // Every session created and not deleted must still be there (e.g. after replicas were killed).
   client::InbetweenClient checker(channel, client_options);
-  for (const std::string& id : run.sessions()) {
+  for (const std::string& id : run.alive_sessions()) {
     auto got = checker.GetSession(id, /*full=*/false);
     if (!got.ok() && absl::IsNotFound(got.status())) ++report.lost_sessions;
     if (!got.ok() && !absl::IsNotFound(got.status())) {

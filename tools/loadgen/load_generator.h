@@ -1,8 +1,8 @@
 // inbetween-loadgen's engine: N virtual studios, each a thread running the animator's loop over
 // the C++ client library (create a session, upload drawings, build, optimize, stream frames,
-// read it back, edit a drawing, list sessions) against one target until a duration or a total
-// request count is reached; per-RPC latencies and errors by status code, then a check that every
-// session created is still there. Streams go through the library's failover (resumed after a
+// read it back, edit a drawing, list sessions, delete it) against one target until a duration or a
+// total request count is reached; per-RPC latencies and errors by status code, then a check that
+// every session created is still there. Streams go through the library's failover (resumed after a
 // replica dies), so an Inbetween latency includes its retries.
 #pragma once
 
@@ -40,14 +40,14 @@ struct RpcSummary {
 struct LoadReport {
   int studios = 0;
   double seconds = 0;    // wall time of the run (without the final session check)
-  int64_t requests = 0;  // RPCs sent (each stream counts once)
+  int64_t requests = 0;  // RPCs sent (a stream once; a busy-pool retry again)
   int64_t errors = 0;
   std::map<std::string, int64_t> errors_by_code;  // "UNAVAILABLE" -> count
   std::map<std::string, RpcSummary> rpcs;         // "Inbetween" -> summary
   double unary_p99_ms = 0;                        // over every successful unary call
   int64_t retries = 0;                            // retries made by the client library
   int64_t sessions = 0;                           // sessions created
-  int64_t lost_sessions = 0;                      // created, later NOT_FOUND
+  int64_t lost_sessions = 0;                      // created, not deleted, then NOT_FOUND
   int64_t streams_completed = 0;                  // Inbetween streams with every frame
   bool frames_identical = true;                   // every completed stream gave the same frames
 };

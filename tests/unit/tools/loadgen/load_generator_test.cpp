@@ -57,25 +57,25 @@ TEST(LoadGeneratorTest, BoundedRunAgainstARealServer) {
   LoadGenOptions options;
   options.studios = 3;
   options.duration = std::chrono::seconds(600);  // the request budget ends the run
-  options.max_requests = 40;
+  options.max_requests = 60;
   options.frames = 6;
   options.drawings_svg = {ReadExample("examples/square_hexagon/square.svg"),
                           ReadExample("examples/square_hexagon/hexagon.svg")};
   auto report = RunLoad((*server)->InProcessChannel(), options);
   ASSERT_TRUE(report.ok()) << report.status();
 
-  EXPECT_EQ(report->requests, 40);
+  EXPECT_EQ(report->requests, 60);
   EXPECT_EQ(report->errors, 0) << FormatTable(*report);
   EXPECT_TRUE(report->errors_by_code.empty());
   for (const char* rpc : {"CreateSession", "PutDrawing", "BuildMultimesh", "OptimizeComesh",
-                          "Inbetween", "GetSession", "ListSessions"}) {
+                          "Inbetween", "GetSession", "ListSessions", "DeleteSession"}) {
     ASSERT_TRUE(report->rpcs.count(rpc)) << rpc << "\n" << FormatTable(*report);
     EXPECT_GT(report->rpcs.at(rpc).calls, 0) << rpc;
     EXPECT_LE(report->rpcs.at(rpc).p50_ms, report->rpcs.at(rpc).p99_ms) << rpc;
   }
   int64_t calls = 0;
   for (const auto& [rpc, s] : report->rpcs) calls += s.calls;
-  EXPECT_EQ(calls, 40);
+  EXPECT_EQ(calls, 60);
   EXPECT_EQ(report->sessions, report->rpcs.at("CreateSession").calls);
   EXPECT_EQ(report->lost_sessions, 0);
   EXPECT_EQ(report->streams_completed, report->rpcs.at("Inbetween").calls);
@@ -84,7 +84,7 @@ TEST(LoadGeneratorTest, BoundedRunAgainstARealServer) {
   // The JSON carries the fields scripts and dashboards read.
   nlohmann::json j = nlohmann::json::parse(FormatJson(*report));
   EXPECT_EQ(j["studios"], 3);
-  EXPECT_EQ(j["requests"], 40);
+  EXPECT_EQ(j["requests"], 60);
   EXPECT_EQ(j["lost_sessions"], 0);
   EXPECT_EQ(j["frames_identical"], true);
   EXPECT_TRUE(j["errors_by_code"].is_object());
