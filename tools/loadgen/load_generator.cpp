@@ -53,6 +53,7 @@ class Run {
       s.ms.push_back(ms);
     } else {
       ++s.errors;
+      ++s.errors_by_code[absl::StatusCodeToString(status.code())];
       ++errors_by_code_[absl::StatusCodeToString(status.code())];
     }
     return status;
@@ -110,6 +111,7 @@ class Run {
       RpcSummary& out = r.rpcs[rpc];
       out.calls = s.calls;
       out.errors = s.errors;
+      out.errors_by_code = s.errors_by_code;
       out.p50_ms = Percentile(s.ms, 50);
       out.p95_ms = Percentile(s.ms, 95);
       out.p99_ms = Percentile(s.ms, 99);
@@ -128,6 +130,7 @@ class Run {
  private:
   struct Samples {
     int64_t calls = 0, errors = 0;
+    std::map<std::string, int64_t> errors_by_code;
     std::vector<double> ms;
   };
   const LoadGenOptions& options_;
@@ -323,11 +326,14 @@ absl::StatusOr<LoadReport> RunLoad(std::shared_ptr<grpc::Channel> channel,
 }
 
 std::string FormatTable(const LoadReport& r) {
-  std::string out = absl::StrFormat("%-16s %8s %7s %10s %10s %10s %10s\n", "rpc", "calls", "errors",
-                                    "p50 ms", "p95 ms", "p99 ms", "max ms");
+  std::string out =
+      absl::StrFormat("%-16s %8s %7s %10s %10s %10s %10s  %s\n", "rpc", "calls", "errors", "p50 ms",
+                      "p95 ms", "p99 ms", "max ms", "errors by code");
   for (const auto& [rpc, s] : r.rpcs) {
-    absl::StrAppendFormat(&out, "%-16s %8d %7d %10.2f %10.2f %10.2f %10.2f\n", rpc, s.calls,
-                          s.errors, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms);
+    std::string codes;
+    for (const auto& [code, n] : s.errors_by_code) absl::StrAppend(&codes, " ", code, "=", n);
+    absl::StrAppendFormat(&out, "%-16s %8d %7d %10.2f %10.2f %10.2f %10.2f %s\n", rpc, s.calls,
+                          s.errors, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms, codes);
   }
   absl::StrAppendFormat(&out,
                         "%d studios, %.1f s, %d requests (%.1f/s), %d errors, unary p99 %.2f ms, "
@@ -358,6 +364,8 @@ std::string FormatJson(const LoadReport& r) {
   for (const auto& [rpc, s] : r.rpcs) {
     j["rpcs"][rpc] = {{"calls", s.calls},   {"errors", s.errors}, {"p50_ms", s.p50_ms},
                       {"p95_ms", s.p95_ms}, {"p99_ms", s.p99_ms}, {"max_ms", s.max_ms}};
+    j["rpcs"][rpc]["errors_by_code"] = nlohmann::json::object();
+    for (const auto& [code, n] : s.errors_by_code) j["rpcs"][rpc]["errors_by_code"][code] = n;
   }
   return j.dump(2);
 }

@@ -35,6 +35,7 @@ struct RpcSummary {
   int64_t calls = 0;
   int64_t errors = 0;
   double p50_ms = 0, p95_ms = 0, p99_ms = 0, max_ms = 0;
+  std::map<std::string, int64_t> errors_by_code;
 };
 
 struct LoadReport {

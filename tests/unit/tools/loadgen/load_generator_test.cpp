@@ -103,6 +103,7 @@ TEST(LoadGeneratorTest, UnreachableTargetIsCountedByCode) {
   ASSERT_TRUE(report.ok()) << report.status();
   EXPECT_EQ(report->requests, 3);
   EXPECT_EQ(report->errors_by_code["UNAVAILABLE"], 3);
+  EXPECT_EQ(report->rpcs["CreateSession"].errors_by_code["UNAVAILABLE"], 3);
   EXPECT_EQ(report->sessions, 0);
 }
 
