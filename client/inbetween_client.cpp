@@ -54,10 +54,10 @@ void InbetweenClient::CancelInFlight() {
   cancel_cv_.notify_all();
 }
 
-bool InbetweenClient::PrepareRetry(const std::string& method, int failed_attempt,
-                                   const grpc::Status& status, uint32_t resume_frame) {
+grpc::Status InbetweenClient::PrepareRetry(const std::string& method, int failed_attempt,
+                                           const grpc::Status& status, uint32_t resume_frame) {
   const RetryOptions& retry = options_.retry;
-  if (!IsTransient(status) || failed_attempt >= retry.max_attempts) return false;
+  if (!IsTransient(status) || failed_attempt >= retry.max_attempts) return status;
   const double ms =
       std::min(static_cast<double>(retry.max_backoff.count()),
                retry.initial_backoff.count() * std::pow(retry.multiplier, failed_attempt - 1));
@@ -70,7 +70,11 @@ bool InbetweenClient::PrepareRetry(const std::string& method, int failed_attempt
                                  .resume_frame = resume_frame});
   }
   std::unique_lock<std::mutex> lock(mu_);
-  return !cancel_cv_.wait_for(lock, backoff, [this] { return cancelled_; });
+  if (cancel_cv_.wait_for(lock, backoff, [this] { return cancelled_; })) {
+    return grpc::Status(grpc::StatusCode::CANCELLED,
+                        absl::StrCat(method, " cancelled while waiting to retry"));
+  }
+  return grpc::Status::OK;
 }
 
 grpc::Status InbetweenClient::CallWithRetry(
@@ -82,7 +86,8 @@ grpc::Status InbetweenClient::CallWithRetry(
       Call call(this, session_id);
       status = rpc(&call.context);
     }
-    if (status.ok() || !PrepareRetry(method, attempt, status)) return status;
+    if (status.ok()) return status;
+    if (grpc::Status retry = PrepareRetry(method, attempt, status); !retry.ok()) return retry;
   }
 }
 
@@ -246,9 +251,9 @@ absl::StatusOr<FramesResult> InbetweenClient::Inbetween(
     if (status.ok()) break;
     // Every frame arrived before the connection broke: nothing to resume.
     if (have_header && result.frames.size() == result.header.frames()) break;
-    if (!PrepareRetry("Inbetween", attempt, status, static_cast<uint32_t>(result.frames.size()))) {
-      return FromGrpcStatus(status);
-    }
+    grpc::Status retry =
+        PrepareRetry("Inbetween", attempt, status, static_cast<uint32_t>(result.frames.size()));
+    if (!retry.ok()) return FromGrpcStatus(retry);
   }
   if (!have_header) return absl::InternalError("Inbetween stream ended without a header");
   if (result.frames.size() != result.header.frames()) {

@@ -100,10 +100,11 @@ class InbetweenClient {
   // attempts run out; for idempotent unary calls only.
   grpc::Status CallWithRetry(const std::string& method, const std::string& session_id,
                              const std::function<grpc::Status(grpc::ClientContext*)>& rpc);
-  // Reports the retry and waits the backoff before attempt `failed_attempt + 1`; false when the
-  // attempts are used up, the failure is not transient, or CancelInFlight() came.
-  bool PrepareRetry(const std::string& method, int failed_attempt, const grpc::Status& status,
-                    uint32_t resume_frame = 0);
+  // Reports the retry and waits the backoff before attempt `failed_attempt + 1`: OK to go on;
+  // else what the call returns: `status` itself when it is not transient or the attempts are
+  // used up, CANCELLED when CancelInFlight() came during the wait.
+  grpc::Status PrepareRetry(const std::string& method, int failed_attempt,
+                            const grpc::Status& status, uint32_t resume_frame = 0);
 
   std::unique_ptr<v1::Inbetween::Stub> stub_;
   ClientOptions options_;

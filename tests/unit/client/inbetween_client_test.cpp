@@ -254,6 +254,19 @@ TEST_F(InbetweenClientFailoverTest, FramesOfAnotherSessionVersionAreNotSpliced) 
   EXPECT_THAT(front_->start_frames, ElementsAre(0u, 5u));
 }
 
+TEST_F(InbetweenClientFailoverTest, CancelDuringTheBackoffEndsTheCall) {
+  front_->faults = {{kUnavailable, 2}};
+  ClientOptions options;
+  options.retry.initial_backoff = std::chrono::minutes(10);  // only a cancel ends this wait
+  InbetweenClient* client_ptr = nullptr;
+  options.on_retry = [&](const RetryEvent&) { client_ptr->CancelInFlight(); };  // Ctrl-C
+  InbetweenClient client(front_server_->InProcessChannel({}), options);
+  client_ptr = &client;
+  auto frames = client.Inbetween(session_.id(), parameters_, nullptr);
+  EXPECT_EQ(frames.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_THAT(front_->start_frames, ElementsAre(0u));
+}
+
 TEST_F(InbetweenClientFailoverTest, GetSessionAndListSessionsAreRetried) {
   auto client = FrontClient();
   front_->faults = {{kUnavailable, 0}, {kProxyReset, 0}};
