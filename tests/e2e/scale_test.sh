@@ -29,6 +29,17 @@ for i in 1 2 3 4; do
   SESSIONS+=("$(session_of "$WORK/small-$i.out")")
 done
 
+# Affinity (no replica down yet): every call naming a small session reached one replica.
+# (CreateSession, round-robin as it names no session yet, is left out.)
+for sid in "${SESSIONS[@]}"; do
+  serving=0
+  for n in 1 2 3; do
+    c=$(grep "session=$sid" "$WORK/replica-$n.log" | grep -vc 'rpc=CreateSession' || true)
+    [[ "$c" -gt 0 ]] && serving=$((serving + 1))
+  done
+  [[ $serving -eq 1 ]] || { echo "session $sid was served by $serving replicas"; exit 1; }
+done
+
 # The long stream: walk, 1200 frames (~20 MB of frames, far more than the buffers between the
 # replica and a paused CLI hold).
 WALK=("$INBETWEEN_SRC"/examples/walk/[1-4]_*.svg)

@@ -125,3 +125,40 @@ CONF
   done
   echo "nginx did not start" >&2; return 1
 }
+
+# start_haproxy PORT...: HAProxy from deploy/haproxy/inbetween.cfg with its servers replaced by
+# 127.0.0.1:PORT... and its frontend by a free loopback port; sets HAPROXY_ADDR, HAPROXY_PID.
+start_haproxy() {
+  command -v haproxy >/dev/null || { echo "haproxy is not installed (scripts/setup)"; return 1; }
+  local template="$INBETWEEN_SRC/deploy/haproxy/inbetween.cfg" port
+  [[ $(grep -cE '^\s*server r[0-9]+ 127\.0\.0\.1:[0-9]+' "$template") -eq $# ]] ||
+    { echo "expected $# server lines in $template" >&2; return 1; }
+  for _ in 1 2 3 4 5; do
+    port=$(free_port)
+    "$PY" - "$template" "$WORK/haproxy.cfg" "$port" "$@" <<'PYEOF'
+import re, sys
+template, out, listen, ports = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
+text = open(template).read()
+text, n = re.subn(r"bind 127\.0\.0\.1:\d+ ", f"bind 127.0.0.1:{listen} ", text)
+assert n == 1, "bind line not found in the template"
+it = iter(ports)
+text = re.sub(r"(^\s*server r\d+ )127\.0\.0\.1:\d+", lambda m: f"{m.group(1)}127.0.0.1:{next(it)}",
+              text, flags=re.M)
+open(out, "w").write(text)
+PYEOF
+    haproxy -db -f "$WORK/haproxy.cfg" >"$WORK/haproxy.log" 2>&1 &
+    HAPROXY_PID=$!
+    PIDS+=("$HAPROXY_PID")
+    for _ in $(seq 1 200); do
+      if ! kill -0 "$HAPROXY_PID" 2>/dev/null; then break; fi
+      if (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then
+        HAPROXY_ADDR="127.0.0.1:$port"
+        return 0
+      fi
+      sleep 0.05
+    done
+    kill -9 "$HAPROXY_PID" 2>/dev/null || true
+    cat "$WORK/haproxy.log" 2>/dev/null || true
+  done
+  echo "haproxy did not start" >&2; return 1
+}
