@@ -47,12 +47,15 @@ LONG=(animate "${WALK[@]}" --frames 1200 --format json)
 cli -q "${LONG[@]}" --out "$WORK/reference" >"$WORK/reference.out"
 SESSIONS+=("$(session_of "$WORK/reference.out")")
 
-# chaos_round R: a long stream; after the CLI's first frame, pause the CLI, SIGKILL the replica
-# serving its session (nginx's access log names it), resume the CLI, restart the replica.
+# chaos_try R A: a long stream; after the CLI's first frame, pause the CLI, SIGKILL the replica
+# serving its session (the one that answered its BuildMultimesh, in nginx's access log), resume
+# the CLI, restart the replica. Returns 2 when the stream turned out to run on another replica
+# (nginx moved it, e.g. off a stale keepalive connection): nothing was interrupted, try again.
 KILLS=0
-chaos_round() {
-  local r=$1 out="$WORK/chaos-$1" err="$WORK/chaos-$1.err" cli_pid line sid up victim=""
-  cli "${LONG[@]}" --out "$out" >"$WORK/chaos-$r.out" 2>"$err" &
+chaos_try() {
+  local r=$1 a=$2 out="$WORK/chaos-$1-$2" err="$WORK/chaos-$1-$2.err" cli_pid line sid up
+  local victim="" resume streamed
+  cli "${LONG[@]}" --out "$out" >"$out.txt" 2>"$err" &
   cli_pid=$!
   for _ in $(seq 1 1200); do
     grep -q '^frames' "$err" && break
@@ -60,7 +63,7 @@ chaos_round() {
     sleep 0.05
   done
   grep -q '^frames' "$err" || { cat "$err"; echo "round $r: no frame arrived"; return 1; }
-  kill -STOP "$cli_pid"
+  kill -STOP "$cli_pid" || return 1
   # The CLI's session: the last one built (calls are sequential in this test).
   line=$(grep '|/inbetween.v1.Inbetween/BuildMultimesh|' "$WORK/nginx/access.log" | tail -1)
   sid=$(cut -d'|' -f1 <<<"$line")
@@ -72,19 +75,36 @@ chaos_round() {
   KILLS=$((KILLS + 1))
   kill -CONT "$cli_pid"
   wait "$cli_pid" || { cat "$err"; echo "round $r: the CLI failed after the failover"; return 1; }
-  start_replica "$victim" "${REPLICA_PORT[$victim]}" --store "$store" "${FLAGS[@]}"
-  [[ "$(session_of "$WORK/chaos-$r.out")" == "$sid" ]] || { echo "round $r: other session"; return 1; }
+  start_replica "$victim" "${REPLICA_PORT[$victim]}" --store "$store" "${FLAGS[@]}" || return 1
+  [[ "$(session_of "$out.txt")" == "$sid" ]] || { echo "round $r: other session"; return 1; }
   SESSIONS+=("$sid")
-  # Resumed mid-stream (not from the start, not after the end), and identical to the reference.
-  local resume
-  resume=$(grep -oE 'retry: Inbetween attempt 1 failed .*resuming at frame [0-9]+' "$err" |
-           grep -oE '[0-9]+$' | head -1 || true)
-  [[ -n "$resume" && "$resume" -gt 0 && "$resume" -lt 1200 ]] ||
-    { cat "$err"; echo "round $r: no mid-stream resume reported"; return 1; }
   cmp "$WORK/reference/frames.json" "$out/frames.json" ||
     { echo "round $r: frames differ from the uninterrupted run"; return 1; }
+  # Resumed mid-stream (not from the start, not after the end).
+  resume=$(grep -oE 'retry: Inbetween attempt 1 failed .*resuming at frame [0-9]+' "$err" |
+           grep -oE '[0-9]+$' | head -1 || true)
+  if [[ -z "$resume" ]]; then
+    streamed=$(grep "^$sid|.*|/inbetween.v1.Inbetween/Inbetween|" "$WORK/nginx/access.log" |
+               cut -d'|' -f2 | awk -F', ' '{print $NF}')
+    if [[ -n "$streamed" && "$streamed" != "$up" ]]; then
+      echo "round $r: the stream ran on $streamed, not on the killed replica; again"
+      rm -rf "$out"
+      return 2
+    fi
+    cat "$err"; echo "round $r: no mid-stream resume reported"; return 1
+  fi
+  [[ "$resume" -gt 0 && "$resume" -lt 1200 ]] || { echo "round $r: resumed at $resume"; return 1; }
   echo "round $r: resumed at frame $resume on another replica; 1200 frames identical"
   rm -rf "$out"
+}
+chaos_round() {
+  local rc
+  for a in 1 2 3; do
+    rc=0
+    chaos_try "$1" "$a" || rc=$?
+    [[ $rc -eq 2 ]] || return "$rc"
+  done
+  echo "round $1: the killed replica never carried the stream"; return 1
 }
 chaos_round 1
 chaos_round 2
