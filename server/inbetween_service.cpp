@@ -796,6 +796,7 @@ grpc::Status InbetweenService::BuildMultimesh(
         const Clock::time_point start = Clock::now();
         solver::MultimeshReport report;
         solver::MultimeshOptions options = ToMultimeshOptions(meshing);
+        options.max_mesh_vertices = options_.limits.max_mesh_vertices;  // bounds the refinement
         for (const v1::Correspondence& mark : state->session.correspondences()) {
           options.marks.push_back(FromProto(mark.points()));
         }
