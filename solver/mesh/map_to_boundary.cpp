@@ -3,7 +3,8 @@
 // Convex target: Tutte embedding with mean-value weights (Floater 2003), injective for a convex
 // boundary once boundary chords are split (see split_boundary_chords.h).
 // Otherwise, in the spirit of LIM (Schueller et al. 2013): start from the identity (shape 1's
-// own, valid geometry), pull the boundary vertices towards their targets with a quadratic
+// own, valid geometry) or, when it folds nothing, its least-squares affine fit to the target
+// boundary, pull the boundary vertices towards their targets with a quadratic
 // penalty whose weight grows stage by stage, while minimising the symmetric Dirichlet energy
 // relative to shape 1's triangles, SD(J) = |J|^2 + |J^-1|^2, which is infinite at a fold. Each
 // iteration solves the SLIM proxy (Rabinovich et al. 2017: reweighted local-global system) and
@@ -300,6 +301,30 @@ bool TutteEmbedding(const Points& source, const std::vector<Triangle>& triangles
   return true;
 }
 
+// The least-squares affine map of the source boundary onto the target boundary, applied to every
+// vertex: when the target is (close to) an affine image of the source, a start that is already
+// (close to) done. False when that map reverses orientation or folds a triangle.
+bool AffineStart(const Points& source, const std::vector<Triangle>& triangles,
+                 const std::vector<int>& boundary, const Points& target_boundary, Points* out) {
+  const int m = static_cast<int>(boundary.size());
+  Point cs = Point::Zero(), ct = Point::Zero();
+  for (int k = 0; k < m; ++k) cs += source[boundary[k]], ct += target_boundary[k];
+  cs /= m;
+  ct /= m;
+  Eigen::Matrix2d ss = Eigen::Matrix2d::Zero(), ts = Eigen::Matrix2d::Zero();
+  for (int k = 0; k < m; ++k) {
+    const Point a = source[boundary[k]] - cs, b = target_boundary[k] - ct;
+    ss += a * a.transpose();
+    ts += b * a.transpose();
+  }
+  if (!(std::abs(ss.determinant()) > 1e-300)) return false;
+  const Eigen::Matrix2d map = ts * ss.inverse();
+  if (!map.allFinite() || !(map.determinant() > 0.0)) return false;
+  out->resize(source.size());
+  for (size_t v = 0; v < source.size(); ++v) (*out)[v] = ct + map * (source[v] - cs);
+  return CountInverted(triangles, *out) == 0;
+}
+
 }  // namespace
 
 absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Triangle>& triangles,
@@ -363,8 +388,16 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
     }
   }
   if (!placed) {
-    // Progressive boundary pull from the identity (or the given start).
-    x = options.start != nullptr ? *options.start : source;
+    // Progressive boundary pull from the given start, else from the best-fitting affine image of
+    // the source (exact for a rotated, scaled or sheared copy), else from the identity.
+    Points affine;
+    if (options.start != nullptr) {
+      x = *options.start;
+    } else if (AffineStart(source, triangles, boundary, target_boundary, &affine)) {
+      x = std::move(affine);
+    } else {
+      x = source;
+    }
     Constraints pull;
     pull.free_index.resize(n);
     for (int v = 0; v < n; ++v) pull.free_index[v] = v;

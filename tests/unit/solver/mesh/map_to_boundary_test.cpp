@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <cmath>
 
 #include "solver/geometry/correspondence.h"
@@ -130,6 +131,30 @@ TEST(MapToBoundaryTest, ArchToBarNonConvexSource) {
   absl::StatusOr<Points> x = MapToBoundary(s.source, s.triangles, s.boundary, s.target);
   ASSERT_TRUE(x.ok()) << x.status();
   ExpectInjectiveAndExact(s, *x);
+}
+
+TEST(MapToBoundaryTest, AffineImageStartsFromTheAffineMap) {
+  // A non-convex arch onto a rotated, sheared, scaled copy of itself: the pull starts from the
+  // least-squares affine fit of the boundaries, which is exact here, so no stage is needed and
+  // every vertex lands where the affine map puts it.
+  MapCase s = Make(Arch(), Arch(), 96);
+  Eigen::Matrix2d map;
+  map << 1.2 * std::cos(0.7), -std::sin(0.7), 0.3 + std::sin(0.7), 0.8 * std::cos(0.7);
+  ASSERT_GT(map.determinant(), 0.0);
+  auto affine = [&](const Point& p) { return Point(map * p + Point(40, -25)); };
+  for (size_t k = 0; k < s.boundary.size(); ++k) s.target[k] = affine(s.source[s.boundary[k]]);
+  MapToBoundaryOptions options;
+  options.tutte_first_always = false;
+  MapToBoundaryReport report;
+  absl::StatusOr<Points> x =
+      MapToBoundary(s.source, s.triangles, s.boundary, s.target, options, nullptr, &report);
+  ASSERT_TRUE(x.ok()) << x.status();
+  ExpectInjectiveAndExact(s, *x);
+  EXPECT_FALSE(report.tutte);
+  EXPECT_EQ(report.stages, 0);
+  for (size_t v = 0; v < s.source.size(); ++v) {
+    EXPECT_LT(((*x)[v] - affine(s.source[v])).norm(), 1e-6) << v;
+  }
 }
 
 TEST(MapToBoundaryTest, ImpossibleTargetFailsWithoutFolding) {
