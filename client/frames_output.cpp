@@ -22,6 +22,7 @@ render::FrameSet ToFrameSet(const FramesResult& frames) {
       valid.boundary_overlaps = static_cast<int>(f.stats().boundary_overlaps());
       valid.min_area_ratio = f.stats().min_area_ratio();
       valid.max_area_ratio = f.stats().max_area_ratio();
+      valid.hold_back = f.stats().overlap_hold_back();
       data.valid = valid;
     }
     out.frames.push_back(std::move(data));

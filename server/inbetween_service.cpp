@@ -1061,6 +1061,7 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
             stats->set_min_area_ratio(report.min_area_ratio);
             stats->set_max_area_ratio(report.max_area_ratio);
             stats->set_separated_cohesive_edges(report.separated_edges);
+            stats->set_overlap_hold_back(report.hold_back);
             stats->set_seconds(report.seconds > 0 ? report.seconds : seconds);
             if (!writer->Write(message)) return StoppedStatus(*context, "Inbetween");
           }

@@ -127,6 +127,13 @@ absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc) {
       validity.boundary_overlaps = v["boundary_overlaps"].get<int>();
       validity.min_area_ratio = v["min_area_ratio"].get<double>();
       validity.max_area_ratio = v["max_area_ratio"].get<double>();
+      if (v.contains("hold_back")) {  // optional: frames.json files written before it existed
+        if (!v["hold_back"].is_number() || v["hold_back"].get<double>() < 0 ||
+            v["hold_back"].get<double>() > 1) {
+          return PathError(fp + ".valid.hold_back", "expected a number in [0, 1]");
+        }
+        validity.hold_back = v["hold_back"].get<double>();
+      }
       data.valid = validity;
     }
     const auto& verts = fr["vertices"];
@@ -178,7 +185,8 @@ nlohmann::json FrameSetToJson(const FrameSet& frames) {
       frame["valid"] = {{"inverted_triangles", f.valid->inverted_triangles},
                         {"boundary_overlaps", f.valid->boundary_overlaps},
                         {"min_area_ratio", f.valid->min_area_ratio},
-                        {"max_area_ratio", f.valid->max_area_ratio}};
+                        {"max_area_ratio", f.valid->max_area_ratio},
+                        {"hold_back", f.valid->hold_back}};
     }
     out_frames.push_back(std::move(frame));
   }

@@ -21,6 +21,7 @@ struct FrameValidity {
   int boundary_overlaps = 0;   // boundary vertices inside the shape + crossing boundary segments
   double min_area_ratio = 1.0;  // triangle area / its area blended over the drawings
   double max_area_ratio = 1.0;
+  double hold_back = 0.0;  // how far non-overlap held the frame back (0 = not at all)
 };
 
 struct FrameData {

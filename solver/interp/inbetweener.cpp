@@ -43,6 +43,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <utility>
@@ -156,8 +157,8 @@ struct Inbetweener::Impl {
   std::vector<Triangle> triangles;
   std::vector<Coords> shapes;
   std::vector<Eigen::VectorXd> shape_area2;  // [example][triangle] doubled signed area, lazily
-  std::optional<BlendedArap> arap;         // kZhu17 energy (also reported for all methods)
-  std::optional<CohesiveEnergy> cohesive;  // may have no edges
+  std::optional<BlendedArap> arap;           // kZhu17 energy (also reported for all methods)
+  std::optional<CohesiveEnergy> cohesive;    // may have no edges
   std::optional<OverlapChecker> overlap;
   std::optional<ArapEnergy> alexa_energy;  // example 0, kAlexa
   ExampleRotations rotations;              // kAlexa split, unwrapped
@@ -176,7 +177,7 @@ struct Inbetweener::Impl {
 
   SparseCholesky solver;          // kAlexa: K_0; kZhu17: Kbar + Hbar (pinned)
   SparseCholesky dynamic_solver;  // Kbar + Hbar + beta_max M (not pinned), epsilon > 0
-  SparseCholesky contact_solver;  // Kbar + Hbar + gamma on boundary vertices (pinned), lazily
+  SparseCholesky contact_solver;  // Kbar + Hbar + gamma on boundary vertices (not pinned), lazily
   bool contact_factored = false;
   double contact_stiffness = 0.0;
   Eigen::SparseMatrix<double> zhu_matrix;  // Kbar + Hbar, full
@@ -224,6 +225,13 @@ struct Inbetweener::Impl {
   absl::StatusOr<Coords> Zhu17(const ExampleWeights& w, const Frame& previous,
                                const Frame& before_previous, const CancelToken* cancel,
                                FrameReport* report);
+  // No inverted triangle and no overlap.
+  bool Clean(const Coords& x) const {
+    return CountInverted(triangles, x) == 0 && overlap->Count(x) == 0;
+  }
+  // Moves *to back towards the clean `from` until it is clean: the largest fraction t of the
+  // step found by bisection (`from` + t (*to - `from`), t in [0, 1]); returns t.
+  double HoldBack(const Coords& from, Coords* to) const;
   // Returns whether the final x was checked and has no boundary vertex inside the shape.
   absl::StatusOr<bool> EnforceNonOverlap(Problem* p, Coords* x, const CancelToken* cancel,
                                          FrameReport* report);
@@ -431,7 +439,7 @@ absl::StatusOr<Coords> Inbetweener::Impl::GlobalSolve(
     if (absl::Status st = s.SolveInPlace(&rhs, options.threads); !st.ok()) return st;
     x = rhs;
   }
-  Translate(centroid_target, &x);
+  if (!centroid_target.empty()) Translate(centroid_target, &x);
   return x;
 }
 
@@ -458,13 +466,17 @@ double Inbetweener::Impl::Evaluate(const Coords& x, const Problem& p, Coords* rh
     }
   }
   if (p.contact) {
-    // gamma ||x_v - target||^2 for contacts; gamma ||x_v - x_v^k||^2 (proximal, zero at x) for
-    // the other boundary vertices. Only the contact springs count as energy.
+    // Non-overlap as one-sided springs gamma min(0, n.(x_v - q))^2 (zero once x_v is past the
+    // contact's line), majorized at x by gamma ||x_v - x_v^k||^2 plus the gradient: the matrix
+    // holds gamma on every boundary vertex (a proximal term, zero at x, for the vertices without
+    // a contact) and the right-hand side gamma (x_v - n min(0, n.(x_v - q))). The vertex can
+    // slide along the line; the majorizer keeps the energy from rising.
     for (int v : overlap->boundary_vertices()) rhs->row(v) += contact_stiffness * x.row(v);
     for (const OverlapContact& c : p.contacts) {
-      const Eigen::RowVector2d d = x.row(c.vertex) - c.target.transpose();
-      energy += contact_stiffness * d.squaredNorm();
-      rhs->row(c.vertex) += contact_stiffness * (c.target.transpose() - x.row(c.vertex));
+      const double s = c.normal.dot(x.row(c.vertex).transpose() - c.target);
+      if (s >= 0.0) continue;
+      energy += contact_stiffness * s * s;
+      rhs->row(c.vertex) -= contact_stiffness * s * c.normal.transpose();
     }
   }
   return energy;
@@ -474,7 +486,11 @@ absl::StatusOr<Coords> Inbetweener::Impl::Iterate(const Problem& p, Coords x, do
                                                   Coords rhs, const CancelToken* cancel,
                                                   FrameReport* report) const {
   const SparseCholesky& s = p.contact ? contact_solver : p.dynamic ? dynamic_solver : solver;
-  const bool pinned = !p.dynamic;
+  // The contact springs are not translation invariant: that solve pins nothing and is not moved
+  // into the gauge afterwards (the springs on every boundary vertex make its matrix definite).
+  const bool pinned = !p.dynamic && !p.contact;
+  static const std::vector<Eigen::Vector2d> kNoGauge;
+  const std::vector<Eigen::Vector2d>& gauge = p.contact ? kNoGauge : p.group_centroids;
   Anderson anderson(std::max(1, options.anderson_history));
   const double displacement_limit = options.displacement_tolerance * size;
   int iterations = 0;
@@ -484,7 +500,7 @@ absl::StatusOr<Coords> Inbetweener::Impl::Iterate(const Problem& p, Coords x, do
     if (cancel != nullptr && cancel->IsCancelled()) {
       return absl::CancelledError("inbetweening cancelled");
     }
-    absl::StatusOr<Coords> g = GlobalSolve(s, pinned, rhs, p.group_centroids);
+    absl::StatusOr<Coords> g = GlobalSolve(s, pinned, rhs, gauge);
     if (!g.ok()) return g.status();
     ++iterations;
     const double step = (*g - x).cwiseAbs().maxCoeff();
@@ -531,14 +547,14 @@ absl::StatusOr<Coords> Inbetweener::Impl::Iterate(const Problem& p, Coords x, do
   return x;
 }
 
-void Inbetweener::Impl::AreaRatios(const Coords& x, const ExampleWeights& w,
-                                    FrameReport* report) {
+void Inbetweener::Impl::AreaRatios(const Coords& x, const ExampleWeights& w, FrameReport* report) {
   const int num_triangles = static_cast<int>(triangles.size());
   if (shape_area2.empty()) {
     shape_area2.resize(shapes.size());
     for (size_t i = 0; i < shapes.size(); ++i) {
       shape_area2[i].resize(num_triangles);
-      for (int t = 0; t < num_triangles; ++t) shape_area2[i][t] = DoubleArea(triangles[t], shapes[i]);
+      for (int t = 0; t < num_triangles; ++t)
+        shape_area2[i][t] = DoubleArea(triangles[t], shapes[i]);
     }
   }
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -585,14 +601,18 @@ absl::StatusOr<bool> Inbetweener::Impl::EnforceNonOverlap(Problem* p, Coords* x,
     Eigen::SparseMatrix<double> m = zhu_matrix;
     for (int v : overlap->boundary_vertices()) m.coeffRef(v, v) += contact_stiffness;
     m.makeCompressed();
-    absl::StatusOr<Eigen::SparseMatrix<double>> k = Reduce(m);
-    if (!k.ok()) return k.status();
-    if (absl::Status s = contact_solver.Compute(*k); !s.ok()) return s;
+    if (absl::Status s = contact_solver.Compute(m); !s.ok()) return s;
     contact_factored = true;
   }
   p->contact = true;
+  // The active set only grows within a frame: a vertex pushed out in one round keeps its
+  // half-plane in the next ones (else it springs back in and the rounds flip-flop), while a
+  // vertex still inside gets a new way out.
+  std::map<int, OverlapContact> active;
   for (int round = 0; round < 10 && !contacts.empty(); ++round) {
-    p->contacts = std::move(contacts);
+    for (const OverlapContact& c : contacts) active[c.vertex] = c;
+    p->contacts.clear();
+    for (const auto& [v, c] : active) p->contacts.push_back(c);
     Coords rhs;
     const double energy = Evaluate(*x, *p, &rhs, nullptr);
     absl::StatusOr<Coords> next = Iterate(*p, *x, energy, std::move(rhs), cancel, report);
@@ -604,6 +624,21 @@ absl::StatusOr<bool> Inbetweener::Impl::EnforceNonOverlap(Problem* p, Coords* x,
   const bool inside_free = contacts.empty();
   p->contacts.clear();
   return inside_free;
+}
+
+double Inbetweener::Impl::HoldBack(const Coords& from, Coords* to) const {
+  const Coords step = *to - from;
+  double good = 0.0, bad = 1.0;
+  for (int k = 0; k < 12; ++k) {  // 1/4096 of the step
+    const double t = 0.5 * (good + bad);
+    if (Clean(from + t * step)) {
+      good = t;
+    } else {
+      bad = t;
+    }
+  }
+  *to = from + good * step;
+  return good;
 }
 
 absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const Frame& previous,
@@ -665,9 +700,19 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
   Rotate(w, &x);
   Translate(p.group_centroids, &x);
   if (options.prevent_overlap) {
+    const Coords unpushed = x;
     absl::StatusOr<bool> inside_free = EnforceNonOverlap(&p, &x, cancel, report);
     if (!inside_free.ok()) return inside_free.status();
     known_inside_free = *inside_free;
+    if (!Clean(x)) {
+      // The push-out left an overlap (or folded a triangle to make room): the frame stops where
+      // the motion from the previous frame first meets one instead, when that frame is clean.
+      if (CountInverted(triangles, x) > 0 && CountInverted(triangles, unpushed) == 0) x = unpushed;
+      if (prev && Clean(*prev)) {
+        report->hold_back = 1.0 - HoldBack(*prev, &x);
+        known_inside_free = true;
+      }
+    }
   }
   if (options.epsilon <= 0.0 || !prev) return x;
   known_inside_free = false;

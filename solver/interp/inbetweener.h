@@ -86,6 +86,11 @@ struct FrameReport {
   // with the frame's weights (1 = area kept; <= 0 = inverted).
   double min_area_ratio = 1.0;
   double max_area_ratio = 1.0;
+  // Added by issue 6 (non-overlap): above 0 when pushing the boundary out of the shape (W_O)
+  // could not make the frame clean, so it stopped short of its solution: the fraction of the way
+  // from the previous frame to the solution it was held back (the frame is the furthest point on
+  // that way with no overlap and no inverted triangle; 1 = it did not move).
+  double hold_back = 0.0;
 };
 
 class Inbetweener {

@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <queue>
 #include <utility>
 
 namespace inbetween::solver {
@@ -125,26 +126,41 @@ bool ProperlyCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eig
 
 constexpr double kMargin = 1e-9;
 
+Eigen::Vector2d ClosestOnSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                                 const Eigen::Vector2d& b) {
+  const Eigen::Vector2d d = b - a;
+  const double u = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-300), 0.0, 1.0);
+  return a + u * d;
+}
+
 }  // namespace
 
 OverlapChecker::OverlapChecker(const std::vector<Triangle>& triangles,
                                const std::vector<std::array<int, 4>>& cohesive_edges,
                                int num_vertices)
     : triangles_(triangles), twins_(num_vertices) {
-  std::map<std::pair<int, int>, int> count;
-  for (const Triangle& t : triangles) {
+  // Per undirected edge: the triangle edges (t, k) on it.
+  std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> sides;
+  const int num_triangles = static_cast<int>(triangles.size());
+  for (int t = 0; t < num_triangles; ++t) {
     for (int k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      ++count[{std::min(a, b), std::max(a, b)}];
+      const int a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      sides[{std::min(a, b), std::max(a, b)}].emplace_back(t, k);
     }
   }
+  neighbours_.assign(num_triangles, {-1, -1, -1});
+  edge_segment_.assign(num_triangles, {-1, -1, -1});
   std::vector<char> on_boundary(num_vertices, 0);
-  for (const Triangle& t : triangles) {
+  for (int t = 0; t < num_triangles; ++t) {
     for (int k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      if (count[{std::min(a, b), std::max(a, b)}] == 1) {
+      const int a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      const auto& on_edge = sides[{std::min(a, b), std::max(a, b)}];
+      if (on_edge.size() == 1) {
+        edge_segment_[t][k] = static_cast<int>(segments_.size());
         segments_.push_back({a, b});
         on_boundary[a] = on_boundary[b] = 1;
+      } else if (on_edge.size() == 2) {
+        neighbours_[t][k] = on_edge[0].first == t ? on_edge[1].first : on_edge[0].first;
       }
     }
   }
@@ -220,14 +236,14 @@ std::vector<std::pair<int, int>> OverlapChecker::Inside(const Coords& x) const {
   return inside;
 }
 
-int OverlapChecker::Crossings(const Coords& x) const {
+std::vector<std::pair<int, int>> OverlapChecker::CrossingPairs(const Coords& x) const {
   std::vector<Box> boxes(segments_.size());
   for (size_t s = 0; s < segments_.size(); ++s) {
     boxes[s].extend(P(x, segments_[s][0]));
     boxes[s].extend(P(x, segments_[s][1]));
   }
   const Bvh& bvh = Tree(std::move(boxes), &segment_tree_);
-  int crossings = 0;
+  std::vector<std::pair<int, int>> pairs;
   for (int s = 0; s < static_cast<int>(segments_.size()); ++s) {
     // Not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda.
     const int a = segments_[s][0], b = segments_[s][1];
@@ -235,10 +251,14 @@ int OverlapChecker::Crossings(const Coords& x) const {
       if (r <= s) return;
       const auto [c, d] = segments_[r];
       if (Exempt(a, b, c, d)) return;
-      if (ProperlyCross(P(x, a), P(x, b), P(x, c), P(x, d))) ++crossings;
+      if (ProperlyCross(P(x, a), P(x, b), P(x, c), P(x, d))) pairs.emplace_back(s, r);
     });
   }
-  return crossings;
+  return pairs;
+}
+
+int OverlapChecker::Crossings(const Coords& x) const {
+  return static_cast<int>(CrossingPairs(x).size());
 }
 
 int OverlapChecker::Count(const Coords& x) const {
@@ -249,23 +269,45 @@ std::vector<OverlapContact> OverlapChecker::Contacts(const Coords& x) const {
   std::vector<OverlapContact> contacts;
   const std::vector<std::pair<int, int>> inside = Inside(x);
   if (inside.empty()) return contacts;
-  for (auto [v, t] : inside) {
+  // Best-first walk over triangles from the one holding p, in order of their distance to p,
+  // never entering a triangle incident to v; the closest boundary segment (not incident to v)
+  // on a visited triangle wins once no unvisited triangle is nearer than it.
+  std::vector<int> seen(triangles_.size(), -1);
+  for (auto [v, start] : inside) {
     const Eigen::Vector2d p = P(x, v);
     double best = std::numeric_limits<double>::infinity();
-    Eigen::Vector2d target = p;
-    // Closest point on a boundary segment not incident to v (linear scan: contacts are rare).
-    for (const auto& [a, b] : segments_) {
-      if (a == v || b == v) continue;
-      const Eigen::Vector2d pa = P(x, a), pb = P(x, b);
-      const Eigen::Vector2d d = pb - pa;
-      const double u = std::clamp((p - pa).dot(d) / std::max(d.squaredNorm(), 1e-300), 0.0, 1.0);
-      const Eigen::Vector2d q = pa + u * d;
-      if ((q - p).squaredNorm() < best) {
-        best = (q - p).squaredNorm();
-        target = q;
+    int best_segment = -1;
+    Eigen::Vector2d best_point = p;
+    using Entry = std::pair<double, int>;  // (distance from p, triangle)
+    std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+    queue.emplace(0.0, start);
+    seen[start] = v;
+    while (!queue.empty() && queue.top().first < best) {
+      const int t = queue.top().second;
+      queue.pop();
+      for (int k = 0; k < 3; ++k) {
+        const int a = triangles_[t][k], b = triangles_[t][(k + 1) % 3];
+        const Eigen::Vector2d q = ClosestOnSegment(p, P(x, a), P(x, b));
+        const double distance = (q - p).norm();
+        if (const int s = edge_segment_[t][k]; s >= 0) {
+          if (a != v && b != v && distance < best)
+            best = distance, best_segment = s, best_point = q;
+          continue;
+        }
+        const int u = neighbours_[t][k];
+        if (u < 0 || seen[u] == v) continue;
+        seen[u] = v;
+        const Triangle& tu = triangles_[u];
+        if (tu[0] == v || tu[1] == v || tu[2] == v) continue;
+        queue.emplace(distance, u);  // the shared edge is the nearest u can be reached through
       }
     }
-    contacts.push_back({v, target});
+    if (best_segment < 0) continue;  // enclosed by its own triangles: nowhere to go
+    const auto [a, b] = segments_[best_segment];
+    const Eigen::Vector2d d = P(x, b) - P(x, a);
+    // Triangles are positive, so the interior is on the segment's left.
+    const Eigen::Vector2d normal = Eigen::Vector2d(d.y(), -d.x()).normalized();
+    contacts.push_back({v, best_point + 1e-2 * d.norm() * normal, normal});
   }
   return contacts;
 }

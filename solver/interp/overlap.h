@@ -20,8 +20,14 @@
 namespace inbetween::solver {
 
 struct OverlapContact {
-  int vertex = -1;         // boundary vertex inside the shape
-  Eigen::Vector2d target;  // closest point on a boundary segment not incident to it
+  int vertex = -1;  // boundary vertex inside the shape
+  // Where it leaves the material it is in: the closest boundary point of that material (found by
+  // a walk over triangles from the one holding the vertex, see Contacts), moved outward by 1% of
+  // that segment's length so that a one-sided spring pushing the vertex past the segment's line
+  // leaves it outside.
+  Eigen::Vector2d target;
+  Eigen::Vector2d normal;  // the segment's outward unit normal: the vertex belongs where
+                           // normal . (x - target) >= 0
 };
 
 class OverlapChecker {
@@ -37,7 +43,11 @@ class OverlapChecker {
   // length) plus properly crossing boundary segment pairs.
   int Count(const Coords& x) const;
 
-  // Boundary vertices strictly inside the shape, each with the closest point on the boundary.
+  // Boundary vertices strictly inside the shape, each with its way out. The target is searched
+  // from the triangle holding the vertex outward (best first by distance, never through the
+  // vertex's own triangles), so it is a boundary point of the material the vertex entered. The
+  // plain closest boundary point is often the vertex's own side (its neighbours along the
+  // boundary are one edge away), which pushes it along its own boundary instead of out.
   std::vector<OverlapContact> Contacts(const Coords& x) const;
 
   const std::vector<int>& boundary_vertices() const { return boundary_vertices_; }
@@ -52,11 +62,14 @@ class OverlapChecker {
   const Bvh& Tree(std::vector<Box> boxes, std::unique_ptr<Bvh>* tree) const;
   bool Exempt(int v, const Triangle& t) const;
   bool Exempt(int a, int b, int c, int d) const;
-  std::vector<std::pair<int, int>> Inside(const Coords& x) const;  // (vertex, triangle)
+  std::vector<std::pair<int, int>> Inside(const Coords& x) const;         // (vertex, triangle)
+  std::vector<std::pair<int, int>> CrossingPairs(const Coords& x) const;  // segment indices
 
   std::vector<Triangle> triangles_;
   std::vector<std::array<int, 2>> segments_;  // boundary edges
   std::vector<int> boundary_vertices_;
+  std::vector<std::array<int, 3>> neighbours_;    // per triangle, across edge k (t[k], t[k+1])
+  std::vector<std::array<int, 3>> edge_segment_;  // per triangle edge: boundary segment or -1
   std::vector<std::vector<int>> twins_;         // per vertex: cohesive twins (collocated partners)
   mutable std::unique_ptr<Bvh> triangle_tree_;  // built on the first check, refit after
   mutable std::unique_ptr<Bvh> segment_tree_;
