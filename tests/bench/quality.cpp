@@ -9,7 +9,11 @@
 //                 along the bar (a spiral that tightens; the inner edge keeps its length);
 //   clamped_270   the first quarter clamped straight, the rest curled 270 degrees uniformly
 //                 about the inner edge.
+// and every example under examples/ (meshed as the examples' test does, default inbetweening
+// parameters; 24 frames per pair of keys): there the distortion column is the worst frame's,
+// measured from the frame's nearest key, and key_distort the worst between neighbouring keys.
 // Usage: quality [--json FILE] [--frames N] [--tolerance T (zhu17 displacement tolerance)]
+//                [--no-examples]
 #include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -26,7 +30,9 @@
 #include "nlohmann/json.hpp"
 #include "solver/interp/inbetweener.h"
 #include "solver/interp/timing.h"
+#include "solver/mesh/build_multimesh.h"
 #include "tests/unit/solver/interp/test_meshes.h"
+#include "tests/unit/solver/mesh/example_projects.h"
 
 namespace {
 
@@ -62,6 +68,7 @@ Points CurlAboutInnerEdge(const Points& rest, const std::function<double(double)
 struct Case {
   std::string name;
   Multimesh mesh;
+  bool example = false;  // from examples/: distortion from the nearest key, over every frame
 };
 
 std::vector<Case> Cases() {
@@ -84,6 +91,27 @@ std::vector<Case> Cases() {
   return cases;
 }
 
+// The examples' multimeshes; one that does not build is reported and skipped.
+std::vector<Case> ExampleCases() {
+  std::vector<Case> cases;
+  for (const std::string& name : example_projects::List()) {
+    absl::StatusOr<example_projects::Example> example = example_projects::Load(name);
+    absl::StatusOr<Multimesh> mesh =
+        example.ok() ? BuildMultimesh(example->drawings, example->options) : example.status();
+    if (!mesh.ok()) {
+      std::fprintf(stderr, "example %s: %s\n", name.c_str(),
+                   std::string(mesh.status().message()).c_str());
+      continue;
+    }
+    cases.push_back({name, *std::move(mesh), true});
+  }
+  return cases;
+}
+
+int NearestKey(const ExampleWeights& w) {
+  return static_cast<int>(std::max_element(w.begin(), w.end()) - w.begin());
+}
+
 // max over triangles of max(sigma_1, 1 / sigma_2) of the affine map rest -> x.
 double MaxDistortion(const Multimesh& mesh, const Points& rest, const Points& x) {
   double worst = 1.0;
@@ -104,10 +132,12 @@ double MaxDistortion(const Multimesh& mesh, const Points& rest, const Points& x)
 int main(int argc, char** argv) {
   std::string json_path;
   int frames = 25;
+  bool examples = true;
   InbetweenOptions defaults;
   for (int a = 1; a < argc; ++a) {
     if (!std::strcmp(argv[a], "--json") && a + 1 < argc) json_path = argv[++a];
     if (!std::strcmp(argv[a], "--frames") && a + 1 < argc) frames = std::atoi(argv[++a]);
+    if (!std::strcmp(argv[a], "--no-examples")) examples = false;
     if (!std::strcmp(argv[a], "--tolerance") && a + 1 < argc) {
       defaults.displacement_tolerance = std::atof(argv[++a]);
       defaults.max_iterations = 5000;
@@ -118,16 +148,26 @@ int main(int argc, char** argv) {
     return 2;
   }
   nlohmann::json rows = nlohmann::json::array();
-  std::printf("%-12s %-7s %9s %12s %9s %10s %12s %12s %12s %10s %9s\n", "case", "method",
+  std::vector<Case> cases = Cases();
+  if (examples) {
+    for (Case& c : ExampleCases()) cases.push_back(std::move(c));
+  }
+  std::printf("%-28s %-7s %9s %12s %9s %10s %12s %12s %12s %10s %9s\n", "case", "method",
               "vertices", "max_inverted", "inv_frames", "max_overlap", "distortion", "key_distort",
               "area_err_mid", "area_err_max", "it/frame");
-  for (const Case& c : Cases()) {
+  for (const Case& c : cases) {
     const Multimesh& mesh = c.mesh;
-    const double key_distortion = MaxDistortion(mesh, mesh.shapes[0], mesh.shapes[1]);
+    const int keys = mesh.num_shapes();
+    double key_distortion = 1.0;
+    for (int i = 0; i + 1 < keys; ++i) {
+      key_distortion =
+          std::max(key_distortion, MaxDistortion(mesh, mesh.shapes[i], mesh.shapes[i + 1]));
+    }
     std::vector<double> key_areas;
     for (const Points& s : mesh.shapes)
       key_areas.push_back(interp_test::TotalArea(s, mesh.triangles));
-    absl::StatusOr<Schedule> schedule = MakeSchedule(2, frames);
+    const int case_frames = c.example ? 24 * (keys - 1) + 1 : frames;
+    absl::StatusOr<Schedule> schedule = MakeSchedule(keys, case_frames);
     if (!schedule.ok()) return 1;
     for (InterpMethod method :
          {InterpMethod::kZhu17, InterpMethod::kAlexa, InterpMethod::kLinear}) {
@@ -142,7 +182,7 @@ int main(int argc, char** argv) {
       int max_inverted = 0, inverted_frames = 0, max_overlaps = 0, iterations = 0;
       double distortion = 0.0, area_mid = 0.0, area_max = 0.0;
       Frame previous;
-      for (int k = 0; k < frames; ++k) {
+      for (int k = 0; k < case_frames; ++k) {
         const ExampleWeights& w = schedule->frames[k].weights;
         FrameReport report;
         absl::StatusOr<Frame> f = ib->Solve(w, previous, nullptr, &report);
@@ -154,12 +194,16 @@ int main(int argc, char** argv) {
         iterations += report.iterations;
         inverted_frames += report.inverted > 0;
         max_overlaps = std::max(max_overlaps, report.overlaps);
-        const double target = w[0] * key_areas[0] + w[1] * key_areas[1];
+        double target = 0.0;
+        for (int i = 0; i < keys; ++i) target += w[i] * key_areas[i];
         const double area = interp_test::TotalArea(f->vertices, mesh.triangles);
         const double error = std::abs(area - target) / target;
         area_max = std::max(area_max, error);
-        if (k == frames / 2) {
-          area_mid = error;
+        if (k == case_frames / 2) area_mid = error;
+        if (c.example) {
+          distortion =
+              std::max(distortion, MaxDistortion(mesh, mesh.shapes[NearestKey(w)], f->vertices));
+        } else if (k == case_frames / 2) {
           distortion = MaxDistortion(mesh, mesh.shapes[0], f->vertices);
         }
         previous = *std::move(f);
@@ -167,23 +211,24 @@ int main(int argc, char** argv) {
       const char* name = method == InterpMethod::kZhu17   ? "zhu17"
                          : method == InterpMethod::kAlexa ? "alexa"
                                                           : "linear";
-      std::printf("%-12s %-7s %9d %12d %9d %10d %12.3f %12.3f %12.4f %10.4f %9.2f\n",
+      std::printf("%-28s %-7s %9d %12d %9d %10d %12.3f %12.3f %12.4f %10.4f %9.2f\n",
                   c.name.c_str(), name, mesh.num_vertices(), max_inverted, inverted_frames,
                   max_overlaps, distortion, key_distortion, area_mid, area_max,
-                  static_cast<double>(iterations) / frames);
+                  static_cast<double>(iterations) / case_frames);
       rows.push_back({{"case", c.name},
                       {"method", name},
                       {"vertices", mesh.num_vertices()},
-                      {"frames", frames},
+                      {"frames", case_frames},
+                      {"example", c.example},
                       {"max_inverted_triangles", max_inverted},
                       {"frames_with_inversions", inverted_frames},
                       {"max_overlaps", max_overlaps},
-                      {"middle_max_distortion",
+                      {c.example ? "max_distortion" : "middle_max_distortion",
                        std::isfinite(distortion) ? nlohmann::json(distortion) : nlohmann::json()},
                       {"key_max_distortion", key_distortion},
                       {"middle_area_error", area_mid},
                       {"max_area_error", area_max},
-                      {"iterations_per_frame", static_cast<double>(iterations) / frames}});
+                      {"iterations_per_frame", static_cast<double>(iterations) / case_frames}});
     }
   }
   if (!json_path.empty()) std::ofstream(json_path) << rows.dump(2) << "\n";
