@@ -1036,6 +1036,7 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
           absl::StatusOr<solver::Frame> frame =
               inbetweener->Solve(timing.weights, previous, &token, &report);
           const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+          if (options_.metrics) options_.metrics->CountFrameSolved();
           if (token.IsCancelled()) return StoppedStatus(*context, "Inbetween");
           if (!frame.ok()) {
             return absl::Status(frame.status().code(),

@@ -82,6 +82,11 @@ std::string Metrics::Render(const std::vector<Gauge>& gauges) const {
   out += "# HELP inbetween_stage_seconds Solver stage run time by stage.\n";
   out += "# TYPE inbetween_stage_seconds histogram\n";
   RenderHistogram(out, "inbetween_stage_seconds", "stage", stage_seconds_);
+  absl::StrAppend(&out,
+                  "# HELP inbetween_frames_solved_total Inbetween frames solved.\n"
+                  "# TYPE inbetween_frames_solved_total counter\n"
+                  "inbetween_frames_solved_total ",
+                  frames_solved(), "\n");
   for (const Gauge& g : gauges) {
     absl::StrAppend(&out, "# HELP ", g.name, " ", g.help, "\n# TYPE ", g.name, " gauge\n", g.name,
                     " ", absl::StrFormat("%g", g.value), "\n");

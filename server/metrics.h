@@ -30,9 +30,13 @@ class Metrics {
   void ObserveRpc(absl::string_view method, absl::string_view code, double seconds);
   // Seconds a solver stage ("build", "optimize", "inbetween") ran.
   void ObserveStage(absl::string_view stage, double seconds);
+  // One inbetween frame solved (sent or not: frames before a resumed stream's start are solved).
+  void CountFrameSolved() { frames_solved_.fetch_add(1, std::memory_order_relaxed); }
+  uint64_t frames_solved() const { return frames_solved_.load(std::memory_order_relaxed); }
 
   // The exposition text: inbetween_rpcs_total{method,code}, inbetween_rpc_duration_seconds
-  // histogram {method}, inbetween_stage_seconds histogram {stage}, then `gauges`.
+  // histogram {method}, inbetween_stage_seconds histogram {stage},
+  // inbetween_frames_solved_total, then `gauges`.
   std::string Render(const std::vector<Gauge>& gauges) const;
 
  private:
@@ -49,6 +53,7 @@ class Metrics {
   std::map<std::pair<std::string, std::string>, uint64_t> rpc_counts_;
   std::map<std::string, Histogram, std::less<>> rpc_seconds_;
   std::map<std::string, Histogram, std::less<>> stage_seconds_;
+  std::atomic<uint64_t> frames_solved_{0};
 };
 
 // Serves GET /metrics (anything else: 404) on HOST:PORT until destroyed.
