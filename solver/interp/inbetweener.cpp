@@ -230,11 +230,14 @@ struct Inbetweener::Impl {
     return CountInverted(triangles, x) == 0 && overlap->Count(x) == 0;
   }
   // Moves *to back towards the clean `from` until it is clean: the largest fraction t of the
-  // step found by bisection (`from` + t (*to - `from`), t in [0, 1]); returns t.
-  double HoldBack(const Coords& from, Coords* to) const;
+  // step found by bisection (`from` + t (*to - `from`), t in [0, 1]); returns t. *first_bad:
+  // the point just past it, where the step first overlaps.
+  double HoldBack(const Coords& from, Coords* to, Coords* first_bad) const;
   // Returns whether the final x was checked and has no boundary vertex inside the shape.
+  // `seed`: contacts to start from (else those of *x).
   absl::StatusOr<bool> EnforceNonOverlap(Problem* p, Coords* x, const CancelToken* cancel,
-                                         FrameReport* report);
+                                         FrameReport* report,
+                                         std::vector<OverlapContact> seed = {});
   absl::StatusOr<Frame> Solve(const ExampleWeights& weights, const Frame& previous,
                               const Frame& before_previous, const CancelToken* cancel,
                               FrameReport* report);
@@ -588,8 +591,9 @@ absl::StatusOr<Coords> Inbetweener::Impl::Alexa(const ExampleWeights& w) const {
 
 absl::StatusOr<bool> Inbetweener::Impl::EnforceNonOverlap(Problem* p, Coords* x,
                                                           const CancelToken* cancel,
-                                                          FrameReport* report) {
-  std::vector<OverlapContact> contacts = overlap->Contacts(*x);
+                                                          FrameReport* report,
+                                                          std::vector<OverlapContact> contacts) {
+  if (contacts.empty()) contacts = overlap->Contacts(*x);
   if (contacts.empty()) return true;
   if (!contact_factored) {
     // Springs an order of magnitude stiffer than the material around a boundary vertex.
@@ -626,7 +630,7 @@ absl::StatusOr<bool> Inbetweener::Impl::EnforceNonOverlap(Problem* p, Coords* x,
   return inside_free;
 }
 
-double Inbetweener::Impl::HoldBack(const Coords& from, Coords* to) const {
+double Inbetweener::Impl::HoldBack(const Coords& from, Coords* to, Coords* first_bad) const {
   const Coords step = *to - from;
   double good = 0.0, bad = 1.0;
   for (int k = 0; k < 12; ++k) {  // 1/4096 of the step
@@ -637,6 +641,7 @@ double Inbetweener::Impl::HoldBack(const Coords& from, Coords* to) const {
       bad = t;
     }
   }
+  *first_bad = from + bad * step;
   *to = from + good * step;
   return good;
 }
@@ -709,8 +714,20 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
       // the motion from the previous frame first meets one instead, when that frame is clean.
       if (CountInverted(triangles, x) > 0 && CountInverted(triangles, unpushed) == 0) x = unpushed;
       if (prev && Clean(*prev)) {
-        report->hold_back = 1.0 - HoldBack(*prev, &x);
+        Coords first_bad;
+        report->hold_back = 1.0 - HoldBack(*prev, &x, &first_bad);
         known_inside_free = true;
+        // Continue from the clean frame where the motion met the overlap, with the contacts of
+        // that meeting: the push then starts on the right side of every contact instead of
+        // from deep inside. Kept when it comes out clean.
+        Coords resumed = x;
+        absl::StatusOr<bool> resumed_free =
+            EnforceNonOverlap(&p, &resumed, cancel, report, overlap->Contacts(first_bad));
+        if (!resumed_free.ok()) return resumed_free.status();
+        if (Clean(resumed)) {
+          x = std::move(resumed);
+          report->hold_back = 0.0;
+        }
       }
     }
   }
