@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""gRPC health check of inbetween-server (the container HEALTHCHECK; Debian has no grpc_health_probe).
+"""Container HEALTHCHECK: grpc.health.v1 Check of inbetween-server (Debian has no grpc_health_probe)
 
 Usage: healthcheck.py [HOST:PORT] [SERVICE]   (defaults: 127.0.0.1:50051, inbetween.v1.Inbetween)
 Calls grpc.health.v1.Health/Check over plaintext and exits 0 when the answer is SERVING, 1

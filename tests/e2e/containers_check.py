@@ -18,7 +18,6 @@ import shlex
 import socket
 import subprocess
 import sys
-import tempfile
 import time
 
 import yaml
@@ -42,6 +41,17 @@ def help_flags(cmd):
     """The --long-flags a program's --help lists."""
     out = run(cmd + ["--help"])
     return set(re.findall(r"(--[a-z][a-z0-9-]*)", out.stdout + out.stderr)) - {"--help"}
+
+
+def gateway_options(main_mjs):
+    """The gateway's flags, from its parseArgs options in main.mjs (running it needs the npm
+    packages, which tests/e2e/web_test.sh may be installing at the same time)."""
+    source = open(main_mjs).read()
+    block = re.search(r"parseArgs\(\{\s*options:\s*\{(.*?)\n\s*\},\s*\}\)", source, re.S)
+    keys = re.findall(
+        r'^\s*"?([a-z][a-z-]*)"?:\s*\{\s*type:', block.group(1) if block else "", re.M
+    )
+    return {f"--{k}" for k in keys} - {"--help"}
 
 
 def flags_of(args):
@@ -130,8 +140,9 @@ def wait_port(proc, port):
 
 
 def healthcheck(src, addr, service=HEALTH_SERVICE):
-    out = run(["/usr/bin/python3", os.path.join(src, "docker/healthcheck.py"), addr, service],
-              timeout=30)
+    out = run(
+        ["/usr/bin/python3", os.path.join(src, "docker/healthcheck.py"), addr, service], timeout=30
+    )
     return out.returncode, (out.stdout + out.stderr).strip()
 
 
@@ -143,14 +154,25 @@ def check_health_answers(src):
 
     answer = {}
     server = grpc.server(futures.ThreadPoolExecutor(max_workers=2))
-    server.add_generic_rpc_handlers([grpc.method_handlers_generic_handler(
-        "grpc.health.v1.Health",
-        {"Check": grpc.unary_unary_rpc_method_handler(lambda request, context: answer["reply"])})])
+    server.add_generic_rpc_handlers(
+        [
+            grpc.method_handlers_generic_handler(
+                "grpc.health.v1.Health",
+                {
+                    "Check": grpc.unary_unary_rpc_method_handler(
+                        lambda request, context: answer["reply"]
+                    )
+                },
+            )
+        ]
+    )
     port = server.add_insecure_port("127.0.0.1:0")
     server.start()
     try:
         for reply, want in ((b"\x08\x01", 0), (b"\x08\x02", 1), (b"", 1), (b"\x08\x03", 1)):
-            answer["reply"] = reply  # HealthCheckResponse: SERVING, NOT_SERVING, UNKNOWN, SERVICE_UNKNOWN
+            answer[
+                "reply"
+            ] = reply  # HealthCheckResponse: SERVING, NOT_SERVING, UNKNOWN, SERVICE_UNKNOWN
             rc, out = healthcheck(src, f"127.0.0.1:{port}")
             check(rc == want, f"healthcheck.py exits {rc} for the reply {reply!r}: {out}")
     finally:
@@ -213,18 +235,23 @@ def dockerignored(patterns, path):
         negate = pattern.startswith("!")
         p = pattern.lstrip("!").strip("/")
         for prefix in prefixes:
-            if fnmatch.fnmatch(prefix, p) or (p.startswith("**/") and (
-                    fnmatch.fnmatch(prefix, p[3:]) or fnmatch.fnmatch(prefix, "*/" + p[3:]))):
+            if fnmatch.fnmatch(prefix, p) or (
+                p.startswith("**/")
+                and (fnmatch.fnmatch(prefix, p[3:]) or fnmatch.fnmatch(prefix, "*/" + p[3:]))
+            ):
                 ignored = not negate
     return ignored
 
 
-def check_dockerfile(src, bin_dir, server_flags, loadgen_flags, gateway_flags):
+def check_dockerfile(src, bin_dir, server_flags, gateway_flags):
     path = os.path.join(src, "docker/Dockerfile")
     stages = parse_dockerfile(path)
     by_name = {name: (base, instrs) for name, base, instrs in stages}
-    ignore = [l.strip() for l in open(os.path.join(src, ".dockerignore"))
-              if l.strip() and not l.startswith("#")]
+    ignore = [
+        l.strip()
+        for l in open(os.path.join(src, ".dockerignore"))
+        if l.strip() and not l.startswith("#")
+    ]
     for d in ("build", "build/test", "build-server", "out", "client/web/node_modules"):
         check(dockerignored(ignore, d), f".dockerignore does not exclude {d}/ from the context")
 
@@ -236,34 +263,51 @@ def check_dockerfile(src, bin_dir, server_flags, loadgen_flags, gateway_flags):
                 for s in srcs if source is None else []:
                     if s == ".":
                         continue
-                    check(os.path.exists(os.path.join(src, s)), f"Dockerfile {name}: COPY {s} is missing")
-                    check(not dockerignored(ignore, s), f"Dockerfile {name}: COPY {s} is in .dockerignore")
+                    check(
+                        os.path.exists(os.path.join(src, s)),
+                        f"Dockerfile {name}: COPY {s} is missing",
+                    )
+                    check(
+                        not dockerignored(ignore, s),
+                        f"Dockerfile {name}: COPY {s} is in .dockerignore",
+                    )
 
     # build: debian:12, runs exactly the scripts CI runs.
-    check(stages and stages[0][0] == "build" and stages[0][1] == "debian:12",
-          "the first stage is not `FROM debian:12 AS build`")
+    check(
+        stages and stages[0][0] == "build" and stages[0][1] == "debian:12",
+        "the first stage is not `FROM debian:12 AS build`",
+    )
     base, instrs = by_name.get("build", ("", []))
     commands = []
     for word, text in instrs:
         if word == "RUN":
             text = re.sub(r"^(--\S+\s+)+", "", text)
             commands += [c.strip() for c in text.split("&&")]
-    check(commands == ["scripts/setup", "scripts/build build/release Release ${BUILD_ARGS}"],
-          f"the build stage's RUN steps are {commands}, not exactly scripts/setup and scripts/build")
+    check(
+        commands == ["scripts/setup", "scripts/build build/release Release ${BUILD_ARGS}"],
+        f"the build stage's RUN steps are {commands}, not exactly scripts/setup and scripts/build",
+    )
     ci = open(os.path.join(src, ".ci/run")).read()
     test_script = open(os.path.join(src, "scripts/test")).read()
-    check("scripts/test" in ci and '"$root/scripts/setup"' in test_script and
-          '"$root/scripts/build"' in test_script,
-          "CI (.ci/run -> scripts/test) no longer runs scripts/setup and scripts/build")
+    check(
+        "scripts/test" in ci
+        and '"$root/scripts/setup"' in test_script
+        and '"$root/scripts/build"' in test_script,
+        "CI (.ci/run -> scripts/test) no longer runs scripts/setup and scripts/build",
+    )
     workdir = next((t for w, t in instrs if w == "WORKDIR"), "/")
     build_prefix = os.path.join(workdir, "build/release") + "/"
 
     # web-build runs the script tests/e2e/web_test.sh runs.
     _, web = by_name.get("web-build", ("", []))
-    check(any(w == "RUN" and "client/web/scripts/prepare.sh" in t for w, t in web),
-          "the web-build stage does not run client/web/scripts/prepare.sh")
-    check("scripts/prepare.sh" in open(os.path.join(src, "tests/e2e/web_test.sh")).read(),
-          "tests/e2e/web_test.sh no longer runs client/web/scripts/prepare.sh")
+    check(
+        any(w == "RUN" and "client/web/scripts/prepare.sh" in t for w, t in web),
+        "the web-build stage does not run client/web/scripts/prepare.sh",
+    )
+    check(
+        "scripts/prepare.sh" in open(os.path.join(src, "tests/e2e/web_test.sh")).read(),
+        "tests/e2e/web_test.sh no longer runs client/web/scripts/prepare.sh",
+    )
     web_generated = open(os.path.join(src, "client/web/.gitignore")).read().split()
 
     images = {}
@@ -272,67 +316,120 @@ def check_dockerfile(src, bin_dir, server_flags, loadgen_flags, gateway_flags):
             continue
         base, instrs = by_name[name]
         users = [t for w, t in instrs if w == "USER"]
-        check(users and users[-1].split(":")[0] not in ("root", "0"),
-              f"stage {name} does not end as a non-root USER")
+        check(
+            users and users[-1].split(":")[0] not in ("root", "0"),
+            f"stage {name} does not end as a non-root USER",
+        )
         copies = {}
         for w, t in instrs:
             if w == "COPY":
                 source, srcs, dest = copy_parts(t)
                 for s in srcs:
-                    copies[dest if len(srcs) == 1 else os.path.join(dest, os.path.basename(s))] = (source, s)
+                    copies[dest if len(srcs) == 1 else os.path.join(dest, os.path.basename(s))] = (
+                        source,
+                        s,
+                    )
                     if source == "build":
-                        check(s.startswith(build_prefix) and
-                              os.access(os.path.join(bin_dir, s[len(build_prefix):]), os.X_OK),
-                              f"stage {name}: COPY --from=build {s} is not a binary scripts/build makes "
-                              f"(under {build_prefix})")
+                        check(
+                            s.startswith(build_prefix)
+                            and os.access(os.path.join(bin_dir, s[len(build_prefix) :]), os.X_OK),
+                            f"stage {name}: COPY --from=build {s} is not a binary "
+                            f"scripts/build makes "
+                            f"(under {build_prefix})",
+                        )
                     if source == "web-build":
                         rel = os.path.relpath(s, "/src/client/web")
-                        check(os.path.exists(os.path.join(src, "client/web", rel)) or
-                              rel + "/" in web_generated,
-                              f"stage {name}: COPY --from=web-build {s} is neither in client/web "
-                              f"nor one of its generated directories")
+                        check(
+                            os.path.exists(os.path.join(src, "client/web", rel))
+                            or rel + "/" in web_generated,
+                            f"stage {name}: COPY --from=web-build {s} is neither in client/web "
+                            f"nor one of its generated directories",
+                        )
         expose = {int(p.split("/")[0]) for w, t in instrs if w == "EXPOSE" for p in t.split()}
         entry = next((exec_form(t) for w, t in reversed(instrs) if w == "ENTRYPOINT"), None)
         cmd = next((exec_form(t) for w, t in reversed(instrs) if w == "CMD"), None) or []
         health = next((t for w, t in reversed(instrs) if w == "HEALTHCHECK"), None)
         check(entry, f"stage {name} has no exec-form ENTRYPOINT")
-        images[name] = dict(base=base, copies=copies, expose=expose, entry=entry or [], cmd=cmd,
-                            health=health, instrs=instrs)
+        images[name] = dict(
+            base=base,
+            copies=copies,
+            expose=expose,
+            entry=entry or [],
+            cmd=cmd,
+            health=health,
+            instrs=instrs,
+        )
 
     server = images.get("server")
     if server:
         check(server["base"] == "debian:12-slim", "the server stage is not FROM debian:12-slim")
-        pk = [d for d, (s, f) in server["copies"].items() if s is None and f == "docker/runtime-packages.txt"]
-        check(pk and any(w == "RUN" and pk[0] in t and "apt-get install" in t
-                         for w, t in server["instrs"]),
-              "the server stage does not apt-get install the packages of docker/runtime-packages.txt")
-        check(server["entry"][:1] == ["/usr/local/bin/inbetween-server"] or
-              server["entry"][:1] == ["inbetween-server"], "the server image's ENTRYPOINT is not inbetween-server")
-        check(set(flags_of(server["cmd"])) <= server_flags,
-              f"the server image's CMD has flags inbetween-server does not know: {server['cmd']}")
+        pk = [
+            d
+            for d, (s, f) in server["copies"].items()
+            if s is None and f == "docker/runtime-packages.txt"
+        ]
+        check(
+            pk
+            and any(
+                w == "RUN" and pk[0] in t and "apt-get install" in t for w, t in server["instrs"]
+            ),
+            "the server stage does not apt-get install the packages of docker/runtime-packages.txt",
+        )
+        check(
+            server["entry"][:1] == ["/usr/local/bin/inbetween-server"]
+            or server["entry"][:1] == ["inbetween-server"],
+            "the server image's ENTRYPOINT is not inbetween-server",
+        )
+        check(
+            set(flags_of(server["cmd"])) <= server_flags,
+            f"the server image's CMD has flags inbetween-server does not know: {server['cmd']}",
+        )
         for flag in ("--listen", "--metrics-listen"):
             value = flag_value(server["cmd"], flag)
-            check(value and port_of(value) in server["expose"], f"the server image does not EXPOSE its {flag} port")
+            check(
+                value and port_of(value) in server["expose"],
+                f"the server image does not EXPOSE its {flag} port",
+            )
         hc = exec_form(re.sub(r"^.*?\bCMD\s+", "", server["health"] or "")) or []
-        check(hc and server["copies"].get(os.path.join("/usr/local/bin", hc[0]) if "/" not in hc[0] else hc[0],
-                                          (None, ""))[1] == "docker/healthcheck.py",
-              f"the server HEALTHCHECK does not run docker/healthcheck.py: {server['health']}")
-        check(len(hc) >= 2 and port_of(hc[1]) == port_of(flag_value(server["cmd"], "--listen") or ":0"),
-              "the server HEALTHCHECK does not check the port of the default --listen")
-        check(len(hc) < 3 or hc[2] == HEALTH_SERVICE, f"the HEALTHCHECK's service is not {HEALTH_SERVICE}")
+        check(
+            hc
+            and server["copies"].get(
+                os.path.join("/usr/local/bin", hc[0]) if "/" not in hc[0] else hc[0], (None, "")
+            )[1]
+            == "docker/healthcheck.py",
+            f"the server HEALTHCHECK does not run docker/healthcheck.py: {server['health']}",
+        )
+        check(
+            len(hc) >= 2
+            and port_of(hc[1]) == port_of(flag_value(server["cmd"], "--listen") or ":0"),
+            "the server HEALTHCHECK does not check the port of the default --listen",
+        )
+        check(
+            len(hc) < 3 or hc[2] == HEALTH_SERVICE,
+            f"the HEALTHCHECK's service is not {HEALTH_SERVICE}",
+        )
     gateway = images.get("gateway")
     if gateway:
         check(gateway["base"].startswith("node:20"), "the gateway stage is not on Node 20")
-        check(set(flags_of(gateway["cmd"])) <= gateway_flags,
-              f"the gateway image's CMD has unknown flags: {gateway['cmd']}")
+        check(
+            set(flags_of(gateway["cmd"])) <= gateway_flags,
+            f"the gateway image's CMD has unknown flags: {gateway['cmd']}",
+        )
     proxy = images.get("proxy")
     if proxy:
         entry_script = open(os.path.join(src, "docker/nginx-entrypoint.sh")).read()
         template = re.search(r"INBETWEEN_NGINX_TEMPLATE:-([^}]+)}", entry_script).group(1)
-        check(proxy["copies"].get(template, (None, ""))[1] == "deploy/nginx/inbetween.conf",
-              f"the proxy image does not put deploy/nginx/inbetween.conf at {template}")
-        check(any(w == "RUN" and re.search(r"apt-get install .*\bnginx\b.*\bhaproxy\b", t)
-                  for w, t in proxy["instrs"]), "the proxy stage does not install nginx and haproxy")
+        check(
+            proxy["copies"].get(template, (None, ""))[1] == "deploy/nginx/inbetween.conf",
+            f"the proxy image does not put deploy/nginx/inbetween.conf at {template}",
+        )
+        check(
+            any(
+                w == "RUN" and re.search(r"apt-get install .*\bnginx\b.*\bhaproxy\b", t)
+                for w, t in proxy["instrs"]
+            ),
+            "the proxy stage does not install nginx and haproxy",
+        )
     return images
 
 
@@ -345,7 +442,9 @@ def dpkg_owners(paths):
     candidates = {}
     for path in paths:
         for c in (path, os.path.realpath(path)):
-            other = c[4:] if c.startswith("/usr/lib/") else "/usr" + c if c.startswith("/lib") else c
+            other = (
+                c[4:] if c.startswith("/usr/lib/") else "/usr" + c if c.startswith("/lib") else c
+            )
             candidates.setdefault(path, []).extend([c, other])
     owners = {}
     out = run(["dpkg", "-S"] + sorted({c for cs in candidates.values() for c in cs}))
@@ -361,6 +460,11 @@ def check_runtime_packages(src, binaries):
     for line in open(os.path.join(src, "docker/runtime-packages.txt")):
         listed += line.split("#", 1)[0].split()
     check(len(listed) == len(set(listed)), "docker/runtime-packages.txt repeats a package")
+    if not check(
+        run(["apt-cache", "show", "libc6"]).returncode == 0,
+        "apt-cache knows no packages (empty package lists: run apt-get update)",
+    ):
+        return
     out = run(["apt-cache", "show", "--no-all-versions"] + listed)
     known = set(re.findall(r"^Package: (\S+)$", out.stdout, re.M))
     for pkg in listed:
@@ -376,13 +480,21 @@ def check_runtime_packages(src, binaries):
                 libs.setdefault(m.group(1), set()).add(os.path.basename(binary))
     needed = {}
     for lib, pkg in dpkg_owners(libs).items():
-        if check(pkg, f"{lib} (needed by {', '.join(sorted(libs[lib]))}) belongs to no Debian package"):
+        if check(
+            pkg, f"{lib} (needed by {', '.join(sorted(libs[lib]))}) belongs to no Debian package"
+        ):
             needed.setdefault(pkg, set()).add(os.path.basename(lib))
     for pkg, names in sorted(needed.items()):
-        check(pkg in listed, f"docker/runtime-packages.txt lacks {pkg} ({', '.join(sorted(names))})")
-    check("python3-grpcio" in listed, "docker/runtime-packages.txt lacks python3-grpcio (HEALTHCHECK)")
-    print(f"runtime packages: {len(listed)} listed, {len(needed)} needed by ldd ({len(libs)} "
-          f"libraries), all present")
+        check(
+            pkg in listed, f"docker/runtime-packages.txt lacks {pkg} ({', '.join(sorted(names))})"
+        )
+    check(
+        "python3-grpcio" in listed, "docker/runtime-packages.txt lacks python3-grpcio (HEALTHCHECK)"
+    )
+    print(
+        f"runtime packages: {len(listed)} listed, {len(needed)} needed by ldd ({len(libs)} "
+        f"libraries), all present"
+    )
 
 
 # ---------------------------------------------------------------------------------- compose
@@ -396,80 +508,140 @@ def check_compose(src, images, server_flags, loadgen_flags, gateway_flags):
         build = svc.get("build")
         if build:
             context = os.path.normpath(os.path.join(src, "docker", build.get("context", ".")))
-            check(context == os.path.normpath(src), f"compose {name}: build context is not the repository root")
-            check(os.path.join(context, build.get("dockerfile", "Dockerfile")) ==
-                  os.path.join(src, "docker/Dockerfile"), f"compose {name}: not built from docker/Dockerfile")
-            check(build.get("target") in stages, f"compose {name}: unknown build target {build.get('target')}")
+            check(
+                context == os.path.normpath(src),
+                f"compose {name}: build context is not the repository root",
+            )
+            check(
+                os.path.join(context, build.get("dockerfile", "Dockerfile"))
+                == os.path.join(src, "docker/Dockerfile"),
+                f"compose {name}: not built from docker/Dockerfile",
+            )
+            check(
+                build.get("target") in stages,
+                f"compose {name}: unknown build target {build.get('target')}",
+            )
         for dep in svc.get("depends_on", {}) or {}:
             check(dep in services, f"compose {name}: depends_on unknown service {dep}")
     for want in ("redis", "nginx", "gateway", "loadgen"):
         check(want in services, f"compose has no service {want}")
     redis = services.get("redis", {})
-    check(str(redis.get("image", "")).startswith("redis:") and redis.get("healthcheck"),
-          "compose redis: not a redis image with a healthcheck")
+    check(
+        str(redis.get("image", "")).startswith("redis:") and redis.get("healthcheck"),
+        "compose redis: not a redis image with a healthcheck",
+    )
 
     def target(svc):
         return (svc.get("build") or {}).get("target")
 
-    replicas = {n: s for n, s in services.items()
-                if target(s) == "server" and "load" not in (s.get("profiles") or [])}
+    replicas = {
+        n: s
+        for n, s in services.items()
+        if target(s) == "server" and "load" not in (s.get("profiles") or [])
+    }
     check(len(replicas) == 3, f"compose has {len(replicas)} inbetween-server replicas, not 3")
     for name, svc in replicas.items():
         args = svc.get("command") or []
-        check(set(flags_of(args)) <= server_flags, f"compose {name}: unknown inbetween-server flags in {args}")
-        check(flag_value(args, "--store") == "redis://redis:6379",
-              f"compose {name}: --store is not the redis service (redis://redis:6379)")
-        check(svc.get("depends_on", {}).get("redis", {}).get("condition") == "service_healthy",
-              f"compose {name}: does not wait for a healthy redis")
+        check(
+            set(flags_of(args)) <= server_flags,
+            f"compose {name}: unknown inbetween-server flags in {args}",
+        )
+        check(
+            flag_value(args, "--store") == "redis://redis:6379",
+            f"compose {name}: --store is not the redis service (redis://redis:6379)",
+        )
+        check(
+            svc.get("depends_on", {}).get("redis", {}).get("condition") == "service_healthy",
+            f"compose {name}: does not wait for a healthy redis",
+        )
 
     nginx = services.get("nginx", {})
     env = nginx.get("environment", {})
     listed = env.get("INBETWEEN_REPLICAS", "").split()
     check(target(nginx) == "proxy", "compose nginx: not the proxy image")
-    check(sorted(h.rsplit(":", 1)[0] for h in listed) == sorted(replicas),
-          f"compose nginx: INBETWEEN_REPLICAS {listed} are not the replica services {sorted(replicas)}")
+    check(
+        sorted(h.rsplit(":", 1)[0] for h in listed) == sorted(replicas),
+        f"compose nginx: INBETWEEN_REPLICAS {listed} are not the replica services "
+        f"{sorted(replicas)}",
+    )
     for hostport in listed:
         rep = replicas.get(hostport.rsplit(":", 1)[0])
         if rep:
-            check(port_of(hostport) == port_of(flag_value(rep["command"], "--listen") or ":0"),
-                  f"compose nginx: {hostport} is not that replica's --listen port")
-        check(nginx.get("depends_on", {}).get(hostport.rsplit(":", 1)[0], {}).get("condition") ==
-              "service_healthy", f"compose nginx: does not wait for {hostport} to be healthy")
+            check(
+                port_of(hostport) == port_of(flag_value(rep["command"], "--listen") or ":0"),
+                f"compose nginx: {hostport} is not that replica's --listen port",
+            )
+        check(
+            nginx.get("depends_on", {}).get(hostport.rsplit(":", 1)[0], {}).get("condition")
+            == "service_healthy",
+            f"compose nginx: does not wait for {hostport} to be healthy",
+        )
     proxy_port = int(str(env.get("INBETWEEN_PROXY_LISTEN", "0")).rsplit(":", 1)[-1])
 
     gateway = services.get("gateway", {})
     gargs = gateway.get("command") or []
     check(target(gateway) == "gateway", "compose gateway: not the gateway image")
-    check(set(flags_of(gargs)) <= gateway_flags, f"compose gateway: unknown gateway flags in {gargs}")
-    check(flag_value(gargs, "--upstream") == f"nginx:{proxy_port}",
-          f"compose gateway: --upstream is not nginx:{proxy_port}")
+    check(
+        set(flags_of(gargs)) <= gateway_flags, f"compose gateway: unknown gateway flags in {gargs}"
+    )
+    check(
+        flag_value(gargs, "--upstream") == f"nginx:{proxy_port}",
+        f"compose gateway: --upstream is not nginx:{proxy_port}",
+    )
 
     load = services.get("loadgen", {})
     check("load" in (load.get("profiles") or []), "compose loadgen: not under the `load` profile")
-    check(target(load) == "server", "compose loadgen: not the server image (which has inbetween-loadgen)")
-    check(load.get("network_mode") == "service:nginx",
-          "compose loadgen: not in nginx's network namespace (its target must be loopback)")
+    check(
+        target(load) == "server",
+        "compose loadgen: not the server image (which has inbetween-loadgen)",
+    )
+    check(
+        load.get("network_mode") == "service:nginx",
+        "compose loadgen: not in nginx's network namespace (its target must be loopback)",
+    )
     largs = (load.get("entrypoint") or [])[1:] + (load.get("command") or [])
-    check((load.get("entrypoint") or [""])[0] in ("inbetween-loadgen", "/usr/local/bin/inbetween-loadgen")
-          and "/usr/local/bin/inbetween-loadgen" in images.get("server", {}).get("copies", {}),
-          "compose loadgen: its entrypoint is not the image's inbetween-loadgen")
+    check(
+        (load.get("entrypoint") or [""])[0]
+        in ("inbetween-loadgen", "/usr/local/bin/inbetween-loadgen")
+        and "/usr/local/bin/inbetween-loadgen" in images.get("server", {}).get("copies", {}),
+        "compose loadgen: its entrypoint is not the image's inbetween-loadgen",
+    )
     check(set(flags_of(largs)) <= loadgen_flags, f"compose loadgen: unknown flags in {largs}")
     tgt = flag_value(largs, "--target") or ":0"
-    check(tgt.rsplit(":", 1)[0] in ("127.0.0.1", "localhost") and port_of(tgt) == proxy_port,
-          f"compose loadgen: --target {tgt} is not nginx's port {proxy_port} on loopback")
-    examples_dest = next((d for d, (s, f) in images.get("server", {}).get("copies", {}).items()
-                          if s is None and f == "examples"), None)
+    check(
+        tgt.rsplit(":", 1)[0] in ("127.0.0.1", "localhost") and port_of(tgt) == proxy_port,
+        f"compose loadgen: --target {tgt} is not nginx's port {proxy_port} on loopback",
+    )
+    examples_dest = next(
+        (
+            d
+            for d, (s, f) in images.get("server", {}).get("copies", {}).items()
+            if s is None and f == "examples"
+        ),
+        None,
+    )
     drawings = []
     i = largs.index("--drawings") + 1 if "--drawings" in largs else len(largs)
     while i < len(largs) and not largs[i].startswith("--"):
         d = largs[i]
-        local = os.path.join(src, "examples", os.path.relpath(d, examples_dest)) if examples_dest else ""
-        check(examples_dest and d.startswith(examples_dest + "/") and os.path.isfile(local),
-              f"compose loadgen: drawing {d} is not a file the image copies from examples/")
+        local = (
+            os.path.join(src, "examples", os.path.relpath(d, examples_dest))
+            if examples_dest
+            else ""
+        )
+        check(
+            examples_dest and d.startswith(examples_dest + "/") and os.path.isfile(local),
+            f"compose loadgen: drawing {d} is not a file the image copies from examples/",
+        )
         drawings.append(local)
         i += 1
-    return dict(replicas=replicas, listed=listed, proxy_port=proxy_port, loadgen_args=largs,
-                drawings=drawings)
+    return dict(
+        replicas=replicas,
+        listed=listed,
+        proxy_port=proxy_port,
+        loadgen_args=largs,
+        drawings=drawings,
+    )
 
 
 def run_compose_locally(src, bin_dir, procs, work, redis_port, compose):
@@ -488,17 +660,25 @@ def run_compose_locally(src, bin_dir, procs, work, redis_port, compose):
         rc, out = healthcheck(src, addr)
         check(rc == 0, f"HEALTHCHECK against compose {name} ({addr}): {out}")
     port = free_port()
-    env = dict(os.environ,
-               INBETWEEN_REPLICAS=" ".join(addrs[h.rsplit(":", 1)[0]] for h in compose["listed"]),
-               INBETWEEN_PROXY_LISTEN=f"127.0.0.1:{port}",
-               INBETWEEN_NGINX_TEMPLATE=os.path.join(src, "deploy/nginx/inbetween.conf"),
-               INBETWEEN_NGINX_DIR=os.path.join(work, "nginx"), INBETWEEN_NGINX_WORKERS="1")
+    env = dict(
+        os.environ,
+        INBETWEEN_REPLICAS=" ".join(addrs[h.rsplit(":", 1)[0]] for h in compose["listed"]),
+        INBETWEEN_PROXY_LISTEN=f"127.0.0.1:{port}",
+        INBETWEEN_NGINX_TEMPLATE=os.path.join(src, "deploy/nginx/inbetween.conf"),
+        INBETWEEN_NGINX_DIR=os.path.join(work, "nginx"),
+        INBETWEEN_NGINX_WORKERS="1",
+    )
     nginx = procs.start("compose-nginx", [os.path.join(src, "docker/nginx-entrypoint.sh")], env=env)
-    if not check(wait_port(nginx, port), f"docker/nginx-entrypoint.sh did not start nginx:\n{log_of(nginx)}"):
+    if not check(
+        wait_port(nginx, port), f"docker/nginx-entrypoint.sh did not start nginx:\n{log_of(nginx)}"
+    ):
         return
     rendered = open(os.path.join(work, "nginx/inbetween.conf")).read()
-    check(sorted(re.findall(r"^\s*server (127\.0\.0\.1:\d+) max_fails=", rendered, re.M)) ==
-          sorted(addrs.values()), "the nginx entrypoint did not put the replicas into the upstream")
+    check(
+        sorted(re.findall(r"^\s*server (127\.0\.0\.1:\d+) max_fails=", rendered, re.M))
+        == sorted(addrs.values()),
+        "the nginx entrypoint did not put the replicas into the upstream",
+    )
     rc, out = healthcheck(src, f"127.0.0.1:{port}")
     check(rc == 0, f"HEALTHCHECK through the nginx entrypoint: {out}")
 
@@ -512,17 +692,31 @@ def run_compose_locally(src, bin_dir, procs, work, redis_port, compose):
         i += 1
     args = with_value(with_value(args, "--seconds", "20"), "--max-requests", "80")
     report_path = os.path.join(work, "loadgen.json")
-    out = run([os.path.join(bin_dir, "tools/loadgen/inbetween-loadgen")] + args +
-              ["--json", report_path], timeout=120)
-    if check(out.returncode == 0, f"inbetween-loadgen {shlex.join(args)}: exit {out.returncode}\n"
-             f"{out.stdout}{out.stderr}"):
+    out = run(
+        [os.path.join(bin_dir, "tools/loadgen/inbetween-loadgen")] + args + ["--json", report_path],
+        timeout=120,
+    )
+    if check(
+        out.returncode == 0,
+        f"inbetween-loadgen {shlex.join(args)}: exit {out.returncode}\n"
+        f"{out.stdout}{out.stderr}",
+    ):
         report = json.load(open(report_path))
-        other = {k: v for k, v in report.get("errors_by_code", {}).items() if k != "RESOURCE_EXHAUSTED"}
-        check(report.get("requests", 0) >= 80 and not other and report.get("lost_sessions") == 0 and
-              report.get("streams_completed", 0) >= 1 and report.get("frames_identical"),
-              f"the compose load run through nginx: {json.dumps(report)[:600]}")
-        print(f"compose on loopback: 3 replicas on Redis, nginx entrypoint, loadgen "
-              f"{report['requests']} requests, {report['streams_completed']} streams, 0 lost")
+        other = {
+            k: v for k, v in report.get("errors_by_code", {}).items() if k != "RESOURCE_EXHAUSTED"
+        }
+        check(
+            report.get("requests", 0) >= 80
+            and not other
+            and report.get("lost_sessions") == 0
+            and report.get("streams_completed", 0) >= 1
+            and report.get("frames_identical"),
+            f"the compose load run through nginx: {json.dumps(report)[:600]}",
+        )
+        print(
+            f"compose on loopback: 3 replicas on Redis, nginx entrypoint, loadgen "
+            f"{report['requests']} requests, {report['streams_completed']} streams, 0 lost"
+        )
 
 
 # ------------------------------------------------------------------------------- kubernetes
@@ -532,7 +726,7 @@ def labels_match(selector, labels):
     return bool(selector) and all(labels.get(k) == v for k, v in selector.items())
 
 
-def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags, images):
+def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags):
     docs = [d for d in yaml.safe_load_all(open(rendered)) if d]
     kinds = {}
     for d in docs:
@@ -555,22 +749,35 @@ def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags, ima
 
     for w in workloads:
         name = w["metadata"]["name"]
-        check(labels_match(w["spec"]["selector"]["matchLabels"], pod_labels(w)),
-              f"{name}: its selector does not match its pods")
+        check(
+            labels_match(w["spec"]["selector"]["matchLabels"], pod_labels(w)),
+            f"{name}: its selector does not match its pods",
+        )
         sc = w["spec"]["template"]["spec"].get("securityContext", {})
         for c in containers(w):
             limits = c.get("resources", {}).get("limits", {})
-            check("cpu" in limits and "memory" in limits, f"{name}/{c['name']}: no cpu and memory limits")
-            check(sc.get("runAsNonRoot") or c.get("securityContext", {}).get("runAsNonRoot"),
-                  f"{name}/{c['name']}: not runAsNonRoot")
+            check(
+                "cpu" in limits and "memory" in limits,
+                f"{name}/{c['name']}: no cpu and memory limits",
+            )
+            check(
+                sc.get("runAsNonRoot") or c.get("securityContext", {}).get("runAsNonRoot"),
+                f"{name}/{c['name']}: not runAsNonRoot",
+            )
             for e in c.get("env", []):
                 ref = e.get("valueFrom", {}).get("configMapKeyRef")
                 if ref:
-                    check(ref["key"] in configmaps.get(ref["name"], {}),
-                          f"{name}: env {e['name']} refers to missing ConfigMap key {ref['name']}/{ref['key']}")
+                    check(
+                        ref["key"] in configmaps.get(ref["name"], {}),
+                        f"{name}: env {e['name']} refers to missing ConfigMap key "
+                        f"{ref['name']}/{ref['key']}",
+                    )
         for v in w["spec"]["template"]["spec"].get("volumes", []):
             if "configMap" in v:
-                check(v["configMap"]["name"] in configmaps, f"{name}: volume of missing ConfigMap {v['configMap']['name']}")
+                check(
+                    v["configMap"]["name"] in configmaps,
+                    f"{name}: volume of missing ConfigMap {v['configMap']['name']}",
+                )
         check(services_for(w), f"{name}: no Service selects its pods")
 
     servers = [w for w in kinds.get("Deployment", []) if image_of(w).startswith("inbetween-server")]
@@ -582,40 +789,66 @@ def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags, ima
     for e in c.get("env", []):
         ref = e.get("valueFrom", {}).get("configMapKeyRef")
         env[e["name"]] = configmaps.get(ref["name"], {}).get(ref["key"]) if ref else e.get("value")
-    args = [re.sub(r"\$\(([A-Za-z_][A-Za-z0-9_]*)\)", lambda m: str(env.get(m.group(1), m.group(0))), a)
-            for a in c.get("args", [])]
+    args = [
+        re.sub(r"\$\(([A-Za-z_][A-Za-z0-9_]*)\)", lambda m: str(env.get(m.group(1), m.group(0))), a)
+        for a in c.get("args", [])
+    ]
     check(c["image"].startswith("inbetween-server:"), f"the server image has no tag: {c['image']}")
     check(not any("$(" in a for a in args), f"the server args have unresolved variables: {args}")
-    check(set(flags_of(args)) <= server_flags, f"the server Deployment's args have unknown flags: {args}")
+    check(
+        set(flags_of(args)) <= server_flags,
+        f"the server Deployment's args have unknown flags: {args}",
+    )
     listen_port = port_of(flag_value(args, "--listen") or ":0")
     for probe in ("readinessProbe", "livenessProbe"):
         grpc = c.get(probe, {}).get("grpc", {})
-        check(grpc.get("port") == listen_port and grpc.get("service") == HEALTH_SERVICE,
-              f"server {probe} is not a grpc probe of {HEALTH_SERVICE} on port {listen_port}: {c.get(probe)}")
+        check(
+            grpc.get("port") == listen_port and grpc.get("service") == HEALTH_SERVICE,
+            f"server {probe} is not a grpc probe of {HEALTH_SERVICE} on port {listen_port}: "
+            f"{c.get(probe)}",
+        )
     limits = c["resources"]["limits"]
     cpus = float(str(limits["cpu"]).rstrip("m")) / (1000 if str(limits["cpu"]).endswith("m") else 1)
     heavy = int(flag_value(args, "--max-heavy-jobs") or 0)
     threads = int(flag_value(args, "--solver-threads") or 1)
-    check(0 < heavy * threads <= max(1, round(cpus)),
-          f"--max-heavy-jobs {heavy} x --solver-threads {threads} does not fit the CPU limit {limits['cpu']}")
+    check(
+        0 < heavy * threads <= max(1, round(cpus)),
+        f"--max-heavy-jobs {heavy} x --solver-threads {threads} does not fit the CPU limit "
+        f"{limits['cpu']}",
+    )
     grace = int(flag_value(args, "--shutdown-grace-ms") or 5000) / 1000
-    check(deploy["spec"]["template"]["spec"].get("terminationGracePeriodSeconds", 30) > grace,
-          "terminationGracePeriodSeconds does not exceed --shutdown-grace-ms")
+    check(
+        deploy["spec"]["template"]["spec"].get("terminationGracePeriodSeconds", 30) > grace,
+        "terminationGracePeriodSeconds does not exceed --shutdown-grace-ms",
+    )
 
     headless = [s for s in services_for(deploy) if s["spec"].get("clusterIP") == "None"]
-    check(headless and any(p["port"] == listen_port for p in headless[0]["spec"]["ports"]),
-          "no headless Service lists the server pods on the gRPC port")
-    hpas = [h for h in kinds.get("HorizontalPodAutoscaler", [])
-            if h["spec"]["scaleTargetRef"] == {"apiVersion": "apps/v1", "kind": "Deployment",
-                                               "name": deploy["metadata"]["name"]}]
-    pdbs = [p for p in kinds.get("PodDisruptionBudget", [])
-            if labels_match(p["spec"]["selector"]["matchLabels"], pod_labels(deploy))]
+    check(
+        headless and any(p["port"] == listen_port for p in headless[0]["spec"]["ports"]),
+        "no headless Service lists the server pods on the gRPC port",
+    )
+    hpas = [
+        h
+        for h in kinds.get("HorizontalPodAutoscaler", [])
+        if h["spec"]["scaleTargetRef"]
+        == {"apiVersion": "apps/v1", "kind": "Deployment", "name": deploy["metadata"]["name"]}
+    ]
+    pdbs = [
+        p
+        for p in kinds.get("PodDisruptionBudget", [])
+        if labels_match(p["spec"]["selector"]["matchLabels"], pod_labels(deploy))
+    ]
     if check(hpas, "no HorizontalPodAutoscaler scales the server Deployment"):
         hpa = hpas[0]["spec"]
-        check(2 <= hpa["minReplicas"] <= hpa["maxReplicas"], f"HPA replicas {hpa['minReplicas']}..{hpa['maxReplicas']}")
+        check(
+            2 <= hpa["minReplicas"] <= hpa["maxReplicas"],
+            f"HPA replicas {hpa['minReplicas']}..{hpa['maxReplicas']}",
+        )
         if check(pdbs, "no PodDisruptionBudget covers the server pods"):
-            check(0 < pdbs[0]["spec"].get("minAvailable", 0) < hpa["minReplicas"],
-                  "the PDB's minAvailable must be below the HPA's minReplicas (else drains block)")
+            check(
+                0 < pdbs[0]["spec"].get("minAvailable", 0) < hpa["minReplicas"],
+                "the PDB's minAvailable must be below the HPA's minReplicas (else drains block)",
+            )
 
     # Redis: a workload on a redis image behind the Service that --store names.
     store = flag_value(args, "--store") or ""
@@ -623,8 +856,10 @@ def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags, ima
     redis = [w for w in workloads if image_of(w).startswith("redis:")]
     if check(m and redis, f"--store {store} is not redis://SERVICE:PORT, or no Redis workload"):
         svc = [s for s in services_for(redis[0]) if s["metadata"]["name"] == m.group(1)]
-        check(svc and any(p["port"] == int(m.group(2)) for p in svc[0]["spec"]["ports"]),
-              f"--store {store}: no Service of that name and port selects the Redis pods")
+        check(
+            svc and any(p["port"] == int(m.group(2)) for p in svc[0]["spec"]["ports"]),
+            f"--store {store}: no Service of that name and port selects the Redis pods",
+        )
 
     # The proxy: HAProxy from the proxy image with the generated ConfigMap.
     proxies = [w for w in kinds.get("Deployment", []) if image_of(w).startswith("inbetween-proxy")]
@@ -637,26 +872,42 @@ def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags, ima
         vols = {v["name"]: v for v in proxies[0]["spec"]["template"]["spec"].get("volumes", [])}
         vol = vols.get(mounts.get(os.path.dirname(cfg_path)), {})
         data = configmaps.get(vol.get("configMap", {}).get("name"), {})
-        check(cmd[:1] == ["haproxy"] and os.path.basename(cfg_path) in data,
-              f"the proxy does not run haproxy -f on a mounted ConfigMap file: {cmd}")
+        check(
+            cmd[:1] == ["haproxy"] and os.path.basename(cfg_path) in data,
+            f"the proxy does not run haproxy -f on a mounted ConfigMap file: {cmd}",
+        )
         haproxy_cfg = data.get(os.path.basename(cfg_path))
-        check(haproxy_cfg == open(os.path.join(src, "deploy/k8s/haproxy.cfg")).read(),
-              "the rendered HAProxy ConfigMap is not deploy/k8s/haproxy.cfg")
+        check(
+            haproxy_cfg == open(os.path.join(src, "deploy/k8s/haproxy.cfg")).read(),
+            "the rendered HAProxy ConfigMap is not deploy/k8s/haproxy.cfg",
+        )
         check("readinessProbe" in p, "the proxy has no readinessProbe")
         envs = {e["name"]: e for e in p.get("env", [])}
-        check(envs.get("POD_NAMESPACE", {}).get("valueFrom", {}).get("fieldRef", {}).get("fieldPath") ==
-              "metadata.namespace", "the proxy does not get POD_NAMESPACE from the downward API")
+        check(
+            envs.get("POD_NAMESPACE", {}).get("valueFrom", {}).get("fieldRef", {}).get("fieldPath")
+            == "metadata.namespace",
+            "the proxy does not get POD_NAMESPACE from the downward API",
+        )
         pports = {cp["containerPort"] for cp in p.get("ports", [])}
         check(services_for(proxies[0]), "no Service for the proxy")
     if haproxy_cfg:
-        check_haproxy_k8s(src, work, haproxy_cfg, headless, listen_port, pports,
-                          hpas[0]["spec"]["maxReplicas"] if hpas else 0)
+        check_haproxy_k8s(
+            src,
+            work,
+            haproxy_cfg,
+            headless,
+            listen_port,
+            pports,
+            hpas[0]["spec"]["maxReplicas"] if hpas else 0,
+        )
 
     # The Deployment's args, run for real: a server on the test's Redis, health as the probes ask.
     run_args = with_value(args, "--listen", "127.0.0.1:0")
     run_args = with_value(run_args, "--metrics-listen", "127.0.0.1:0")
     run_args = with_value(run_args, "--store", f"redis://127.0.0.1:{redis_port}")
-    addr = start_server(procs, os.path.join(bin_dir, "server/inbetween-server"), "k8s-server", run_args)
+    addr = start_server(
+        procs, os.path.join(bin_dir, "server/inbetween-server"), "k8s-server", run_args
+    )
     if addr:
         rc, out = healthcheck(src, addr, c["readinessProbe"]["grpc"]["service"])
         check(rc == 0, f"the Deployment's server does not answer its probe's health check: {out}")
@@ -668,7 +919,9 @@ def check_haproxy_k8s(src, work, cfg, headless, listen_port, proxy_ports, max_re
     with open(path, "w") as f:
         f.write(cfg)
     out = run(["haproxy", "-c", "-f", path], env=dict(os.environ, POD_NAMESPACE="default"))
-    check(out.returncode == 0, f"haproxy -c rejects deploy/k8s/haproxy.cfg:\n{out.stdout}{out.stderr}")
+    check(
+        out.returncode == 0, f"haproxy -c rejects deploy/k8s/haproxy.cfg:\n{out.stdout}{out.stderr}"
+    )
 
     def settings(text):
         return {l.split("#")[0].strip() for l in text.splitlines() if l.split("#")[0].strip()}
@@ -676,16 +929,28 @@ def check_haproxy_k8s(src, work, cfg, headless, listen_port, proxy_ports, max_re
     template = settings(open(os.path.join(src, "deploy/haproxy/inbetween.cfg")).read())
     ours = settings(cfg)
     shared = {l for l in template if not re.match(r"(server|bind) ", l)}
-    check(shared <= ours, f"deploy/k8s/haproxy.cfg lacks template settings: {sorted(shared - ours)}")
+    check(
+        shared <= ours, f"deploy/k8s/haproxy.cfg lacks template settings: {sorted(shared - ours)}"
+    )
     m = re.search(r'^\s*server-template \S+ (\d+) "?([^"\s]+):(\d+)"? .*resolvers', cfg, re.M)
     if check(m, "deploy/k8s/haproxy.cfg has no server-template with resolvers"):
-        check(headless and m.group(2).split(".")[0] == headless[0]["metadata"]["name"] and
-              int(m.group(3)) == listen_port,
-              f"the server-template {m.group(2)}:{m.group(3)} is not the headless Service's gRPC port")
-        check(int(m.group(1)) >= max_replicas,
-              f"server-template has {m.group(1)} slots, fewer than the HPA's maxReplicas {max_replicas}")
+        check(
+            headless
+            and m.group(2).split(".")[0] == headless[0]["metadata"]["name"]
+            and int(m.group(3)) == listen_port,
+            f"the server-template {m.group(2)}:{m.group(3)} is not the headless Service's "
+            "gRPC port",
+        )
+        check(
+            int(m.group(1)) >= max_replicas,
+            f"server-template has {m.group(1)} slots, fewer than the HPA's maxReplicas "
+            f"{max_replicas}",
+        )
     b = re.search(r"^\s*bind \S*:(\d+) ", cfg, re.M)
-    check(b and int(b.group(1)) in proxy_ports, "HAProxy's bind port is not the proxy container's port")
+    check(
+        b and int(b.group(1)) in proxy_ports,
+        "HAProxy's bind port is not the proxy container's port",
+    )
 
 
 # ------------------------------------------------------------------------------------- main
@@ -703,9 +968,11 @@ def main():
     loadgen_bin = os.path.join(a.bin, "tools/loadgen/inbetween-loadgen")
     server_flags = help_flags([server_bin])
     loadgen_flags = help_flags([loadgen_bin])
-    gateway_flags = help_flags(["node", os.path.join(a.src, "client/web/src/gateway/main.mjs")])
-    check("--store" in server_flags and "--target" in loadgen_flags and "--upstream" in gateway_flags,
-          "could not read the programs' flags from --help")
+    gateway_flags = gateway_options(os.path.join(a.src, "client/web/src/gateway/main.mjs"))
+    check(
+        "--store" in server_flags and "--target" in loadgen_flags and "--upstream" in gateway_flags,
+        "could not read the programs' flags from --help",
+    )
 
     procs = Processes(a.work)
     try:
@@ -714,22 +981,27 @@ def main():
         tokens = os.path.join(a.work, "tokens")
         with open(tokens, "w") as f:
             f.write("secret-probe probe\n")
-        addr = start_server(procs, server_bin, "health", ["--listen", "127.0.0.1:0", "--tokens", tokens])
+        addr = start_server(
+            procs, server_bin, "health", ["--listen", "127.0.0.1:0", "--tokens", tokens]
+        )
         if addr:
             rc, out = healthcheck(a.src, addr)
-            check(rc == 0 and out == "SERVING", f"healthcheck.py on a server with --tokens: {rc} {out}")
+            check(
+                rc == 0 and out == "SERVING",
+                f"healthcheck.py on a server with --tokens: {rc} {out}",
+            )
             rc, out = healthcheck(a.src, addr, "no.such.Service")
             check(rc == 1, f"healthcheck.py accepted an unknown service: {rc} {out}")
         rc, out = healthcheck(a.src, f"127.0.0.1:{free_port()}")
         check(rc == 1, f"healthcheck.py accepted a port nobody listens on: {rc} {out}")
         check_health_answers(a.src)
 
-        images = check_dockerfile(a.src, a.bin, server_flags, loadgen_flags, gateway_flags)
+        images = check_dockerfile(a.src, a.bin, server_flags, gateway_flags)
         check_runtime_packages(a.src, [server_bin, loadgen_bin])
         compose = check_compose(a.src, images, server_flags, loadgen_flags, gateway_flags)
         run_compose_locally(a.src, a.bin, procs, a.work, a.redis_port, compose)
         if a.k8s:
-            check_k8s(a.src, a.bin, procs, a.work, a.redis_port, a.k8s, server_flags, images)
+            check_k8s(a.src, a.bin, procs, a.work, a.redis_port, a.k8s, server_flags)
     finally:
         procs.stop_all()
     if FAILURES:
