@@ -4,7 +4,10 @@
 // frames per second (frames / time from the request to the last frame) and per-frame latency
 // (time between consecutive frames at the client, p50/p99). Then the unary latency while every
 // heavy slot runs an Inbetween stream: GetSession p50/p99 over loopback TCP. The solver alone
-// (the handler's work without RPC) is printed for reference.
+// (the handler's work without RPC) is printed for reference. Last, cancellation latency: a long
+// Inbetween stream and an OptimizeComesh run are cancelled by the client after 200 ms; the time
+// from TryCancel to the server's handler returning CANCELLED (its RPC counted in the metrics,
+// i.e. the solver stopped and the heavy slot freed), per trial (target: within 100 ms).
 // Usage: service [--json FILE] [--frames N] [--runs R] [--max-edge E] [--boundary B]
 //                [--unary-calls N]
 #include <grpcpp/grpcpp.h>
@@ -87,6 +90,38 @@ v1::Session Prepare(v1::Inbetween::Stub& stub, const std::string& examples, doub
   }
   if (auto s = reader->Finish(); !s.ok()) Fail("build", s);
   return session;
+}
+
+// inbetween_rpcs_total{method=METHOD,code="CANCELLED"} in the server's metrics text.
+uint64_t CancelledCount(const inbetween::server::InbetweenServer& server,
+                        const std::string& method) {
+  const std::string text = server.RenderMetrics();
+  const std::string key = "inbetween_rpcs_total{method=\"" + method + "\",code=\"CANCELLED\"} ";
+  const size_t at = text.find(key);
+  return at == std::string::npos ? 0 : std::strtoull(text.c_str() + at + key.size(), nullptr, 10);
+}
+
+// Milliseconds from the client's TryCancel, 200 ms into `method`, to the server's handler having
+// returned CANCELLED (polled every 0.2 ms).
+template <class Start>
+double CancelLatencyMs(const inbetween::server::InbetweenServer& server, const std::string& method,
+                       Start start) {
+  const uint64_t before = CancelledCount(server, method);
+  grpc::ClientContext context;
+  std::thread reader([&] { start(&context); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const Clock::time_point cancelled = Clock::now();
+  context.TryCancel();
+  double ms = -1;
+  while (std::chrono::duration<double>(Clock::now() - cancelled).count() < 10.0) {
+    if (CancelledCount(server, method) > before) {
+      ms = std::chrono::duration<double, std::milli>(Clock::now() - cancelled).count();
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  reader.join();
+  return ms;  // -1: the handler did not stop within 10 s (or finished before the cancel)
 }
 
 struct Run {
@@ -287,6 +322,52 @@ int main(int argc, char** argv) {
       "finished meanwhile): p50 %.3f ms, p99 %.3f ms, max %.3f ms (%d calls)\n",
       cores, heavy_streams.load(), unary_p50, unary_p99,
       *std::max_element(unary_ms.begin(), unary_ms.end()), unary_calls);
+
+  // Cancellation latency.
+  std::vector<double> cancel_inbetween, cancel_optimize;
+  for (int trial = 0; trial < 10; ++trial) {
+    cancel_inbetween.push_back(
+        CancelLatencyMs(**server, "Inbetween", [&](grpc::ClientContext* context) {
+          v1::InbetweenRequest request;
+          request.set_session_id(session.id());
+          request.mutable_parameters()->set_frames(100000);  // far longer than the 200 ms
+          auto reader = inprocess->Inbetween(context, request);
+          v1::InbetweenResponse response;
+          while (reader->Read(&response)) {
+          }
+          reader->Finish();
+        }));
+    cancel_optimize.push_back(
+        CancelLatencyMs(**server, "OptimizeComesh", [&](grpc::ClientContext* context) {
+          v1::OptimizeComeshRequest request;
+          request.set_session_id(session.id());
+          request.set_expected_version(session.version());
+          auto reader = inprocess->OptimizeComesh(context, request);
+          v1::OptimizeComeshResponse response;
+          while (reader->Read(&response)) {
+          }
+          reader->Finish();
+        }));
+  }
+  auto summary = [](const std::vector<double>& ms) {
+    return nlohmann::json{{"p50_ms", Percentile(ms, 0.5)},
+                          {"max_ms", *std::max_element(ms.begin(), ms.end())},
+                          {"trials", ms.size()}};
+  };
+  std::printf(
+      "\ncancellation, client TryCancel -> server handler returned CANCELLED (10 trials, target "
+      "100 ms): Inbetween p50 %.2f ms, max %.2f ms; OptimizeComesh p50 %.2f ms, max %.2f ms "
+      "(-1: did not stop)\n",
+      Percentile(cancel_inbetween, 0.5),
+      *std::max_element(cancel_inbetween.begin(), cancel_inbetween.end()),
+      Percentile(cancel_optimize, 0.5),
+      *std::max_element(cancel_optimize.begin(), cancel_optimize.end()));
+  rows.push_back({{"cancel", "Inbetween"}, {"latency", summary(cancel_inbetween)}});
+  rows.push_back({{"cancel", "OptimizeComesh"}, {"latency", summary(cancel_optimize)}});
+  rows.push_back({{"unary", "GetSession"},
+                  {"p50_ms", unary_p50},
+                  {"p99_ms", unary_p99},
+                  {"heavy_streams", cores}});
 
   if (!json_path.empty()) {
     std::ofstream out(json_path);
