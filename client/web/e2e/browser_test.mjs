@@ -5,18 +5,22 @@
 // Checks: a server error shows next to its control (bad SVG -> on its card; Inbetween before a
 // multimesh -> next to the button), the drawn cut comes back with rebuilt boundaries, build
 // and optimize fill the energy chart, the player shows different non-blank frames, the mesh
-// overlay changes the picture, the GIF download decodes, and the layout fits a phone.
+// overlay changes the picture, the GIF download decodes, the κ/τ/α/ε sliders reach the
+// Inbetween request (decoded from what the page sends) and ε > 0 changes the frames, the
+// project file download is docs/project-file.md's format with the cut and the slider values
+// (and, for drawings made with the mouse, comes with their SVGs), and the layout fits a phone.
 // Screenshots go to --out. Prints "N passed, N failed".
 import assert from "node:assert/strict";
 import { readFileSync, writeFileSync } from "node:fs";
-import { join } from "node:path";
+import { basename, join } from "node:path";
 import { parseArgs } from "node:util";
 
+import { fromBinary } from "@bufbuild/protobuf";
 import { createClient } from "@connectrpc/connect";
 import { createConnectTransport } from "@connectrpc/connect-node";
 import { chromium } from "playwright-core";
 
-import { Inbetween } from "../src/gen/inbetween/v1/inbetween_pb.js";
+import { Inbetween, InbetweenRequestSchema } from "../src/gen/inbetween/v1/inbetween_pb.js";
 
 const { values: args } = parseArgs({
   options: {
@@ -69,6 +73,19 @@ async function canvasInfo(page) {
   });
 }
 
+// The InbetweenRequest in the body of a Connect server-stream call made with the binary format:
+// one envelope (flags byte, big-endian 32-bit length, protobuf message).
+function decodeInbetweenRequest({ contentType, body }) {
+  assert.equal(contentType, "application/connect+proto");
+  assert.ok(body && body.length >= 5, `request body of ${body?.length} bytes`);
+  assert.equal(body[0], 0, "envelope flags (compressed or end-of-stream)");
+  const length = body.readUInt32BE(1);
+  assert.equal(body.length, 5 + length, "one envelope");
+  return fromBinary(InbetweenRequestSchema, body.subarray(5));
+}
+
+const near = (a, b, tol = 1e-9) => Math.abs(a - b) <= tol;
+
 async function scrubTo(page, i) {
   await page.locator("#scrub").evaluate((el, v) => {
     el.value = String(v);
@@ -98,6 +115,13 @@ try {
   const page = await context.newPage();
   page.setDefaultTimeout(STEP_MS);
   page.on("pageerror", (e) => pageErrors.push(e.message));
+  // Every Inbetween call the page makes, as sent (content type and body).
+  const inbetweenCalls = [];
+  page.on("request", (r) => {
+    if (new URL(r.url()).pathname === "/inbetween.v1.Inbetween/Inbetween") {
+      inbetweenCalls.push({ contentType: r.headers()["content-type"], body: r.postDataBuffer() });
+    }
+  });
 
   await step("page loads and creates a session", async () => {
     await page.goto(args.url);
@@ -284,6 +308,143 @@ try {
     for (const p of paths) assert.equal(p.ks.k.length, 12);
   });
 
+  // A digest of every frame as the player draws it (paused, scrubbed to each frame in turn).
+  const allFrames = async () => {
+    if (await page.locator("#play").textContent() === "Pause") await page.click("#play");
+    const n = Number(await page.locator("#scrub").getAttribute("max")) + 1;
+    const hashes = [];
+    for (let i = 0; i < n; i++) {
+      await scrubTo(page, i);
+      hashes.push((await canvasInfo(page)).hash);
+    }
+    return hashes;
+  };
+  // Clicks "Make inbetweens", waits for the stream to end; returns the request the page sent.
+  const makeInbetweens = async () => {
+    const calls = inbetweenCalls.length;
+    await page.click("#inbetween");
+    await page.waitForFunction(() => !document.getElementById("inbetween").disabled);
+    assert.equal(await text(page, "#error-inbetween"), "");
+    assert.match(await text(page, "#frame-label"), /^frame \d+ \/ 12/);
+    assert.equal(inbetweenCalls.length, calls + 1, "one Inbetween call per click");
+    return decodeInbetweenRequest(inbetweenCalls[calls]).parameters;
+  };
+  const slider = async (id) => ({
+    value: Number(await page.locator(`#${id}`).inputValue()),
+    shown: await page.locator(`output[for="${id}"]`).textContent(),
+  });
+  // What the sliders were set to (kappa as sent: 10^slider).
+  const set = {};
+
+  await step("the κ, τ, α sliders reach the Inbetween request; then ε > 0 changes the frames", async () => {
+    // The run played above was made with the sliders untouched: the defaults went out.
+    const first = decodeInbetweenRequest(inbetweenCalls.at(-1)).parameters;
+    assert.equal(first.frames, 12);
+    assert.ok(near(first.tau, 0.1) && near(first.alpha, 0.5) && first.epsilon === 0 && first.stiffness.length === 0,
+      `default parameters sent: ${JSON.stringify({ tau: first.tau, alpha: first.alpha, epsilon: first.epsilon, stiffness: first.stiffness.length })}`);
+    await page.uncheck("#overlay");
+    const before = await allFrames();
+    assert.equal(before.length, 12);
+
+    // Real input events: keyboard arrows on τ and κ, fill (input + change) on α.
+    await page.focus("#tau");
+    for (let i = 0; i < 5; i++) await page.keyboard.press("ArrowRight"); // 0.1 + 5 × 0.01
+    await page.focus("#kappa");
+    for (let i = 0; i < 10; i++) await page.keyboard.press("ArrowRight"); // 0 + 10 × 0.1: κ = 10
+    await page.locator("#alpha").fill("0.8");
+    const tau = await slider("tau");
+    const kappa = await slider("kappa");
+    const alpha = await slider("alpha");
+    assert.ok(near(tau.value, 0.15, 1e-12), `τ slider at ${tau.value}`);
+    assert.ok(near(kappa.value, 1, 1e-12), `κ slider at ${kappa.value}`);
+    assert.equal(alpha.value, 0.8);
+    assert.deepEqual([tau.shown, kappa.shown, alpha.shown], ["0.15", "10.0", "0.8"]);
+    Object.assign(set, { tau: tau.value, alpha: alpha.value, kappa: 10 ** kappa.value });
+
+    const sent = await makeInbetweens();
+    assert.ok(near(sent.tau, set.tau), `tau sent ${sent.tau}`);
+    assert.ok(near(sent.alpha, set.alpha), `alpha sent ${sent.alpha}`);
+    assert.equal(sent.epsilon, 0);
+    // κ: one region around all of drawing 1 (examples/split: x 10..110, y 30..70).
+    assert.equal(sent.stiffness.length, 1);
+    assert.ok(near(sent.stiffness[0].kappa, set.kappa), `kappa sent ${sent.stiffness[0].kappa}`);
+    const xs = sent.stiffness[0].polygon.points.map((q) => q.x);
+    const ys = sent.stiffness[0].polygon.points.map((q) => q.y);
+    assert.ok(xs.length >= 3 && Math.min(...xs) < 10 && Math.max(...xs) > 110 && Math.min(...ys) < 30 &&
+      Math.max(...ys) > 70, `stiffness region ${JSON.stringify(sent.stiffness[0].polygon.points)}`);
+    const noDynamics = await allFrames();
+    // The solver is deterministic: the same request draws the same frames (so that the
+    // comparison below shows what ε does, not noise).
+    const again = await makeInbetweens();
+    assert.ok(near(again.tau, set.tau) && again.epsilon === 0);
+    assert.deepEqual(await allFrames(), noDynamics, "same parameters, different frames");
+
+    // ε from 0 to 2: the same request otherwise, and the inbetweens move differently.
+    await page.locator("#epsilon").fill("2");
+    const epsilon = await slider("epsilon");
+    assert.deepEqual(epsilon, { value: 2, shown: "2" });
+    set.epsilon = 2;
+    const sentDyn = await makeInbetweens();
+    assert.equal(sentDyn.epsilon, 2);
+    assert.ok(near(sentDyn.tau, set.tau) && near(sentDyn.alpha, set.alpha) && near(sentDyn.stiffness[0]?.kappa, set.kappa));
+    const dynamics = await allFrames();
+    assert.equal(dynamics.length, 12);
+    const changed = dynamics.filter((h, i) => h !== noDynamics[i]).length;
+    assert.ok(changed >= 1, `ε = 2 drew the same 12 frames as ε = 0`);
+    console.log(`     frames changed: ${before.filter((h, i) => h !== noDynamics[i]).length}/12 by κ, τ, α; ` +
+      `${changed}/12 by ε`);
+    await scrubTo(page, 5);
+    await page.screenshot({ path: join(args.out, "sliders-epsilon-2.png") });
+  });
+
+  await step("the project file download: version 1, both drawings, the cut, the slider values", async () => {
+    const [dl] = await Promise.all([page.waitForEvent("download"), page.click("#download-project")]);
+    assert.equal(dl.suggestedFilename(), "project.json");
+    const path = join(args.out, "project.json");
+    await dl.saveAs(path);
+    const project = JSON.parse(readFileSync(path, "utf8"));
+    // Only fields docs/project-file.md defines (the CLI refuses unknown ones).
+    const allowed = {
+      "": ["version", "drawings", "correspondences", "meshing", "comesh", "inbetween", "output"],
+      comesh: ["map_weight", "max_outer_iterations", "max_inner_iterations", "tolerance"],
+      inbetween: ["method", "frames", "timing", "ease", "stiffness", "lambda", "tau", "alpha", "epsilon",
+        "rho", "timestep", "max_iterations"],
+      output: ["formats", "width", "fps", "fill", "mesh_overlay"],
+    };
+    for (const [section, keys] of Object.entries(allowed)) {
+      const obj = section ? project[section] : project;
+      for (const k of Object.keys(obj ?? {})) assert.ok(keys.includes(k), `unknown field ${section}.${k}`);
+    }
+    assert.equal(project.version, 1);
+    assert.equal(project.drawings.length, 2);
+    const [d1, d2] = project.drawings;
+    assert.equal(d1.file, basename(args.first));
+    assert.equal(d2.file, basename(args.second));
+    for (const d of project.drawings) {
+      for (const k of Object.keys(d)) assert.ok(["file", "key_time", "cuts", "openings"].includes(k), `drawings[].${k}`);
+    }
+    // The cut drawn with the mouse, in drawing 1's coordinates (within 2 editor pixels of --cut).
+    assert.equal(d1.cuts?.length, 1, JSON.stringify(d1));
+    assert.equal(d1.cuts[0].length, 2);
+    const pxUnits = 2 / Number(await page.locator("#editor").getAttribute("data-scale"));
+    d1.cuts[0].flat().forEach((v, i) => assert.ok(near(v, cut[i], pxUnits), `cut ${JSON.stringify(d1.cuts[0])} vs ${cut}`));
+    assert.equal(d1.openings, undefined);
+    assert.equal(d2.cuts, undefined);
+    assert.equal(project.correspondences, undefined); // marks were sent empty
+    const ib = project.inbetween;
+    assert.deepEqual({ method: ib.method, frames: ib.frames, timing: ib.timing },
+      { method: "zhu17", frames: 12, timing: "linear" });
+    assert.ok(near(ib.tau, set.tau), `tau ${ib.tau}`);
+    assert.ok(near(ib.alpha, set.alpha), `alpha ${ib.alpha}`);
+    assert.equal(ib.epsilon, set.epsilon);
+    assert.equal(ib.stiffness?.length, 1);
+    assert.ok(near(ib.stiffness[0].kappa, set.kappa), `kappa ${ib.stiffness[0].kappa}`);
+    assert.ok(ib.stiffness[0].polygon.length >= 3 && ib.stiffness[0].polygon.every((q) => q.length === 2));
+    assert.equal(project.comesh.map_weight, 0.5);
+    assert.deepEqual({ fps: project.output.fps, fill: project.output.fill, overlay: project.output.mesh_overlay },
+      { fps: 24, fill: "#3b7dd8", overlay: false });
+  });
+
   await step("phone layout (390×844): nothing wider than the screen", async () => {
     await page.setViewportSize({ width: 390, height: 844 });
     await page.waitForTimeout(200);
@@ -293,6 +454,10 @@ try {
     await page.screenshot({ path: join(args.out, "phone-390x844.png"), fullPage: true });
   });
 
+  const polygons = [
+    [[50, 50], [150, 50], [150, 150], [50, 150]],
+    [[60, 40], [140, 60], [160, 140], [100, 170], [40, 140]],
+  ];
   await step("new session: two polygons drawn with the mouse, one mark, build, inbetween", async () => {
     await page.setViewportSize({ width: 1280, height: 800 });
     await page.click("#server-settings summary");
@@ -304,10 +469,6 @@ try {
       const v = await editor.evaluate((c) => [c.dataset.scale, c.dataset.ox, c.dataset.oy].map(Number));
       for (const [x, y] of points) await editor.click({ position: { x: v[1] + v[0] * x, y: v[2] + v[0] * y } });
     };
-    const polygons = [
-      [[50, 50], [150, 50], [150, 150], [50, 150]],
-      [[60, 40], [140, 60], [160, 140], [100, 170], [40, 140]],
-    ];
     for (const [i, polygon] of polygons.entries()) {
       await page.check('input[name="tool"][value="polygon"]');
       await clickAll(polygon);
@@ -321,7 +482,7 @@ try {
     ]);
     await page.check('input[name="tool"][value="mark"]');
     await page.locator("#drawing-list li[data-drawing-id] canvas").first().click();
-    await clickAll([[52, 48]]); // snaps to the corner (50, 50) of drawing 1; then drawing 2
+    await clickAll([[52, 48]]); // snaps onto drawing 1's top edge; then drawing 2
     await clickAll([[60, 40]]);
     assert.equal(await text(page, "#marks-info"), "1 mark(s)");
     const v = Number(await page.locator("#session-info").getAttribute("data-version"));
@@ -342,6 +503,55 @@ try {
     assert.equal(await text(page, "#error-inbetween"), "");
     assert.match(await text(page, "#frame-label"), /^frame \d+ \/ 6/);
     await page.screenshot({ path: join(args.out, "polygons.png") });
+  });
+
+  await step("the project of drawn polygons downloads with polygon_1.svg and polygon_2.svg", async () => {
+    const downloads = [];
+    const onDownload = (d) => downloads.push(d);
+    page.on("download", onDownload);
+    await page.click("#download-project");
+    for (const t0 = Date.now(); downloads.length < 3 && Date.now() - t0 < STEP_MS;) await page.waitForTimeout(50);
+    page.off("download", onDownload);
+    const files = {};
+    for (const d of downloads) {
+      const path = join(args.out, `polygons-${d.suggestedFilename()}`);
+      await d.saveAs(path);
+      files[d.suggestedFilename()] = readFileSync(path, "utf8");
+    }
+    assert.deepEqual(Object.keys(files).sort(), ["polygon_1.svg", "polygon_2.svg", "project.json"]);
+    const project = JSON.parse(files["project.json"]);
+    assert.equal(project.version, 1);
+    assert.deepEqual(project.drawings, [{ file: "polygon_1.svg" }, { file: "polygon_2.svg" }]);
+    assert.deepEqual({ frames: project.inbetween.frames, timing: project.inbetween.timing, ease: project.inbetween.ease },
+      { frames: 6, timing: "ease_in_out", ease: [0.5] });
+    // Each SVG is the polygon clicked (within 2 editor pixels), filled.
+    const units = 2 / Number(await page.locator("#editor").getAttribute("data-scale"));
+    const outlines = [];
+    for (const [i, polygon] of polygons.entries()) {
+      const svg = files[`polygon_${i + 1}.svg`];
+      assert.match(svg, /^<svg xmlns="http:\/\/www\.w3\.org\/2000\/svg" viewBox="[-\d. ]+">\n  <path fill="#3b7dd8" d="M [^"]+ Z"\/>\n<\/svg>\n$/);
+      const xy = svg.match(/ d="M ([^"]+) Z"/)[1].split(/ (?:L )?/).map(Number);
+      const outline = polygon.map((_, k) => [xy[2 * k], xy[2 * k + 1]]);
+      assert.equal(xy.length, 2 * polygon.length, svg);
+      outline.forEach((q, k) => assert.ok(near(q[0], polygon[k][0], units) && near(q[1], polygon[k][1], units),
+        `polygon_${i + 1}.svg point ${q} vs ${polygon[k]}`));
+      outlines.push(outline);
+    }
+    // The one mark: a point on each drawing's outline, near where it was clicked.
+    assert.equal(project.correspondences?.length, 1);
+    const mark = project.correspondences[0];
+    assert.equal(mark.length, 2);
+    const onOutline = ([x, y], outline) => outline.some(([ax, ay], k) => {
+      const [bx, by] = outline[(k + 1) % outline.length];
+      const cross = (bx - ax) * (y - ay) - (by - ay) * (x - ax);
+      const dot = (x - ax) * (bx - ax) + (y - ay) * (by - ay);
+      const len2 = (bx - ax) ** 2 + (by - ay) ** 2;
+      return Math.abs(cross) / Math.sqrt(len2) < 1e-3 && dot >= 0 && dot <= len2; // SVG: 3 decimals
+    });
+    [[52, 48], [60, 40]].forEach((clicked, i) => {
+      assert.ok(onOutline(mark[i], outlines[i]), `mark ${mark[i]} not on outline ${i + 1}`);
+      assert.ok(Math.hypot(mark[i][0] - clicked[0], mark[i][1] - clicked[1]) < 3 + units, `mark ${mark[i]}`);
+    });
   });
 
   await step("no uncaught errors in the page", async () => {
