@@ -23,13 +23,23 @@ bool IsTransient(const grpc::Status& status) {
          absl::StartsWith(status.error_message(), "Received RST_STREAM");
 }
 
+// gRPC aborts the process on a metadata value outside printable ASCII (API misuse), so such a
+// value (a session id or token typed with a control character) is not sent as metadata: the
+// server then judges the id in the request itself (NOT_FOUND) or sees no token (UNAUTHENTICATED).
+bool IsLegalMetadataValue(const std::string& value) {
+  return std::all_of(value.begin(), value.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
+}
+
 class InbetweenClient::Call {
  public:
   Call(InbetweenClient* client, const std::string& session_id) : client_(client) {
-    if (!client->options_.token.empty()) {
-      context.AddMetadata("authorization", absl::StrCat("Bearer ", client->options_.token));
+    const std::string& token = client->options_.token;
+    if (!token.empty() && IsLegalMetadataValue(token)) {
+      context.AddMetadata("authorization", absl::StrCat("Bearer ", token));
     }
-    if (!session_id.empty()) context.AddMetadata("x-session-id", session_id);
+    if (!session_id.empty() && IsLegalMetadataValue(session_id)) {
+      context.AddMetadata("x-session-id", session_id);
+    }
     std::lock_guard<std::mutex> lock(client_->mu_);
     client_->in_flight_ = &context;
     if (client_->cancelled_) context.TryCancel();
