@@ -74,6 +74,49 @@ void FinishProgress(const RunContext& ctx) {
   if (ctx.progress) ctx.progress->Finish();
 }
 
+// A project drawing as a PutDrawing request: its SVG text, name, key time, cuts and openings.
+v1::PutDrawingRequest DrawingRequest(const ProjectDrawing& d, const v1::Session& session,
+                                     std::string svg) {
+  v1::PutDrawingRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  request.mutable_drawing()->set_name(d.file.filename().string());
+  request.mutable_drawing()->set_svg(std::move(svg));
+  if (d.key_time) request.mutable_drawing()->set_key_time(*d.key_time);
+  for (const auto& [lines, kind] : {std::pair{&d.cuts, v1::ELEMENT_KIND_CUT},
+                                    std::pair{&d.openings, v1::ELEMENT_KIND_OPENING}}) {
+    for (const XYs& line : *lines) {
+      v1::TopologyElement* e = request.add_topology();
+      e->set_kind(kind);
+      *e->mutable_polyline() = ToPolyline(line);
+    }
+  }
+  return request;
+}
+
+// The project's correspondences, else the marks drawn in the SVGs (data-corr), which the
+// service does not keep with the drawings, set on the session (nothing when there are none).
+absl::Status UploadCorrespondences(const Project& project, const std::vector<std::string>& svgs,
+                                   const RunContext& ctx, v1::Session* session) {
+  std::vector<XYs> marks = project.correspondences;
+  if (marks.empty()) {
+    absl::StatusOr<std::vector<XYs>> drawn = SvgMarkCorrespondences(svgs);
+    if (!drawn.ok()) return drawn.status();
+    marks = *std::move(drawn);
+  }
+  if (marks.empty()) return absl::OkStatus();
+  v1::SetCorrespondencesRequest request;
+  request.set_session_id(session->id());
+  request.set_expected_version(session->version());
+  for (const XYs& mark : marks) {
+    *request.add_correspondences()->mutable_points() = ToPolyline(mark).points();
+  }
+  auto updated = ctx.client->SetCorrespondences(request);
+  if (!updated.ok()) return Annotate(updated.status(), "correspondences");
+  *session = *updated;
+  return absl::OkStatus();
+}
+
 // Creates a session and uploads the project's drawings (with their cuts and openings) and
 // correspondences. Errors name the drawing.
 absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::string& name,
@@ -86,44 +129,12 @@ absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::str
     const std::string where = absl::StrCat("drawing ", i + 1, " (", d.file.string(), ")");
     auto svg = ReadFile(d.file);
     if (!svg.ok()) return Annotate(svg.status(), where);
-    v1::PutDrawingRequest request;
-    request.set_session_id(session->id());
-    request.set_expected_version(session->version());
-    request.mutable_drawing()->set_name(d.file.filename().string());
     svgs.push_back(*svg);
-    request.mutable_drawing()->set_svg(*std::move(svg));
-    if (d.key_time) request.mutable_drawing()->set_key_time(*d.key_time);
-    for (const auto& [lines, kind] : {std::pair{&d.cuts, v1::ELEMENT_KIND_CUT},
-                                      std::pair{&d.openings, v1::ELEMENT_KIND_OPENING}}) {
-      for (const XYs& line : *lines) {
-        v1::TopologyElement* e = request.add_topology();
-        e->set_kind(kind);
-        *e->mutable_polyline() = ToPolyline(line);
-      }
-    }
-    auto put = ctx.client->PutDrawing(request);
+    auto put = ctx.client->PutDrawing(DrawingRequest(d, *session, *std::move(svg)));
     if (!put.ok()) return Annotate(put.status(), where);
     *session = put->session();
   }
-  // The project's correspondences, else the marks drawn in the SVGs (data-corr), which the
-  // service does not keep with the drawings.
-  std::vector<XYs> marks = project.correspondences;
-  if (marks.empty()) {
-    absl::StatusOr<std::vector<XYs>> drawn = SvgMarkCorrespondences(svgs);
-    if (!drawn.ok()) return drawn.status();
-    marks = *std::move(drawn);
-  }
-  if (!marks.empty()) {
-    v1::SetCorrespondencesRequest request;
-    request.set_session_id(session->id());
-    request.set_expected_version(session->version());
-    for (const XYs& mark : marks) {
-      *request.add_correspondences()->mutable_points() = ToPolyline(mark).points();
-    }
-    auto updated = ctx.client->SetCorrespondences(request);
-    if (!updated.ok()) return Annotate(updated.status(), "correspondences");
-    *session = *updated;
-  }
+  if (absl::Status s = UploadCorrespondences(project, svgs, ctx, &*session); !s.ok()) return s;
   if (ctx.remote) std::printf("session %s\n", session->id().c_str());
   return session;
 }
@@ -513,10 +524,13 @@ absl::Status RunValidate(const Inputs& inputs, const RunContext& ctx) {
   if (!project.ok()) {
     problems.push_back(std::string(project.status().message()));
   } else {
-    auto session = ctx.client->CreateSession("inbetween validate");
+    // The drawings go up as `animate` sends them (cuts, openings, key times, correspondences),
+    // so what validates is what animates.
+    auto session = ctx.client->CreateSession("inbetween validate", project->parameters);
     if (!session.ok()) return session.status();
     // Every drawing on its own, so one bad drawing does not hide the next.
     int imported = 0;
+    std::vector<std::string> svgs;
     for (size_t i = 0; i < project->drawings.size(); ++i) {
       const ProjectDrawing& d = project->drawings[i];
       const std::string where = absl::StrCat("drawing ", i + 1, " (", d.file.string(), ")");
@@ -525,18 +539,19 @@ absl::Status RunValidate(const Inputs& inputs, const RunContext& ctx) {
         problems.push_back(absl::StrCat(where, ": ", svg.status().message()));
         continue;
       }
-      v1::PutDrawingRequest request;
-      request.set_session_id(session->id());
-      request.set_expected_version(session->version());
-      request.mutable_drawing()->set_name(d.file.filename().string());
-      request.mutable_drawing()->set_svg(*svg);
-      auto put = ctx.client->PutDrawing(request);
+      svgs.push_back(*svg);
+      auto put = ctx.client->PutDrawing(DrawingRequest(d, *session, *std::move(svg)));
       if (!put.ok()) {
         problems.push_back(absl::StrCat(where, ": ", put.status().message()));
         continue;
       }
       *session = put->session();
       ++imported;
+    }
+    if (problems.empty()) {
+      if (absl::Status s = UploadCorrespondences(*project, svgs, ctx, &*session); !s.ok()) {
+        problems.push_back(std::string(s.message()));
+      }
     }
     // Whether the drawings fit together (same topology, mappable) only the build can tell.
     if (problems.empty() && imported >= 2) {

@@ -48,4 +48,28 @@ sid=$(awk '/^session /{print $2}' remote.out)
 [[ -n "$sid" ]] || { echo "no session id printed"; cat remote.out; exit 1; }
 "$CLI_BIN" --server "$SERVER_ADDR" inspect | grep -q "^$sid" || { echo "inspect does not list $sid"; exit 1; }
 "$CLI_BIN" --server "$SERVER_ADDR" inspect "$sid" | grep -q "STAGE_MULTIMESH"
+
+# validate uploads a project's drawings as animate does: a cut given in the project file (not in
+# the SVG) makes the split drawings agree; without it validate names the differing drawing.
+mkdir -p cutproj
+sed '/class="cut"/d' "$INBETWEEN_SRC/examples/split/1_whole.svg" > cutproj/1_whole.svg
+cp "$INBETWEEN_SRC/examples/split/2_two.svg" cutproj/
+cat > cutproj/project.json <<'JSON'
+{"version": 1,
+ "drawings": [{"file": "1_whole.svg", "cuts": [[[60, 20], [60, 80]]]}, "2_two.svg"],
+ "inbetween": {"frames": 6}}
+JSON
+"$CLI_BIN" validate --project cutproj/project.json -q > cutproj/ok.out 2>&1 ||
+  { echo "validate refused the project's cut"; cat cutproj/ok.out; exit 1; }
+grep -qx ok cutproj/ok.out || { cat cutproj/ok.out; exit 1; }
+python3 - <<'PY'
+import json
+p = json.load(open("cutproj/project.json"))
+p["drawings"][0] = "1_whole.svg"
+json.dump(p, open("cutproj/nocut.json", "w"))
+PY
+if "$CLI_BIN" validate --project cutproj/nocut.json -q > cutproj/bad.out 2>&1; then
+  echo "validate accepted drawings of different topology"; cat cutproj/bad.out; exit 1
+fi
+grep -q "drawing 1" cutproj/bad.out || { cat cutproj/bad.out; exit 1; }
 echo ok
