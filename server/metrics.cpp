@@ -38,32 +38,26 @@ void Metrics::Observe(Histogram& h, double seconds) {
 void Metrics::ObserveRpc(absl::string_view method, absl::string_view code, double seconds) {
   std::lock_guard lock(mutex_);
   ++rpc_counts_[{std::string(method), std::string(code)}];
-  auto it = rpc_seconds_.find(method);
-  if (it == rpc_seconds_.end()) it = rpc_seconds_.emplace(std::string(method), Histogram{}).first;
-  Observe(it->second, seconds);
+  Observe(rpc_seconds_[absl::StrCat("method=\"", method, "\",code=\"", code, "\"")], seconds);
 }
 
 void Metrics::ObserveStage(absl::string_view stage, double seconds) {
   std::lock_guard lock(mutex_);
-  auto it = stage_seconds_.find(stage);
-  if (it == stage_seconds_.end())
-    it = stage_seconds_.emplace(std::string(stage), Histogram{}).first;
-  Observe(it->second, seconds);
+  Observe(stage_seconds_[absl::StrCat("stage=\"", stage, "\"")], seconds);
 }
 
-void Metrics::RenderHistogram(std::string& out, absl::string_view name, absl::string_view label,
+void Metrics::RenderHistogram(std::string& out, absl::string_view name,
                               const std::map<std::string, Histogram, std::less<>>& histograms) {
-  for (const auto& [key, h] : histograms) {
+  for (const auto& [labels, h] : histograms) {
     uint64_t cumulative = 0;
     for (size_t i = 0; i < kBuckets.size(); ++i) {
       cumulative += h.buckets.empty() ? 0 : h.buckets[i];
-      absl::StrAppend(&out, name, "_bucket{", label, "=\"", key, "\",le=\"",
-                      absl::StrFormat("%g", kBuckets[i]), "\"} ", cumulative, "\n");
+      absl::StrAppend(&out, name, "_bucket{", labels, ",le=\"", absl::StrFormat("%g", kBuckets[i]),
+                      "\"} ", cumulative, "\n");
     }
-    absl::StrAppend(&out, name, "_bucket{", label, "=\"", key, "\",le=\"+Inf\"} ", h.count, "\n");
-    absl::StrAppend(&out, name, "_sum{", label, "=\"", key, "\"} ", absl::StrFormat("%.6f", h.sum),
-                    "\n");
-    absl::StrAppend(&out, name, "_count{", label, "=\"", key, "\"} ", h.count, "\n");
+    absl::StrAppend(&out, name, "_bucket{", labels, ",le=\"+Inf\"} ", h.count, "\n");
+    absl::StrAppend(&out, name, "_sum{", labels, "} ", absl::StrFormat("%.6f", h.sum), "\n");
+    absl::StrAppend(&out, name, "_count{", labels, "} ", h.count, "\n");
   }
 }
 
@@ -76,12 +70,12 @@ std::string Metrics::Render(const std::vector<Gauge>& gauges) const {
     absl::StrAppend(&out, "inbetween_rpcs_total{method=\"", key.first, "\",code=\"", key.second,
                     "\"} ", count, "\n");
   }
-  out += "# HELP inbetween_rpc_duration_seconds RPC latency by method.\n";
+  out += "# HELP inbetween_rpc_duration_seconds RPC latency by method and status code.\n";
   out += "# TYPE inbetween_rpc_duration_seconds histogram\n";
-  RenderHistogram(out, "inbetween_rpc_duration_seconds", "method", rpc_seconds_);
+  RenderHistogram(out, "inbetween_rpc_duration_seconds", rpc_seconds_);
   out += "# HELP inbetween_stage_seconds Solver stage run time by stage.\n";
   out += "# TYPE inbetween_stage_seconds histogram\n";
-  RenderHistogram(out, "inbetween_stage_seconds", "stage", stage_seconds_);
+  RenderHistogram(out, "inbetween_stage_seconds", stage_seconds_);
   absl::StrAppend(&out,
                   "# HELP inbetween_frames_solved_total Inbetween frames solved.\n"
                   "# TYPE inbetween_frames_solved_total counter\n"

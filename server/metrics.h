@@ -35,7 +35,7 @@ class Metrics {
   uint64_t frames_solved() const { return frames_solved_.load(std::memory_order_relaxed); }
 
   // The exposition text: inbetween_rpcs_total{method,code}, inbetween_rpc_duration_seconds
-  // histogram {method}, inbetween_stage_seconds histogram {stage},
+  // histogram {method,code}, inbetween_stage_seconds histogram {stage},
   // inbetween_frames_solved_total, then `gauges`.
   std::string Render(const std::vector<Gauge>& gauges) const;
 
@@ -46,7 +46,8 @@ class Metrics {
     double sum = 0;
   };
   static void Observe(Histogram& h, double seconds);
-  static void RenderHistogram(std::string& out, absl::string_view name, absl::string_view label,
+  // Keys of `histograms` are the series' label sets, already formatted (method="X",code="Y").
+  static void RenderHistogram(std::string& out, absl::string_view name,
                               const std::map<std::string, Histogram, std::less<>>& histograms);
 
   mutable std::mutex mutex_;

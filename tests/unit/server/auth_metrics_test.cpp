@@ -44,12 +44,18 @@ TEST(MetricsTest, RendersCountersHistogramsAndGauges) {
   const std::string text = metrics.Render({{"inbetween_active_sessions", "Sessions.", 3}});
   EXPECT_THAT(text, HasSubstr("inbetween_rpcs_total{method=\"GetSession\",code=\"OK\"} 1"));
   EXPECT_THAT(text, HasSubstr("inbetween_rpcs_total{method=\"GetSession\",code=\"NOT_FOUND\"} 1"));
+  // Latency per method and status code: the fast OK call and the slow NOT_FOUND one apart.
+  const std::string ok = "inbetween_rpc_duration_seconds_bucket{method=\"GetSession\",code=\"OK\",";
+  const std::string missing =
+      "inbetween_rpc_duration_seconds_bucket{method=\"GetSession\",code=\"NOT_FOUND\",";
+  EXPECT_THAT(text, HasSubstr(ok + "le=\"0.005\"} 1"));
+  EXPECT_THAT(text, HasSubstr(ok + "le=\"+Inf\"} 1"));
+  EXPECT_THAT(text, HasSubstr(missing + "le=\"0.1\"} 0"));
+  EXPECT_THAT(text, HasSubstr(missing + "le=\"0.25\"} 1"));
   EXPECT_THAT(
       text,
-      HasSubstr("inbetween_rpc_duration_seconds_bucket{method=\"GetSession\",le=\"0.005\"} 1"));
-  EXPECT_THAT(
-      text,
-      HasSubstr("inbetween_rpc_duration_seconds_bucket{method=\"GetSession\",le=\"+Inf\"} 2"));
+      HasSubstr(
+          "inbetween_rpc_duration_seconds_count{method=\"GetSession\",code=\"NOT_FOUND\"} 1"));
   EXPECT_THAT(text, HasSubstr("inbetween_stage_seconds_count{stage=\"build\"} 1"));
   EXPECT_THAT(text, HasSubstr("inbetween_active_sessions 3"));
 }
