@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# The CLI as a process (docs/cli.md): --progress json prints one JSON object per progress event
+# on stderr; -q prints no progress at all; the documented exit codes 4 (server unreachable),
+# 5 (server failure: a gRPC server without the Inbetween service answers UNIMPLEMENTED) and
+# 130 (Ctrl-C: SIGINT cancels the running stage, and nothing is written).
+source "$(dirname "$0")/lib/common.sh"
+ex="$INBETWEEN_SRC/examples/square_hexagon"
+cd "$WORK"
+
+# --progress json: every event a JSON object with stage, fraction in [0, 1], elapsed_s and an
+# optional detail; the build and the frames both report.
+"$CLI_BIN" --progress json animate "$ex/square.svg" "$ex/hexagon.svg" --frames 6 --format json \
+  --out json_out 2>progress.err >progress.out
+python3 - progress.err <<'PY'
+import json, sys
+events = [json.loads(l) for l in open(sys.argv[1]) if l.startswith("{")]
+assert len(events) >= 5, events
+for e in events:
+    assert {"stage", "fraction", "elapsed_s"} <= set(e) <= {"stage", "fraction", "detail",
+                                                             "elapsed_s"}, e
+    assert 0.0 <= e["fraction"] <= 1.0 and e["elapsed_s"] >= 0.0, e
+stages = {e["stage"] for e in events}
+assert {"triangulate", "map", "frames"} <= stages, stages
+print(f"progress json: {len(events)} events, stages {sorted(stages)}")
+PY
+
+# -q: no progress output (neither JSON events nor a bar), the result path still on stdout.
+"$CLI_BIN" -q animate "$ex/square.svg" "$ex/hexagon.svg" --frames 6 --format json \
+  --out quiet_out 2>quiet.err >quiet.out
+grep -q "quiet_out/frames.json" quiet.out || { cat quiet.out; exit 1; }
+if grep -qE '^\{|%|stage' quiet.err; then echo "-q printed progress:"; cat quiet.err; exit 1; fi
+
+# 4: nothing listens there.
+set +e
+"$CLI_BIN" --server 127.0.0.1:1 inspect >unreachable.out 2>&1; code=$?
+set -e
+[[ $code -eq 4 ]] || { echo "unreachable server: exit $code, want 4"; cat unreachable.out; exit 1; }
+grep -qi "connect" unreachable.out || { cat unreachable.out; exit 1; }
+
+# 5: a real gRPC server (Debian's python3-grpcio, hence /usr/bin/python3) serving no Inbetween.
+/usr/bin/python3 - >bare.log 2>&1 <<'PY' &
+import grpc, sys, time
+from concurrent import futures
+server = grpc.server(futures.ThreadPoolExecutor(max_workers=2))
+port = server.add_insecure_port("127.0.0.1:0")
+server.start()
+print(f"bare grpc server on 127.0.0.1:{port}", flush=True)
+time.sleep(60)
+PY
+PIDS+=($!)
+bare=""
+for _ in $(seq 1 100); do
+  bare=$(grep -oE '127\.0\.0\.1:[0-9]+' bare.log || true)
+  [[ -n "$bare" ]] && break
+  sleep 0.05
+done
+[[ -n "$bare" ]] || { cat bare.log; echo "bare server did not start"; exit 1; }
+set +e
+"$CLI_BIN" --server "$bare" inspect >unimplemented.out 2>&1; code=$?
+set -e
+[[ $code -eq 5 ]] || { echo "UNIMPLEMENTED: exit $code, want 5"; cat unimplemented.out; exit 1; }
+
+# 130: SIGINT during a long animate (100000 frames) ends it promptly; no output is left behind.
+"$CLI_BIN" -q animate "$ex/square.svg" "$ex/hexagon.svg" --frames 100000 --format json \
+  --out interrupted >interrupted.out 2>&1 &
+cli=$!
+PIDS+=($cli)
+sleep 2
+kill -INT "$cli"
+code=""
+for _ in $(seq 1 100); do  # at most 10 s
+  if ! kill -0 "$cli" 2>/dev/null; then
+    set +e; wait "$cli"; code=$?; set -e
+    break
+  fi
+  sleep 0.1
+done
+[[ -n "$code" ]] || { echo "animate did not stop within 10 s of SIGINT"; exit 1; }
+[[ $code -eq 130 ]] || { echo "SIGINT: exit $code, want 130"; cat interrupted.out; exit 1; }
+[[ ! -e interrupted/frames.json ]] || { echo "an interrupted animate wrote frames.json"; exit 1; }
+echo "ok"
