@@ -624,9 +624,17 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
 
 absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOptions& options,
                                          const CancelToken* cancel, const ProgressFn& progress,
-                                         ComeshReport* report) {
+                                         ComeshReport* report, const ComeshCheckpoint* resume) {
   const auto start = std::chrono::steady_clock::now();
   if (absl::Status st = ValidateInput(mesh); !st.ok()) return st;
+  if (resume != nullptr) {
+    if (absl::Status st = ValidateInput(resume->mesh); !st.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat("comesh checkpoint: ", st.message()));
+    }
+    if (resume->outer < 0 || resume->inner < 0) {
+      return absl::InvalidArgumentError("comesh checkpoint: negative pass or iteration count");
+    }
+  }
   if (options.max_iterations < 0 || options.history < 0 || !(options.max_step_fraction > 0.0) ||
       !(options.max_step_fraction < 1.0) || options.max_outer < 0 ||
       !(options.cure_keep >= 0.0 && options.cure_keep < 1.0) || !(options.blend >= 0.0)) {
@@ -646,8 +654,21 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   rep.map_energy_before = energies.map;
   rep.mesh_energy_before = energies.mesh;
 
-  Multimesh current = mesh;
+  Multimesh current = resume != nullptr ? resume->mesh : mesh;
   InnerStats stats;
+  double pass_start_objective = rep.objective_before;
+  int first_outer = 0;
+  if (resume != nullptr) {  // everything the loop below reads across passes (see the header)
+    first_outer = resume->outer;
+    stats.iterations = resume->inner;
+    stats.evaluations = resume->energy_evaluations;
+    pass_start_objective = resume->pass_start_objective;
+    rep.outer = resume->outer;
+    rep.flips = resume->flips;
+    rep.collapses = resume->collapses;
+    rep.splits = resume->splits;
+    rep.objective_trace = resume->objective_trace;
+  }
   auto inner = [&](int max_iterations) {
     ComeshOptions run = options;
     run.max_iterations = max_iterations;
@@ -657,8 +678,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   };
   // Topology passes, each after a short inner run (positions only need to be roughly relaxed for
   // the operations' decisions), then one inner run to convergence on the final topology.
-  double pass_start_objective = rep.objective_before;
-  for (int outer = 0; outer < options.max_outer; ++outer) {
+  for (int outer = first_outer; outer < options.max_outer; ++outer) {
     if (absl::Status st = inner(std::min(options.max_iterations, options.outer_inner_iterations));
         !st.ok()) {
       return st;
@@ -687,6 +707,17 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
           "comesh", 1.0,
           absl::StrFormat("outer %d: %d flips, %d collapses, %d splits, vertices %d", rep.outer,
                           topo.flips, topo.collapses, topo.splits, current.num_vertices()));
+    }
+    if (options.on_checkpoint) {
+      options.on_checkpoint(ComeshCheckpoint{.mesh = current,
+                                             .outer = rep.outer,
+                                             .inner = stats.iterations,
+                                             .energy_evaluations = stats.evaluations,
+                                             .flips = rep.flips,
+                                             .collapses = rep.collapses,
+                                             .splits = rep.splits,
+                                             .pass_start_objective = pass_start_objective,
+                                             .objective_trace = rep.objective_trace});
     }
   }
   if (absl::Status st = inner(options.max_iterations); !st.ok()) return st;

@@ -29,6 +29,13 @@
 // to convergence on the final topology. The objective is a mean quality (the ODT normalizer uses
 // the current triangle count), so it is comparable across passes and never increases.
 //
+// Checkpoints: after every topology pass that changed the mesh, on_checkpoint (if set) receives
+// a ComeshCheckpoint: the multimesh at that point plus every number the rest of the run reads
+// (pass count, the objective the outer_tolerance stop compares with, the counters and trace of
+// the report). Each inner run starts a fresh L-BFGS history, so nothing else carries over; a run
+// resumed from a checkpoint (OptimizeComesh's `resume`) returns the same multimesh, bit for bit,
+// and the same report (seconds aside) as the uninterrupted run, and numbers its iterations on.
+//
 // Unknowns, per shape: interior vertices move in 2D. With slide_boundary, a boundary vertex that
 // lies strictly inside the straight segment between its two boundary neighbours in that shape
 // slides along that line (one unknown), so the domain of every shape is preserved exactly.
@@ -54,6 +61,8 @@
 #include "solver/mesh/multimesh.h"
 
 namespace inbetween::solver {
+
+struct ComeshCheckpoint;
 
 struct ComeshOptions {
   double map_weight = 0.5;           // w of the objective (S-Table 1 default)
@@ -83,6 +92,24 @@ struct ComeshOptions {
   // Called after every accepted inner iterate (numbered globally from 1) with all shapes'
   // positions (of the current topology); for tests, traces and visualisation.
   std::function<void(int iteration, const std::vector<Points>& shapes)> on_iterate;
+  // Called after every topology pass that changed the mesh (see "Checkpoints" above).
+  std::function<void(const ComeshCheckpoint& checkpoint)> on_checkpoint;
+};
+
+// A run between two topology passes (see "Checkpoints" above). Valid only for the input
+// multimesh and options of the run that reported it.
+struct ComeshCheckpoint {
+  Multimesh mesh;  // after `outer` passes
+  int outer = 0;   // topology passes made (each changed the mesh); the next pass has this index
+  int inner = 0;   // accepted inner iterations so far; the next one is numbered inner + 1
+  int energy_evaluations = 0;
+  int flips = 0;
+  int collapses = 0;
+  int splits = 0;
+  // The objective after the last pass's short inner run: the outer_tolerance stop of the next
+  // pass compares with it.
+  double pass_start_objective = 0.0;
+  std::vector<double> objective_trace;  // ComeshReport::objective_trace so far
 };
 
 struct ComeshReport {
@@ -112,9 +139,12 @@ struct ComeshReport {
 // some shape (the message names shape and triangle); Cancelled if `cancel` fires (checked every
 // iteration). `progress` (may be empty) is called once per iteration; `report` may be null.
 // The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are remapped to
-// the compacted vertex numbering.
+// the compacted vertex numbering. `resume` (may be null): continue from a checkpoint that a run
+// on the same `mesh` with the same options reported (InvalidArgument if its multimesh is not
+// valid); the result and report equal that run's.
 absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOptions& options,
                                          const CancelToken* cancel, const ProgressFn& progress,
-                                         ComeshReport* report);
+                                         ComeshReport* report,
+                                         const ComeshCheckpoint* resume = nullptr);
 
 }  // namespace inbetween::solver

@@ -1,5 +1,6 @@
 // Tests for the comesh inner loop: descent, no inversion at any iterate, conformal limit,
-// improvement on square -> hexagon, cancellation, determinism, input validation.
+// improvement on square -> hexagon, cancellation, determinism, input validation, resuming from a
+// checkpoint.
 #include "solver/comesh/comesh_optimizer.h"
 
 #include <gtest/gtest.h>
@@ -287,6 +288,90 @@ TEST(ComeshOptimizerTest, RejectsBadOuterOptions) {
   options.max_outer = -1;
   EXPECT_EQ(OptimizeComesh(m, options, nullptr, nullptr, nullptr).status().code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+// Resuming from a checkpoint in the middle gives the uninterrupted run, bit for bit: the same
+// multimesh, the same report (seconds aside), the same iterates numbered on.
+TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun) {
+  auto m = BuiltSquareToHexagon(48);
+  ASSERT_TRUE(m.ok()) << m.status();
+  ComeshOptions options;
+  // Short runs between passes and a low outer tolerance: several passes, so that a checkpoint
+  // in the middle has passes (and the outer_tolerance stop) after it.
+  options.outer_inner_iterations = 5;
+  options.outer_tolerance = 1e-7;
+  std::vector<ComeshCheckpoint> checkpoints;
+  std::vector<std::pair<int, std::vector<Points>>> iterates;
+  options.on_checkpoint = [&](const ComeshCheckpoint& c) { checkpoints.push_back(c); };
+  options.on_iterate = [&](int i, const std::vector<Points>& x) { iterates.emplace_back(i, x); };
+  ComeshReport full;
+  auto uninterrupted = OptimizeComesh(*m, options, nullptr, nullptr, &full);
+  ASSERT_TRUE(uninterrupted.ok()) << uninterrupted.status();
+  ASSERT_GE(checkpoints.size(), 3u) << "need a checkpoint in the middle";
+  ASSERT_EQ(static_cast<int>(checkpoints.size()), full.outer);
+  for (size_t k = 0; k < checkpoints.size(); ++k) EXPECT_EQ(checkpoints[k].outer, int(k) + 1);
+
+  const ComeshCheckpoint middle = checkpoints[checkpoints.size() / 2];
+  ASSERT_GT(middle.inner, 0);
+  std::vector<ComeshCheckpoint> later;
+  std::vector<std::pair<int, std::vector<Points>>> resumed_iterates;
+  options.on_checkpoint = [&](const ComeshCheckpoint& c) { later.push_back(c); };
+  options.on_iterate = [&](int i, const std::vector<Points>& x) {
+    resumed_iterates.emplace_back(i, x);
+  };
+  options.threads = 1;  // the thread count does not matter either
+  ComeshReport rest;
+  auto resumed = OptimizeComesh(*m, options, nullptr, nullptr, &rest, &middle);
+  ASSERT_TRUE(resumed.ok()) << resumed.status();
+
+  EXPECT_EQ(resumed->triangles, uninterrupted->triangles);
+  EXPECT_EQ(resumed->shapes, uninterrupted->shapes);  // exact doubles
+  EXPECT_EQ(resumed->boundary, uninterrupted->boundary);
+  EXPECT_EQ(resumed->boundary_loops, uninterrupted->boundary_loops);
+  EXPECT_EQ(resumed->cohesive_edges, uninterrupted->cohesive_edges);
+  EXPECT_EQ(resumed->cohesive_closed, uninterrupted->cohesive_closed);
+  EXPECT_EQ(rest.inner, full.inner);
+  EXPECT_EQ(rest.outer, full.outer);
+  EXPECT_EQ(rest.flips, full.flips);
+  EXPECT_EQ(rest.collapses, full.collapses);
+  EXPECT_EQ(rest.splits, full.splits);
+  EXPECT_EQ(rest.energy_evaluations, full.energy_evaluations);
+  EXPECT_EQ(rest.objective_trace, full.objective_trace);
+  EXPECT_EQ(rest.objective_before, full.objective_before);
+  EXPECT_EQ(rest.objective_after, full.objective_after);
+  EXPECT_EQ(rest.map_energy, full.map_energy);
+  EXPECT_EQ(rest.mesh_energy, full.mesh_energy);
+  EXPECT_EQ(rest.vertices_before, full.vertices_before);
+  EXPECT_EQ(rest.vertices_after, full.vertices_after);
+  EXPECT_EQ(rest.stop_reason, full.stop_reason);
+  // The iterates after the checkpoint, numbered on from it, identical.
+  ASSERT_EQ(resumed_iterates.size(), iterates.size() - middle.inner);
+  for (size_t i = 0; i < resumed_iterates.size(); ++i) {
+    EXPECT_EQ(resumed_iterates[i].first, middle.inner + 1 + static_cast<int>(i));
+    EXPECT_EQ(resumed_iterates[i].second, iterates[middle.inner + i].second) << "iterate " << i;
+  }
+  // And the later checkpoints too.
+  ASSERT_EQ(later.size(), checkpoints.size() - middle.outer);
+  for (size_t k = 0; k < later.size(); ++k) {
+    const ComeshCheckpoint& a = later[k];
+    const ComeshCheckpoint& b = checkpoints[middle.outer + k];
+    EXPECT_EQ(a.outer, b.outer);
+    EXPECT_EQ(a.inner, b.inner);
+    EXPECT_EQ(a.pass_start_objective, b.pass_start_objective);
+    EXPECT_EQ(a.objective_trace, b.objective_trace);
+    EXPECT_EQ(a.mesh.shapes, b.mesh.shapes);
+  }
+}
+
+TEST(ComeshOptimizerTest, RejectsAnInvalidCheckpoint) {
+  auto m = BuiltSquareToHexagon(24);
+  ASSERT_TRUE(m.ok()) << m.status();
+  ComeshCheckpoint bad;
+  bad.mesh = *m;
+  std::swap(bad.mesh.triangles[0][1], bad.mesh.triangles[0][2]);  // inverted
+  auto out = OptimizeComesh(*m, ComeshOptions{}, nullptr, nullptr, nullptr, &bad);
+  EXPECT_EQ(out.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(out.status().message().find("checkpoint"), std::string::npos);
 }
 
 }  // namespace
