@@ -3,6 +3,7 @@
 // ComeshIteration per iterate with its energies, Progress for everything else.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +15,9 @@ namespace inbetween::server {
 
 class ComeshIterationStream {
  public:
+  // `outer`: topology passes already made (a run resumed from a checkpoint).
+  explicit ComeshIterationStream(uint32_t outer = 0) : outer_(outer) {}
+
   // Opens iterate `iteration` (numbered from 1 over the whole run) with the shapes' vertex
   // count. Returns the previously opened iterate if no progress line completed it.
   std::optional<inbetween::v1::OptimizeComeshResponse> Begin(

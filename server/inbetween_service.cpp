@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "server/cancel_watcher.h"
 #include "server/comesh_progress.h"
 #include "server/drawing_import.h"
@@ -134,6 +135,7 @@ v1::Session Compact(const v1::Session& session) {
 // Any change to drawings or correspondences drops the multimesh built from them.
 void InvalidateMultimesh(SessionState& state) {
   state.multimesh.reset();
+  state.comesh_checkpoint.reset();
   state.session.clear_multimesh_stats();
   state.session.set_stage(state.session.drawings_size() > 0 ? v1::STAGE_DRAWINGS
                                                             : v1::STAGE_UNSPECIFIED);
@@ -826,6 +828,7 @@ grpc::Status InbetweenService::BuildMultimesh(
         v1::BuildMultimeshResult* result = message.mutable_result();
         *result->mutable_multimesh() = ToProto(*mesh);
         state->multimesh = std::make_shared<const solver::Multimesh>(*std::move(mesh));
+        state->comesh_checkpoint.reset();  // of the previous multimesh
         state->session.set_stage(v1::STAGE_MULTIMESH);
         *state->session.mutable_multimesh_stats() = stats;
         absl::StatusOr<SessionState> stored =
@@ -845,9 +848,19 @@ grpc::Status InbetweenService::OptimizeComesh(
   Caller caller;
   return RunRpc(
       options_, context, "OptimizeComesh", request->session_id(), &caller, [&]() -> absl::Status {
-        absl::StatusOr<SessionState> state =
-            LoadForUpdate(*store_, request->session_id(), request->expected_version(), caller);
+        absl::StatusOr<SessionState> state = Load(*store_, request->session_id(), caller);
         if (!state.ok()) return state.status();
+        // A resumed request carries the version its first attempt started from; the run's own
+        // checkpoint writes have moved the session on since (docs/api.md "Resuming
+        // OptimizeComesh"). Any other write since is a stale version, as always.
+        const std::shared_ptr<const StoredComeshCheckpoint> checkpoint = state->comesh_checkpoint;
+        const bool own_checkpoint = request->resume() && checkpoint &&
+                                    checkpoint->input_version == request->expected_version() &&
+                                    checkpoint->stored_version == state->session.version();
+        if (state->session.version() != request->expected_version() && !own_checkpoint) {
+          return StaleVersionError(request->session_id(), state->session.version(),
+                                   request->expected_version());
+        }
         if (state->session.stage() < v1::STAGE_MULTIMESH || !state->multimesh) {
           return absl::FailedPreconditionError(
               absl::StrCat("session ", request->session_id(),
@@ -860,6 +873,11 @@ grpc::Status InbetweenService::OptimizeComesh(
             !s.ok()) {
           return s;
         }
+        const std::string parameters_key = comesh.SerializeAsString();
+        // Continue from the checkpoint only for the same parameters; else start over.
+        const solver::ComeshCheckpoint* resume_from =
+            own_checkpoint && checkpoint->parameters == parameters_key ? &checkpoint->checkpoint
+                                                                       : nullptr;
         solver::ComeshOptions options = ToComeshOptions(comesh);
         options.threads = options_.solver_threads;
         absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
@@ -872,9 +890,19 @@ grpc::Status InbetweenService::OptimizeComesh(
           std::lock_guard lock(write_mutex);
           if (!writer->Write(message)) token.Cancel();
         };
+        if (resume_from != nullptr) {
+          v1::OptimizeComeshResponse message;
+          v1::Progress* p = message.mutable_progress();
+          p->set_stage("comesh");
+          p->set_detail(absl::StrFormat(
+              "resumed after outer %d at iteration %d (checkpoint of session version %d)",
+              resume_from->outer, resume_from->inner, checkpoint->stored_version));
+          write(message);
+        }
         // One ComeshIteration per accepted iterate: on_iterate opens it (iteration number, vertex
         // count), the progress call that follows in the same iteration adds the energies.
-        ComeshIterationStream iterations;
+        ComeshIterationStream iterations(
+            resume_from != nullptr ? static_cast<uint32_t>(resume_from->outer) : 0);
         options.on_iterate = [&](int iteration, const std::vector<solver::Points>& shapes) {
           if (std::optional<v1::OptimizeComeshResponse> done =
                   iterations.Begin(iteration, shapes)) {
@@ -889,11 +917,34 @@ grpc::Status InbetweenService::OptimizeComesh(
           }
           write(iterations.OnProgress(stage, fraction, detail));
         };
+        // After every topology pass the checkpoint is stored with the session (a write: the
+        // version moves on; the session is otherwise unchanged). A failed write (another writer,
+        // or the store is down) ends the run: its final write would fail the same way.
+        uint64_t version = state->session.version();
+        absl::Status checkpoint_status;
+        options.on_checkpoint = [&](const solver::ComeshCheckpoint& c) {
+          if (token.IsCancelled() || context->IsCancelled()) return;
+          auto stored = std::make_shared<StoredComeshCheckpoint>();
+          stored->input_version = request->expected_version();
+          stored->stored_version = version + 1;
+          stored->parameters = parameters_key;
+          stored->checkpoint = c;
+          SessionState next = *state;
+          next.comesh_checkpoint = std::move(stored);
+          absl::StatusOr<SessionState> put = store_->Put(std::move(next), version);
+          if (!put.ok()) {
+            checkpoint_status = put.status();
+            token.Cancel();
+            return;
+          }
+          version = put->session.version();
+        };
         solver::ComeshReport report;
-        absl::StatusOr<solver::Multimesh> mesh =
-            solver::OptimizeComesh(*state->multimesh, options, &token, progress, &report);
+        absl::StatusOr<solver::Multimesh> mesh = solver::OptimizeComesh(
+            *state->multimesh, options, &token, progress, &report, resume_from);
         if (std::optional<v1::OptimizeComeshResponse> last = iterations.Flush()) write(*last);
         if (options_.metrics) options_.metrics->ObserveStage("optimize", report.seconds);
+        if (!checkpoint_status.ok()) return checkpoint_status;
         if (token.IsCancelled() || context->IsCancelled()) {
           return StoppedStatus(*context, "OptimizeComesh");
         }
@@ -913,11 +964,15 @@ grpc::Status InbetweenService::OptimizeComesh(
         result->set_inner_iterations(report.inner);
         result->set_outer_iterations(report.outer);
         result->set_seconds(report.seconds);
+        if (resume_from != nullptr) {
+          result->set_resumed_outer(resume_from->outer);
+          result->set_resumed_inner(resume_from->inner);
+        }
         state->multimesh = std::make_shared<const solver::Multimesh>(*std::move(mesh));
+        state->comesh_checkpoint.reset();  // done: nothing to resume
         state->session.set_stage(v1::STAGE_OPTIMIZED);
         *state->session.mutable_multimesh_stats() = stats;
-        absl::StatusOr<SessionState> stored =
-            store_->Put(*std::move(state), request->expected_version());
+        absl::StatusOr<SessionState> stored = store_->Put(*std::move(state), version);
         if (!stored.ok()) return stored.status();
         *result->mutable_session() = Compact(stored->session);
         *result->mutable_stats() = stats;

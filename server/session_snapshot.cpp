@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -17,9 +18,22 @@ namespace v1 = ::inbetween::v1;
 
 constexpr absl::string_view kMagic = "INBSNAP1";
 constexpr absl::string_view kEnd = "INBSEND1";
+constexpr absl::string_view kCheckpoint = "INBCKPT1";
+constexpr absl::string_view kCheckpointEnd = "INBCKEND";
 
 void PutU32(std::string& out, uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+}
+
+void PutU64(std::string& out, uint64_t v) {
+  PutU32(out, static_cast<uint32_t>(v & 0xffffffffu));
+  PutU32(out, static_cast<uint32_t>(v >> 32));
+}
+
+void PutF64(std::string& out, double v) {
+  uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  PutU64(out, bits);
 }
 
 void PutBytes(std::string& out, absl::string_view bytes) {
@@ -51,6 +65,32 @@ class Reader {
       v |= static_cast<uint32_t>(static_cast<unsigned char>(bytes_[at_ + i])) << (8 * i);
     at_ += 4;
     return v;
+  }
+  absl::StatusOr<uint64_t> U64() {
+    absl::StatusOr<uint32_t> low = U32();
+    if (!low.ok()) return low.status();
+    absl::StatusOr<uint32_t> high = U32();
+    if (!high.ok()) return high.status();
+    return static_cast<uint64_t>(*high) << 32 | *low;
+  }
+  absl::StatusOr<double> F64() {
+    absl::StatusOr<uint64_t> bits = U64();
+    if (!bits.ok()) return bits.status();
+    double v;
+    std::memcpy(&v, &*bits, sizeof v);
+    return v;
+  }
+  absl::StatusOr<int> Int() {
+    absl::StatusOr<uint32_t> v = U32();
+    if (!v.ok()) return v.status();
+    if (*v > static_cast<uint32_t>(std::numeric_limits<int>::max())) return Error("bad count");
+    return static_cast<int>(*v);
+  }
+  // Skips `magic` if the bytes continue with it.
+  bool Consume(absl::string_view magic) {
+    if (bytes_.substr(at_, magic.size()) != magic) return false;
+    at_ += magic.size();
+    return true;
   }
   absl::StatusOr<absl::string_view> Bytes() {
     absl::StatusOr<uint32_t> n = U32();
@@ -90,6 +130,73 @@ class Reader {
   size_t at_ = 0;
 };
 
+void EncodeCheckpoint(const StoredComeshCheckpoint& stored, std::string& out) {
+  const solver::ComeshCheckpoint& c = stored.checkpoint;
+  out.append(kCheckpoint.data(), kCheckpoint.size());
+  PutU64(out, stored.input_version);
+  PutU64(out, stored.stored_version);
+  PutBytes(out, stored.parameters);
+  PutBytes(out, ToProto(c.mesh).SerializeAsString());
+  PutLists(out, c.mesh.boundary_loops);
+  PutLists(out, c.mesh.cohesive_closed);
+  for (int v : {c.outer, c.inner, c.energy_evaluations, c.flips, c.collapses, c.splits}) {
+    PutU32(out, static_cast<uint32_t>(v));
+  }
+  PutF64(out, c.pass_start_objective);
+  PutU32(out, static_cast<uint32_t>(c.objective_trace.size()));
+  for (double f : c.objective_trace) PutF64(out, f);
+  out.append(kCheckpointEnd.data(), kCheckpointEnd.size());
+}
+
+// The checkpoint section after the end marker (the reader is just past "INBCKPT1").
+absl::StatusOr<StoredComeshCheckpoint> DecodeCheckpoint(Reader& reader, absl::string_view where) {
+  StoredComeshCheckpoint stored;
+  solver::ComeshCheckpoint& c = stored.checkpoint;
+  absl::StatusOr<uint64_t> input = reader.U64();
+  if (!input.ok()) return input.status();
+  absl::StatusOr<uint64_t> version = reader.U64();
+  if (!version.ok()) return version.status();
+  stored.input_version = *input;
+  stored.stored_version = *version;
+  absl::StatusOr<absl::string_view> parameters = reader.Bytes();
+  if (!parameters.ok()) return parameters.status();
+  stored.parameters = std::string(*parameters);
+  absl::StatusOr<absl::string_view> mesh_bytes = reader.Bytes();
+  if (!mesh_bytes.ok()) return mesh_bytes.status();
+  v1::Multimesh proto;
+  if (!proto.ParseFromArray(mesh_bytes->data(), static_cast<int>(mesh_bytes->size()))) {
+    return reader.Error("bad checkpoint multimesh");
+  }
+  absl::StatusOr<solver::Multimesh> mesh = MultimeshFromProto(proto, where);
+  if (!mesh.ok()) return reader.Error(mesh.status().message());
+  c.mesh = *std::move(mesh);
+  absl::StatusOr<std::vector<std::vector<int>>> loops =
+      reader.Lists(static_cast<uint32_t>(c.mesh.num_vertices()));
+  if (!loops.ok()) return loops.status();
+  absl::StatusOr<std::vector<std::vector<int>>> closed =
+      reader.Lists(static_cast<uint32_t>(c.mesh.cohesive_edges.size()));
+  if (!closed.ok()) return closed.status();
+  c.mesh.boundary_loops = *std::move(loops);
+  c.mesh.cohesive_closed = *std::move(closed);
+  for (int* v : {&c.outer, &c.inner, &c.energy_evaluations, &c.flips, &c.collapses, &c.splits}) {
+    absl::StatusOr<int> n = reader.Int();
+    if (!n.ok()) return n.status();
+    *v = *n;
+  }
+  absl::StatusOr<double> pass_start = reader.F64();
+  if (!pass_start.ok()) return pass_start.status();
+  c.pass_start_objective = *pass_start;
+  absl::StatusOr<int> trace = reader.Int();
+  if (!trace.ok()) return trace.status();
+  for (int i = 0; i < *trace; ++i) {
+    absl::StatusOr<double> f = reader.F64();
+    if (!f.ok()) return f.status();
+    c.objective_trace.push_back(*f);
+  }
+  if (absl::Status s = reader.Expect(kCheckpointEnd); !s.ok()) return s;
+  return stored;
+}
+
 }  // namespace
 
 v1::Session SessionSummary(const v1::Session& session) {
@@ -118,6 +225,7 @@ std::string EncodeSnapshot(const SessionState& state) {
   PutLists(out,
            state.multimesh ? state.multimesh->cohesive_closed : std::vector<std::vector<int>>{});
   out.append(kEnd.data(), kEnd.size());
+  if (state.comesh_checkpoint) EncodeCheckpoint(*state.comesh_checkpoint, out);
   return out;
 }
 
@@ -180,6 +288,14 @@ absl::StatusOr<SessionState> DecodeSnapshot(absl::string_view bytes, absl::strin
     }
   }
   if (absl::Status s = reader.Expect(kEnd); !s.ok()) return s;
+  // Anything else after the end marker is a later version's section: skipped, as older
+  // versions skip the checkpoint.
+  if (reader.Consume(kCheckpoint)) {
+    absl::StatusOr<StoredComeshCheckpoint> checkpoint = DecodeCheckpoint(reader, where);
+    if (!checkpoint.ok()) return checkpoint.status();
+    state.comesh_checkpoint =
+        std::make_shared<const StoredComeshCheckpoint>(*std::move(checkpoint));
+  }
   return state;
 }
 

@@ -4,6 +4,14 @@
 //   "INBSNAP1"  u32 len + owner  u32 len + Session summary  u32 len + SessionArchive
 //   u32 next_drawing_id  u32 loops, per loop u32 n + n x u32  u32 shapes, per shape u32 n + n x u32
 //   "INBSEND1"
+// then, when the session holds a comesh checkpoint (session_state.h), after the end marker (so
+// older servers, which stop reading there, still load the session):
+//   "INBCKPT1"  u64 input_version  u64 stored_version  u32 len + ComeshParameters
+//   u32 len + Multimesh (proto)  loops and closed cohesive edges as above  u32 outer, inner,
+//   energy_evaluations, flips, collapses, splits  f64 pass_start_objective  u32 n + n x f64 trace
+//   "INBCKEND"
+// (f64: the IEEE-754 bits as a little-endian u64, so the checkpoint comes back bit for bit.)
+// Other bytes after "INBSEND1" are skipped (a later version's sections).
 // The head (owner and summary) can be read without the rest, for listing at start-up.
 #pragma once
 

@@ -8,10 +8,21 @@
 #include <vector>
 
 #include "inbetween/v1/inbetween.pb.h"
+#include "solver/comesh/comesh_optimizer.h"
 #include "solver/core/types.h"
 #include "solver/mesh/multimesh.h"
 
 namespace inbetween::server {
+
+// The last checkpoint of an OptimizeComesh run (docs/api.md "Resuming OptimizeComesh"). It
+// belongs to one run: the session version the run started from (its input multimesh) and its
+// effective comesh parameters; usable only while the session is still at stored_version.
+struct StoredComeshCheckpoint {
+  uint64_t input_version = 0;   // the request's expected_version
+  uint64_t stored_version = 0;  // the session version the checkpoint write produced
+  std::string parameters;       // the effective v1::ComeshParameters, serialized
+  solver::ComeshCheckpoint checkpoint;
+};
 
 struct SessionState {
   // The session as the API shows it, drawings with their source (SVG text) and elements.
@@ -25,6 +36,9 @@ struct SessionState {
   uint32_t next_drawing_id = 1;
   // Who may see the session: the caller's token name (auth.h), "" when the server has no tokens.
   std::string owner;
+  // The running or interrupted optimization's last checkpoint, or null. Stored with the session
+  // (snapshots, Redis), never exported (ExportSession).
+  std::shared_ptr<const StoredComeshCheckpoint> comesh_checkpoint;
 };
 
 }  // namespace inbetween::server

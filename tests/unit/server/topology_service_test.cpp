@@ -1,7 +1,8 @@
 // The solver stages wired into the service: PutDrawing.topology (cuts and openings, graph-flow
 // classes and errors), the EditTopology stream, correspondence marks at build time, and the
-// OptimizeComesh stream (iterations, result, stored stage, cancellation).
+// OptimizeComesh stream (iterations, result, stored stage, cancellation, checkpoints and resume).
 #include <gmock/gmock.h>
+#include <google/protobuf/util/message_differencer.h>
 #include <grpcpp/client_context.h>
 #include <gtest/gtest.h>
 
@@ -18,6 +19,7 @@ namespace inbetween::server::testing {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 v1::TopologyElement Line(v1::ElementKind kind, std::vector<std::pair<double, double>> points) {
   v1::TopologyElement element;
@@ -391,7 +393,9 @@ TEST_F(TopologyServiceTest, OptimizeStreamsIterationsStoresTheResultAndInbetween
   }
   const v1::OptimizeComeshResult& result = run.result;
   EXPECT_EQ(result.session().stage(), v1::STAGE_OPTIMIZED);
-  EXPECT_EQ(result.session().version(), built.session().version() + 1);
+  // One write per checkpoint (after each topology pass), then the result.
+  EXPECT_EQ(result.session().version(), built.session().version() + result.outer_iterations() + 1);
+  EXPECT_EQ(result.resumed_outer(), 0u);
   EXPECT_EQ(result.inner_iterations(), run.iterations.size());
   EXPECT_GE(result.stats().map_energy(), 2.0 - 1e-9);
   EXPECT_LE(result.stats().map_energy(), built.stats().map_energy() + 1e-9);
@@ -459,6 +463,209 @@ TEST_F(TopologyServiceTest, CancellingOptimizeStopsItAndKeepsTheSession) {
   EXPECT_EQ(got.session().stage(), v1::STAGE_MULTIMESH);
   // Generous bound (not a benchmark): the solver checks the token every iteration.
   EXPECT_LT(std::chrono::steady_clock::now() - cancelled_at, std::chrono::seconds(5));
+}
+
+// ---------------------------------------------------------------------------------------------
+// OptimizeComesh checkpoints and resume (docs/api.md "Resuming OptimizeComesh")
+
+class OptimizeResumeTest : public TopologyServiceTest {
+ protected:
+  // The square -> hexagon examples, built.
+  v1::Session Built() {
+    grpc::Status status;
+    v1::BuildMultimeshResult built = Build(SessionWithExamples(), &status);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return built.session();
+  }
+
+  static v1::OptimizeComeshRequest Request(const v1::Session& session, bool resume) {
+    v1::OptimizeComeshRequest request;
+    request.set_session_id(session.id());
+    request.set_expected_version(session.version());
+    request.set_resume(resume);
+    request.mutable_comesh()->set_max_outer_iterations(8);
+    request.mutable_comesh()->set_max_inner_iterations(200);
+    return request;
+  }
+
+  OptimizeRun Optimize(const v1::OptimizeComeshRequest& request) {
+    grpc::ClientContext context;
+    return RunOptimize(*stub_, request, &context);
+  }
+
+  // Starts the optimization and cancels it at the first iteration after the first topology pass:
+  // the pass's checkpoint is written before the next inner run starts. Returns the iterations
+  // received.
+  std::vector<v1::ComeshIteration> Interrupt(const v1::OptimizeComeshRequest& request) {
+    grpc::ClientContext context;
+    auto reader = stub_->OptimizeComesh(&context, request);
+    v1::OptimizeComeshResponse message;
+    std::vector<v1::ComeshIteration> iterations;
+    bool passed = false;
+    while (reader->Read(&message)) {
+      EXPECT_FALSE(message.has_result()) << "the optimization ended before it was interrupted";
+      if (message.has_progress() && message.progress().detail().starts_with("outer ")) {
+        passed = true;
+      }
+      if (message.has_iteration()) {
+        iterations.push_back(message.iteration());
+        if (passed) break;
+      }
+    }
+    context.TryCancel();
+    while (reader->Read(&message)) {
+    }
+    EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+    EXPECT_TRUE(passed);
+    // The handler notices the cancel within an iteration (and writes no checkpoint after it).
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    return iterations;
+  }
+
+  v1::Session Get(const std::string& id) {
+    grpc::ClientContext context;
+    v1::GetSessionRequest request;
+    request.set_session_id(id);
+    v1::GetSessionResponse response;
+    EXPECT_TRUE(stub_->GetSession(&context, request, &response).ok());
+    return response.session();
+  }
+
+  static void ExpectSameOptimization(const OptimizeRun& got, const OptimizeRun& want) {
+    EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(got.result.multimesh(),
+                                                                   want.result.multimesh()));
+    EXPECT_EQ(got.result.inner_iterations(), want.result.inner_iterations());
+    EXPECT_EQ(got.result.outer_iterations(), want.result.outer_iterations());
+    EXPECT_EQ(got.result.stats().map_energy(), want.result.stats().map_energy());
+    EXPECT_EQ(got.result.stats().mesh_energy(), want.result.stats().mesh_energy());
+  }
+};
+
+TEST_F(OptimizeResumeTest, ResumeContinuesFromTheStoredCheckpointWithTheSameResult) {
+  const v1::Session reference_session = Built();
+  const OptimizeRun reference = Optimize(Request(reference_session, false));
+  ASSERT_TRUE(reference.status.ok()) << reference.status.error_message();
+  ASSERT_GE(reference.result.outer_iterations(), 2u) << "needs a pass after the checkpoint";
+
+  const v1::Session session = Built();
+  const std::vector<v1::ComeshIteration> before = Interrupt(Request(session, false));
+  ASSERT_FALSE(before.empty());
+  // The checkpoint write moved the version on; the session is otherwise unchanged.
+  const v1::Session interrupted = Get(session.id());
+  EXPECT_EQ(interrupted.version(), session.version() + 1);
+  EXPECT_EQ(interrupted.stage(), v1::STAGE_MULTIMESH);
+  // Without resume the request's version is stale.
+  EXPECT_EQ(Optimize(Request(session, false)).status.error_code(), grpc::StatusCode::ABORTED);
+
+  // The same request with resume: continues after pass 1, numbering on.
+  const OptimizeRun resumed = Optimize(Request(session, true));
+  ASSERT_TRUE(resumed.status.ok()) << resumed.status.error_message();
+  EXPECT_EQ(resumed.result.resumed_outer(), 1u);
+  EXPECT_GT(resumed.result.resumed_inner(), 0u);
+  ASSERT_FALSE(resumed.iterations.empty());
+  EXPECT_EQ(resumed.iterations.front().inner(), resumed.result.resumed_inner() + 1);
+  EXPECT_EQ(resumed.iterations.front().outer(), 1u);
+  EXPECT_LT(resumed.result.resumed_inner(), before.back().inner());
+  ASSERT_FALSE(resumed.progress.empty());
+  EXPECT_THAT(resumed.progress.front().detail(), HasSubstr("resumed after outer 1 at iteration"));
+  ExpectSameOptimization(resumed, reference);
+  // The iterations after the checkpoint equal the uninterrupted run's.
+  ASSERT_EQ(resumed.iterations.size() + resumed.result.resumed_inner(),
+            reference.iterations.size());
+  for (const v1::ComeshIteration& it : resumed.iterations) {
+    EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(
+        it, reference.iterations[it.inner() - 1]))
+        << "iteration " << it.inner();
+  }
+  EXPECT_EQ(resumed.result.session().version(),
+            interrupted.version() + (reference.result.outer_iterations() - 1) + 1);
+  EXPECT_EQ(resumed.result.session().stage(), v1::STAGE_OPTIMIZED);
+  // The checkpoint is gone with the result: resuming again is a stale version.
+  EXPECT_EQ(Optimize(Request(session, true)).status.error_code(), grpc::StatusCode::ABORTED);
+  auto stored = server_->store().Get(session.id());
+  ASSERT_TRUE(stored.ok());
+  EXPECT_EQ(stored->comesh_checkpoint, nullptr);
+}
+
+TEST_F(OptimizeResumeTest, ResumeWithoutACheckpointStartsOver) {
+  const v1::Session reference_session = Built();
+  const OptimizeRun reference = Optimize(Request(reference_session, false));
+  ASSERT_TRUE(reference.status.ok()) << reference.status.error_message();
+
+  const v1::Session session = Built();
+  const OptimizeRun run = Optimize(Request(session, true));
+  ASSERT_TRUE(run.status.ok()) << run.status.error_message();
+  EXPECT_EQ(run.result.resumed_outer(), 0u);
+  EXPECT_EQ(run.result.resumed_inner(), 0u);
+  ASSERT_FALSE(run.iterations.empty());
+  EXPECT_EQ(run.iterations.front().inner(), 1u);
+  for (const v1::Progress& p : run.progress) EXPECT_THAT(p.detail(), Not(HasSubstr("resumed")));
+  ExpectSameOptimization(run, reference);
+}
+
+TEST_F(OptimizeResumeTest, CheckpointOfAnotherVersionOrOtherParametersIsIgnored) {
+  const v1::Session reference_session = Built();
+  const OptimizeRun reference = Optimize(Request(reference_session, false));
+  ASSERT_TRUE(reference.status.ok()) << reference.status.error_message();
+
+  const v1::Session session = Built();
+  Interrupt(Request(session, false));
+  auto stored = server_->store().Get(session.id());
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  ASSERT_NE(stored->comesh_checkpoint, nullptr);
+  EXPECT_EQ(stored->comesh_checkpoint->input_version, session.version());
+  EXPECT_EQ(stored->comesh_checkpoint->stored_version, stored->session.version());
+  EXPECT_EQ(stored->comesh_checkpoint->checkpoint.outer, 1);
+
+  // Other comesh parameters: the checkpoint is not this run's, so the run starts over.
+  {
+    v1::Session other_parameters = Built();
+    Interrupt(Request(other_parameters, false));
+    v1::OptimizeComeshRequest request = Request(other_parameters, true);
+    request.mutable_comesh()->set_max_inner_iterations(199);
+    const OptimizeRun run = Optimize(request);
+    ASSERT_TRUE(run.status.ok()) << run.status.error_message();
+    EXPECT_EQ(run.result.resumed_outer(), 0u);
+    ASSERT_FALSE(run.iterations.empty());
+    EXPECT_EQ(run.iterations.front().inner(), 1u);
+  }
+
+  // Another write to the session (here: the same state written again, checkpoint and all, as
+  // a writer that does not know about checkpoints would): the interrupted run's request is now
+  // stale, resume or not.
+  auto rewritten = server_->store().Put(*stored, stored->session.version());
+  ASSERT_TRUE(rewritten.ok()) << rewritten.status();
+  ASSERT_NE(rewritten->comesh_checkpoint, nullptr);
+  EXPECT_EQ(Optimize(Request(session, true)).status.error_code(), grpc::StatusCode::ABORTED);
+
+  // A checkpoint current with the session but of a run that started from another (older)
+  // version, i.e. from another multimesh: a request at the current version ignores it.
+  SessionState next = *rewritten;
+  auto older = std::make_shared<StoredComeshCheckpoint>(*rewritten->comesh_checkpoint);
+  older->stored_version = rewritten->session.version() + 1;
+  next.comesh_checkpoint = older;
+  auto current = server_->store().Put(next, rewritten->session.version());
+  ASSERT_TRUE(current.ok()) << current.status();
+  ASSERT_EQ(current->session.version(), older->stored_version);
+  const OptimizeRun run = Optimize(Request(current->session, true));
+  ASSERT_TRUE(run.status.ok()) << run.status.error_message();
+  EXPECT_EQ(run.result.resumed_outer(), 0u);
+  ASSERT_FALSE(run.iterations.empty());
+  EXPECT_EQ(run.iterations.front().inner(), 1u);
+  ExpectSameOptimization(run, reference);
+}
+
+TEST_F(OptimizeResumeTest, RebuildingDropsTheCheckpoint) {
+  const v1::Session session = Built();
+  Interrupt(Request(session, false));
+  const v1::Session interrupted = Get(session.id());
+  grpc::Status status;
+  v1::BuildMultimeshResult rebuilt = Build(interrupted, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  auto stored = server_->store().Get(session.id());
+  ASSERT_TRUE(stored.ok());
+  EXPECT_EQ(stored->comesh_checkpoint, nullptr);
+  EXPECT_EQ(Optimize(Request(session, true)).status.error_code(), grpc::StatusCode::ABORTED);
 }
 
 }  // namespace
