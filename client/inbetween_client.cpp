@@ -65,7 +65,8 @@ void InbetweenClient::CancelInFlight() {
 }
 
 grpc::Status InbetweenClient::PrepareRetry(const std::string& method, int failed_attempt,
-                                           const grpc::Status& status, uint32_t resume_frame) {
+                                           const grpc::Status& status, uint32_t resume_frame,
+                                           uint32_t last_iteration) {
   const RetryOptions& retry = options_.retry;
   if (!IsTransient(status) || failed_attempt >= retry.max_attempts) return status;
   const double ms =
@@ -77,7 +78,8 @@ grpc::Status InbetweenClient::PrepareRetry(const std::string& method, int failed
                                  .failed_attempt = failed_attempt,
                                  .status = FromGrpcStatus(status),
                                  .backoff = backoff,
-                                 .resume_frame = resume_frame});
+                                 .resume_frame = resume_frame,
+                                 .last_iteration = last_iteration});
   }
   std::unique_lock<std::mutex> lock(mu_);
   if (cancel_cv_.wait_for(lock, backoff, [this] { return cancelled_; })) {
@@ -192,23 +194,36 @@ absl::StatusOr<v1::BuildMultimeshResult> InbetweenClient::BuildMultimesh(
 
 absl::StatusOr<v1::OptimizeComeshResult> InbetweenClient::OptimizeComesh(
     const v1::Session& session, const std::function<void(const v1::ComeshIteration&)>& on_iter,
-    const ProgressCallback& progress) {
-  Call call(this, session.id());
+    const ProgressCallback& progress, const v1::ComeshParameters* comesh) {
   v1::OptimizeComeshRequest request;
   request.set_session_id(session.id());
+  // Every attempt names the version the first one started from: the server accepts it while
+  // the session changed only by this optimization's own checkpoints.
   request.set_expected_version(session.version());
-  auto reader = stub_->OptimizeComesh(&call.context, request);
-  v1::OptimizeComeshResponse response;
-  std::optional<v1::OptimizeComeshResult> result;
-  while (reader->Read(&response)) {
-    if (response.has_iteration() && on_iter) on_iter(response.iteration());
-    if (response.has_progress() && progress) progress(response.progress());
-    if (response.has_result()) result = std::move(*response.mutable_result());
+  if (comesh != nullptr) *request.mutable_comesh() = *comesh;
+  uint32_t last_iteration = 0;  // iterations up to this one reached on_iter already
+  for (int attempt = 1;; ++attempt) {
+    request.set_resume(attempt > 1);
+    Call call(this, session.id());
+    auto reader = stub_->OptimizeComesh(&call.context, request);
+    v1::OptimizeComeshResponse response;
+    std::optional<v1::OptimizeComeshResult> result;
+    while (reader->Read(&response)) {
+      if (response.has_iteration() && response.iteration().inner() > last_iteration) {
+        last_iteration = response.iteration().inner();
+        if (on_iter) on_iter(response.iteration());
+      }
+      if (response.has_progress() && progress) progress(response.progress());
+      if (response.has_result()) result = std::move(*response.mutable_result());
+    }
+    grpc::Status status = reader->Finish();
+    // The result is the last message, sent after the session was written: done even if the
+    // connection broke after it.
+    if (result) return *std::move(result);
+    if (status.ok()) return absl::InternalError("OptimizeComesh stream ended without a result");
+    grpc::Status retry = PrepareRetry("OptimizeComesh", attempt, status, 0, last_iteration);
+    if (!retry.ok()) return FromGrpcStatus(retry);
   }
-  grpc::Status status = reader->Finish();
-  if (!status.ok()) return FromGrpcStatus(status);
-  if (!result) return absl::InternalError("OptimizeComesh stream ended without a result");
-  return *std::move(result);
 }
 
 absl::StatusOr<FramesResult> InbetweenClient::Inbetween(

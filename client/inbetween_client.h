@@ -4,8 +4,10 @@
 // Failover (docs/scale-out.md): behind a proxy in front of replicas, a replica may die in the
 // middle of a call. `Inbetween` then resumes on another replica from the next frame not yet
 // received (`start_frame`; the solver is deterministic, so the frames equal an uninterrupted
-// run), and the read-only unary calls (GetSession, ListSessions) are sent again; both with
-// exponential backoff and a bounded number of attempts (RetryOptions).
+// run), `OptimizeComesh` is sent again with `resume` (the server continues from the checkpoint
+// it stored after the last topology pass; the result equals an uninterrupted run's), and the
+// read-only unary calls (GetSession, ListSessions) are sent again; all with exponential backoff
+// and a bounded number of attempts (RetryOptions).
 #pragma once
 
 #include <grpcpp/grpcpp.h>
@@ -50,6 +52,7 @@ struct RetryEvent {
   absl::Status status;                // why it failed
   std::chrono::milliseconds backoff;  // wait before the next attempt
   uint32_t resume_frame = 0;          // Inbetween: start_frame of the next attempt
+  uint32_t last_iteration = 0;        // OptimizeComesh: the last iteration received
 };
 
 struct ClientOptions {
@@ -78,9 +81,14 @@ class InbetweenClient {
   absl::StatusOr<v1::Session> SetCorrespondences(const v1::SetCorrespondencesRequest& request);
   absl::StatusOr<v1::BuildMultimeshResult> BuildMultimesh(const v1::Session& session,
                                                           const ProgressCallback& progress);
+  // Optimizes at `session.version()` with the session's comesh parameters, or `comesh` when
+  // given. A transient failure sends the request again with `resume` (same expected_version);
+  // `on_iter` sees each iteration once, in order (a resumed run numbers on from its checkpoint,
+  // and iterations received before the failure are not repeated); `progress` sees every
+  // Progress message, the server's "resumed after outer N at iteration I" included.
   absl::StatusOr<v1::OptimizeComeshResult> OptimizeComesh(
       const v1::Session& session, const std::function<void(const v1::ComeshIteration&)>& on_iter,
-      const ProgressCallback& progress);
+      const ProgressCallback& progress, const v1::ComeshParameters* comesh = nullptr);
   // Streams all frames; `on_frame` (optional) sees each frame as it arrives, once, in order.
   // A transient failure resumes at the next frame; a resumed stream computed from another
   // session version (the session changed meanwhile) is ABORTED.
@@ -104,7 +112,8 @@ class InbetweenClient {
   // else what the call returns: `status` itself when it is not transient or the attempts are
   // used up, CANCELLED when CancelInFlight() came during the wait.
   grpc::Status PrepareRetry(const std::string& method, int failed_attempt,
-                            const grpc::Status& status, uint32_t resume_frame = 0);
+                            const grpc::Status& status, uint32_t resume_frame = 0,
+                            uint32_t last_iteration = 0);
 
   std::unique_ptr<v1::Inbetween::Stub> stub_;
   ClientOptions options_;

@@ -1,7 +1,8 @@
 // Tests InbetweenClient's failover (client/inbetween_client.cpp): a fake front service forwards
 // calls to a real in-process InbetweenServer and breaks them as scripted (a replica dying
 // mid-stream behind a proxy). The client must resume Inbetween at the next frame not received,
-// deliver exactly the frames of an uninterrupted run, retry GetSession/ListSessions, stop after
+// deliver exactly the frames of an uninterrupted run, resume OptimizeComesh from the server's
+// checkpoint with the result of an uninterrupted run, retry GetSession/ListSessions, stop after
 // the attempts run out, never retry a non-transient error, and refuse to splice frames of two
 // session versions.
 #include "client/inbetween_client.h"
@@ -11,6 +12,7 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <deque>
 #include <fstream>
 #include <memory>
@@ -28,7 +30,8 @@ using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
 // How the front breaks one call: forward `after_frames` frames (Inbetween; the header always
-// goes through), then end the call with `status` instead of the rest.
+// goes through) or iterations (OptimizeComesh), then end the call with `status` instead of the
+// rest.
 struct Fault {
   grpc::Status status;
   int after_frames = 0;
@@ -38,7 +41,8 @@ const grpc::Status kUnavailable(grpc::StatusCode::UNAVAILABLE, "Socket closed");
 // What gRPC reports when nginx resets a stream whose replica died.
 const grpc::Status kProxyReset(grpc::StatusCode::INTERNAL, "Received RST_STREAM with error code 2");
 
-// Forwards GetSession, ListSessions and Inbetween to `backend`, failing calls per `faults`
+// Forwards GetSession, ListSessions, Inbetween and OptimizeComesh to `backend`, failing calls
+// per `faults`
 // (consumed in call order, shared by all methods) and recording what the client sent.
 class FlakyFront final : public v1::Inbetween::Service {
  public:
@@ -46,8 +50,10 @@ class FlakyFront final : public v1::Inbetween::Service {
       : backend_(v1::Inbetween::NewStub(std::move(backend))) {}
 
   std::deque<Fault> faults;
-  std::vector<uint32_t> start_frames;    // of every Inbetween call
-  std::vector<std::string> session_ids;  // x-session-id of every call ("" when absent)
+  std::vector<uint32_t> start_frames;       // of every Inbetween call
+  std::vector<bool> resumes;                // `resume` of every OptimizeComesh call
+  std::vector<uint64_t> expected_versions;  // of every OptimizeComesh call
+  std::vector<std::string> session_ids;     // x-session-id of every call ("" when absent)
   int unary_calls = 0;
 
   grpc::Status GetSession(grpc::ServerContext* context, const v1::GetSessionRequest* request,
@@ -80,6 +86,29 @@ class FlakyFront final : public v1::Inbetween::Service {
     while (reader->Read(&response)) {
       if (response.has_frame() && fault && frames++ == fault->after_frames) {
         upstream.TryCancel();
+        reader->Finish();
+        return fault->status;
+      }
+      writer->Write(response);
+    }
+    grpc::Status status = reader->Finish();
+    return fault && status.ok() ? fault->status : status;
+  }
+
+  grpc::Status OptimizeComesh(grpc::ServerContext* context,
+                              const v1::OptimizeComeshRequest* request,
+                              grpc::ServerWriter<v1::OptimizeComeshResponse>* writer) override {
+    Record(*context);
+    resumes.push_back(request->resume());
+    expected_versions.push_back(request->expected_version());
+    std::optional<Fault> fault = NextFault();
+    grpc::ClientContext upstream;
+    auto reader = backend_->OptimizeComesh(&upstream, *request);
+    v1::OptimizeComeshResponse response;
+    int iterations = 0;
+    while (reader->Read(&response)) {
+      if (response.has_iteration() && fault && iterations++ == fault->after_frames) {
+        upstream.TryCancel();  // the replica is gone: its run stops
         reader->Finish();
         return fault->status;
       }
@@ -128,22 +157,8 @@ class InbetweenClientFailoverTest : public ::testing::Test {
     direct_ = std::make_unique<InbetweenClient>(backend_->InProcessChannel());
 
     // A built square -> hexagon session on the real server.
-    auto session = direct_->CreateSession("failover");
-    ASSERT_TRUE(session.ok()) << session.status();
-    for (const char* name : {"square", "hexagon"}) {
-      v1::PutDrawingRequest request;
-      request.set_session_id(session->id());
-      request.set_expected_version(session->version());
-      request.mutable_drawing()->set_name(name);
-      request.mutable_drawing()->set_svg(
-          ReadExample(std::string("examples/square_hexagon/") + name + ".svg"));
-      auto put = direct_->PutDrawing(request);
-      ASSERT_TRUE(put.ok()) << put.status();
-      *session = put->session();
-    }
-    auto built = direct_->BuildMultimesh(*session, nullptr);
-    ASSERT_TRUE(built.ok()) << built.status();
-    session_ = built->session();
+    session_ = BuiltSession("failover");
+    ASSERT_FALSE(session_.id().empty());
     parameters_.set_frames(40);
     parameters_.set_method(v1::METHOD_ZHU17);
 
@@ -156,6 +171,28 @@ class InbetweenClientFailoverTest : public ::testing::Test {
 
   void TearDown() override {
     if (front_server_) front_server_->Shutdown();
+  }
+
+  // A new square -> hexagon session on the real server, built.
+  v1::Session BuiltSession(const std::string& name) {
+    auto session = direct_->CreateSession(name);
+    EXPECT_TRUE(session.ok()) << session.status();
+    if (!session.ok()) return {};
+    for (const char* drawing : {"square", "hexagon"}) {
+      v1::PutDrawingRequest request;
+      request.set_session_id(session->id());
+      request.set_expected_version(session->version());
+      request.mutable_drawing()->set_name(drawing);
+      request.mutable_drawing()->set_svg(
+          ReadExample(std::string("examples/square_hexagon/") + drawing + ".svg"));
+      auto put = direct_->PutDrawing(request);
+      EXPECT_TRUE(put.ok()) << put.status();
+      if (!put.ok()) return {};
+      *session = put->session();
+    }
+    auto built = direct_->BuildMultimesh(*session, nullptr);
+    EXPECT_TRUE(built.ok()) << built.status();
+    return built.ok() ? built->session() : v1::Session();
   }
 
   // A client through the flaky front; backoff of 1, 2, 4 ... ms so the test stays short.
@@ -287,6 +324,101 @@ TEST_F(InbetweenClientFailoverTest, GetSessionAndListSessionsAreRetried) {
   EXPECT_EQ(client->GetSession("nope", false).status().code(), absl::StatusCode::kNotFound);
   EXPECT_EQ(front_->unary_calls, 6);
   EXPECT_EQ(retries_.size(), 3u);
+}
+
+// Bounded so that the test stays short but makes several topology passes.
+v1::ComeshParameters ShortComesh() {
+  v1::ComeshParameters comesh;
+  comesh.set_max_outer_iterations(8);
+  comesh.set_max_inner_iterations(200);
+  return comesh;
+}
+
+TEST_F(InbetweenClientFailoverTest, ResumedOptimizationGivesTheMultimeshOfAnUninterruptedRun) {
+  // The reference: the same drawings, built and optimized without failures.
+  const v1::Session reference_session = BuiltSession("reference");
+  const v1::ComeshParameters comesh = ShortComesh();
+  std::vector<v1::ComeshIteration> reference_iterations;
+  auto reference = direct_->OptimizeComesh(
+      reference_session, [&](const v1::ComeshIteration& it) { reference_iterations.push_back(it); },
+      nullptr, &comesh);
+  ASSERT_TRUE(reference.ok()) << reference.status();
+  ASSERT_GE(reference->outer_iterations(), 3u);
+  // Break the stream 3 iterations after the first topology pass (its checkpoint is stored by
+  // then), and the resumed stream after its first iteration.
+  int first_after_pass = -1;
+  for (size_t i = 0; i < reference_iterations.size() && first_after_pass < 0; ++i) {
+    if (reference_iterations[i].outer() == 1) first_after_pass = static_cast<int>(i);
+  }
+  ASSERT_GT(first_after_pass, 0);
+  ASSERT_GE(std::count_if(reference_iterations.begin(), reference_iterations.end(),
+                          [](const v1::ComeshIteration& it) { return it.outer() == 1; }),
+            5)
+      << "the break must come before pass 2";
+  front_->faults = {{kUnavailable, first_after_pass + 3}, {kProxyReset, 1}};
+
+  // A backoff long enough for the broken run's handler to notice it was cancelled.
+  ClientOptions options;
+  options.retry.initial_backoff = std::chrono::milliseconds(100);
+  options.on_retry = [this](const RetryEvent& e) { retries_.push_back(e); };
+  InbetweenClient client(front_server_->InProcessChannel({}), options);
+  std::vector<v1::ComeshIteration> iterations;
+  std::vector<std::string> progress;
+  auto optimized = client.OptimizeComesh(
+      session_, [&](const v1::ComeshIteration& it) { iterations.push_back(it); },
+      [&](const v1::Progress& p) { progress.push_back(p.detail()); }, &comesh);
+  ASSERT_TRUE(optimized.ok()) << optimized.status();
+
+  // Sent three times, the retries with resume and the version the first one started from.
+  EXPECT_THAT(front_->resumes, ElementsAre(false, true, true));
+  EXPECT_THAT(front_->expected_versions, Each(session_.version()));
+  EXPECT_THAT(front_->session_ids, Each(session_.id()));
+  ASSERT_EQ(retries_.size(), 2u);
+  EXPECT_EQ(retries_[0].method, "OptimizeComesh");
+  EXPECT_EQ(retries_[0].last_iteration, static_cast<uint32_t>(first_after_pass + 3));
+  EXPECT_EQ(retries_[1].status.code(), absl::StatusCode::kInternal);
+  // The server resumed from a checkpoint (after pass 1: the second attempt wrote none).
+  EXPECT_EQ(optimized->resumed_outer(), 1u);
+  EXPECT_GT(optimized->resumed_inner(), 0u);
+  EXPECT_EQ(optimized->resumed_inner(), static_cast<uint32_t>(first_after_pass));
+  EXPECT_EQ(std::count_if(progress.begin(), progress.end(),
+                          [](const std::string& p) {
+                            return p.starts_with("resumed after outer 1 at iteration");
+                          }),
+            2);
+  // Each iteration reached on_iter once, in order, equal to the uninterrupted run's.
+  ASSERT_EQ(iterations.size(), reference_iterations.size());
+  for (size_t i = 0; i < iterations.size(); ++i) {
+    EXPECT_TRUE(
+        google::protobuf::util::MessageDifferencer::Equals(iterations[i], reference_iterations[i]))
+        << "iteration " << i + 1;
+  }
+  EXPECT_EQ(optimized->inner_iterations(), reference->inner_iterations());
+  EXPECT_EQ(optimized->outer_iterations(), reference->outer_iterations());
+
+  // The stored multimesh, fetched after, is the uninterrupted run's, bit for bit.
+  auto stored = direct_->GetSession(session_.id(), /*full=*/true);
+  auto reference_stored = direct_->GetSession(reference_session.id(), /*full=*/true);
+  ASSERT_TRUE(stored.ok() && reference_stored.ok());
+  EXPECT_EQ(stored->session().stage(), v1::STAGE_OPTIMIZED);
+  EXPECT_EQ(stored->session().version(), optimized->session().version());
+  ASSERT_GT(stored->multimesh().shapes_size(), 0);
+  EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(stored->multimesh(),
+                                                                 reference_stored->multimesh()));
+  EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(optimized->multimesh(),
+                                                                 reference->multimesh()));
+  EXPECT_EQ(stored->session().multimesh_stats().map_energy(),
+            reference_stored->session().multimesh_stats().map_energy());
+}
+
+TEST_F(InbetweenClientFailoverTest, OptimizationIsNotRetriedOnANonTransientError) {
+  front_->faults = {{grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, "busy"), 0}};
+  auto client = FrontClient();
+  const v1::ComeshParameters comesh = ShortComesh();
+  auto optimized = client->OptimizeComesh(session_, nullptr, nullptr, &comesh);
+  EXPECT_EQ(optimized.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(front_->resumes, ElementsAre(false));
+  EXPECT_TRUE(retries_.empty());
 }
 
 }  // namespace
