@@ -1,9 +1,11 @@
-// inbetween-loadgen's engine: N virtual studios, each a thread running the animator's loop over
-// the C++ client library (create a session, upload drawings, build, optimize, stream frames,
+// inbetween-loadgen's engine: N virtual studios, each a state machine on the gRPC callback API
+// running the animator's loop (create a session, upload drawings, build, optimize, stream frames,
 // read it back, edit a drawing, list sessions, delete it) against one target until a duration or a
 // total request count is reached; per-RPC latencies and errors by status code, then a check that
-// every session created is still there. Streams go through the library's failover (resumed after a
-// replica dies), so an Inbetween latency includes its retries.
+// every session created is still there. The studios share gRPC's callback threads and one timer
+// thread, however many there are. Streams fail over like the client library's (Inbetween resumed
+// at the next frame after a replica dies; GetSession/ListSessions sent again), so an Inbetween
+// latency includes its retries.
 #pragma once
 
 #include <grpcpp/grpcpp.h>
@@ -21,7 +23,7 @@
 namespace inbetween::loadgen {
 
 struct LoadGenOptions {
-  int studios = 4;                         // concurrent virtual studios (threads)
+  int studios = 4;                         // concurrent virtual studios
   std::chrono::seconds duration{30};       // stop starting RPCs after this long
   int64_t max_requests = 1000;             // stop after this many RPCs in total (all studios)
   std::vector<std::string> drawings_svg;   // the key drawings every studio uploads (>= 2)
@@ -46,11 +48,12 @@ struct LoadReport {
   std::map<std::string, int64_t> errors_by_code;  // "UNAVAILABLE" -> count
   std::map<std::string, RpcSummary> rpcs;         // "Inbetween" -> summary
   double unary_p99_ms = 0;                        // over every successful unary call
-  int64_t retries = 0;                            // retries made by the client library
+  int64_t retries = 0;                            // failover retries (the library's rules)
   int64_t sessions = 0;                           // sessions created
   int64_t lost_sessions = 0;                      // created, not deleted, then NOT_FOUND
   int64_t streams_completed = 0;                  // Inbetween streams with every frame
   bool frames_identical = true;                   // every completed stream gave the same frames
+  int64_t peak_in_flight = 0;                     // most calls outstanding at once
 };
 
 // Targets must be loopback addresses (127.0.0.0/8, ::1, localhost) with a port.

@@ -1,15 +1,30 @@
 // Tests inbetween-loadgen's engine (tools/loadgen/load_generator.cpp): loopback-only targets,
-// nearest-rank percentiles, and a bounded run against a real in-process server that stops at
+// nearest-rank percentiles, a bounded run against a real in-process server that stops at
 // exactly the request budget, exercises every RPC of the studio loop without errors, loses no
-// session and gets the same frames from every stream.
+// session and gets the same frames from every stream, the failover of the client library (through
+// a front that breaks Inbetween streams and a GetSession as a dying replica behind a proxy would:
+// resumed at the next frame, frames identical, x-session-id on every call), and 64 studios against
+// a real inbetween-server process running on far fewer than 64 threads of this process (the
+// callback API), with the same guarantees.
 #include "tools/loadgen/load_generator.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <atomic>
+#include <cstdio>
+#include <deque>
 #include <fstream>
+#include <mutex>
+#include <regex>
 #include <sstream>
+#include <thread>
 
+#include "absl/status/statusor.h"
 #include "nlohmann/json.hpp"
 #include "server/inbetween_server.h"
 
@@ -24,6 +39,180 @@ std::string ReadExample(const std::string& relative) {
   text << in.rdbuf();
   return text.str();
 }
+
+// Forwards every call of the studio loop to `backend`, recording each call's x-session-id against
+// its request's session id and breaking calls as scripted: the Inbetween streams in `faults`
+// (forward `after_frames` frames, then end with `status`), and `get_session_faults` GetSessions.
+class FlakyFront final : public v1::Inbetween::Service {
+ public:
+  struct Fault {
+    grpc::Status status;
+    int after_frames = 0;
+  };
+  explicit FlakyFront(std::shared_ptr<grpc::Channel> backend)
+      : backend_(v1::Inbetween::NewStub(std::move(backend))) {}
+
+  std::mutex mu;  // guards the fields below
+  std::deque<Fault> faults;
+  int get_session_faults = 0;
+  std::vector<uint32_t> start_frames;           // of every Inbetween call
+  std::vector<std::string> missing_session_id;  // methods called without the right x-session-id
+
+  grpc::Status CreateSession(grpc::ServerContext* c, const v1::CreateSessionRequest* q,
+                             v1::CreateSessionResponse* r) override {
+    return Forward(c, *q, r, &v1::Inbetween::Stub::CreateSession);
+  }
+  grpc::Status PutDrawing(grpc::ServerContext* c, const v1::PutDrawingRequest* q,
+                          v1::PutDrawingResponse* r) override {
+    return Forward(c, *q, r, &v1::Inbetween::Stub::PutDrawing);
+  }
+  grpc::Status GetSession(grpc::ServerContext* c, const v1::GetSessionRequest* q,
+                          v1::GetSessionResponse* r) override {
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      if (get_session_faults > 0) {
+        --get_session_faults;
+        return grpc::Status(grpc::StatusCode::UNAVAILABLE, "Socket closed");
+      }
+    }
+    return Forward(c, *q, r, &v1::Inbetween::Stub::GetSession);
+  }
+  grpc::Status ListSessions(grpc::ServerContext* c, const v1::ListSessionsRequest* q,
+                            v1::ListSessionsResponse* r) override {
+    return Forward(c, *q, r, &v1::Inbetween::Stub::ListSessions);
+  }
+  grpc::Status DeleteSession(grpc::ServerContext* c, const v1::DeleteSessionRequest* q,
+                             v1::DeleteSessionResponse* r) override {
+    return Forward(c, *q, r, &v1::Inbetween::Stub::DeleteSession);
+  }
+  grpc::Status BuildMultimesh(grpc::ServerContext* c, const v1::BuildMultimeshRequest* q,
+                              grpc::ServerWriter<v1::BuildMultimeshResponse>* w) override {
+    return ForwardStream(c, *q, w, &v1::Inbetween::Stub::BuildMultimesh);
+  }
+  grpc::Status OptimizeComesh(grpc::ServerContext* c, const v1::OptimizeComeshRequest* q,
+                              grpc::ServerWriter<v1::OptimizeComeshResponse>* w) override {
+    return ForwardStream(c, *q, w, &v1::Inbetween::Stub::OptimizeComesh);
+  }
+  grpc::Status Inbetween(grpc::ServerContext* c, const v1::InbetweenRequest* q,
+                         grpc::ServerWriter<v1::InbetweenResponse>* w) override {
+    std::optional<Fault> fault;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      start_frames.push_back(q->start_frame());
+      if (!faults.empty()) {
+        fault = faults.front();
+        faults.pop_front();
+      }
+    }
+    if (!fault) return ForwardStream(c, *q, w, &v1::Inbetween::Stub::Inbetween);
+    CheckSessionId(*c, q->session_id(), "Inbetween");
+    grpc::ClientContext upstream;
+    auto reader = backend_->Inbetween(&upstream, *q);
+    v1::InbetweenResponse response;
+    int frames = 0;
+    while (reader->Read(&response)) {
+      if (response.has_frame() && frames++ == fault->after_frames) break;
+      w->Write(response);
+    }
+    upstream.TryCancel();  // the replica is gone
+    reader->Finish();
+    return fault->status;
+  }
+
+ private:
+  template <class Request>
+  static std::string SessionOf(const Request& request) {
+    if constexpr (requires { request.session_id(); }) {
+      return request.session_id();
+    } else {
+      return "";
+    }
+  }
+  void CheckSessionId(const grpc::ServerContext& context, const std::string& want,
+                      const std::string& method) {
+    auto it = context.client_metadata().find("x-session-id");
+    const std::string got = it == context.client_metadata().end()
+                                ? std::string()
+                                : std::string(it->second.data(), it->second.size());
+    std::lock_guard<std::mutex> lock(mu);
+    if (got != want) missing_session_id.push_back(method);
+  }
+  template <class Request, class Response, class Method>
+  grpc::Status Forward(grpc::ServerContext* context, const Request& request, Response* response,
+                       Method method) {
+    CheckSessionId(*context, SessionOf(request), Request::descriptor()->name());
+    grpc::ClientContext upstream;
+    return ((*backend_).*method)(&upstream, request, response);
+  }
+  template <class Request, class Response, class Method>
+  grpc::Status ForwardStream(grpc::ServerContext* context, const Request& request,
+                             grpc::ServerWriter<Response>* writer, Method method) {
+    CheckSessionId(*context, SessionOf(request), Request::descriptor()->name());
+    grpc::ClientContext upstream;
+    auto reader = ((*backend_).*method)(&upstream, request);
+    Response response;
+    while (reader->Read(&response)) writer->Write(response);
+    return reader->Finish();
+  }
+
+  std::unique_ptr<v1::Inbetween::Stub> backend_;
+};
+
+// Threads of this process, from /proc/self/status.
+int ThreadCount() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("Threads:", 0) == 0) return std::stoi(line.substr(8));
+  }
+  return -1;
+}
+
+// inbetween-server as a child process on a free loopback port (its threads are not ours).
+class ServerProcess {
+ public:
+  ~ServerProcess() {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      waitpid(pid_, nullptr, 0);
+    }
+    if (out_ != nullptr) fclose(out_);
+  }
+  // Starts it with `flags`; the address it listens on, or an error.
+  absl::StatusOr<std::string> Start(const std::vector<std::string>& flags) {
+    const std::string bin = std::string(INBETWEEN_BINARY_DIR) + "/server/inbetween-server";
+    std::vector<std::string> args = {bin, "--listen", "127.0.0.1:0"};
+    args.insert(args.end(), flags.begin(), flags.end());
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    int pipe_fds[2];
+    if (pipe(pipe_fds) != 0) return absl::InternalError("pipe failed");
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
+    posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
+    const int rc = posix_spawn(&pid_, bin.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    close(pipe_fds[1]);
+    out_ = fdopen(pipe_fds[0], "r");
+    if (rc != 0) {
+      pid_ = 0;
+      return absl::NotFoundError("cannot run " + bin);
+    }
+    char line[512];
+    const std::regex listening("inbetween-server listening on (127\\.0\\.0\\.1:[0-9]+)");
+    while (fgets(line, sizeof line, out_) != nullptr) {
+      std::cmatch m;
+      if (std::regex_search(line, m, listening)) return m[1].str();
+    }
+    return absl::UnavailableError(bin + " exited without listening");
+  }
+
+ private:
+  pid_t pid_ = 0;
+  FILE* out_ = nullptr;
+};
 
 TEST(LoadGeneratorTest, OnlyLoopbackTargets) {
   for (const char* ok : {"127.0.0.1:50051", "127.1.2.3:1", "localhost:8080", "[::1]:443"}) {
@@ -105,6 +294,91 @@ TEST(LoadGeneratorTest, UnreachableTargetIsCountedByCode) {
   EXPECT_EQ(report->errors_by_code["UNAVAILABLE"], 3);
   EXPECT_EQ(report->rpcs["CreateSession"].errors_by_code["UNAVAILABLE"], 3);
   EXPECT_EQ(report->sessions, 0);
+}
+
+TEST(LoadGeneratorTest, StreamsFailOverLikeTheClientLibrary) {
+  auto backend = server::InbetweenServer::Start(server::ServerOptions{});
+  ASSERT_TRUE(backend.ok()) << backend.status();
+  FlakyFront front((*backend)->InProcessChannel());
+  const grpc::Status proxy_reset(grpc::StatusCode::INTERNAL,
+                                 "Received RST_STREAM with error code 2");
+  front.faults = {{grpc::Status(grpc::StatusCode::UNAVAILABLE, "Socket closed"), 5},
+                  {proxy_reset, 3}};
+  front.get_session_faults = 1;
+  grpc::ServerBuilder builder;
+  builder.RegisterService(&front);
+  std::unique_ptr<grpc::Server> front_server = builder.BuildAndStart();
+  ASSERT_NE(front_server, nullptr);
+
+  LoadGenOptions options;
+  options.studios = 1;
+  options.duration = std::chrono::seconds(600);
+  options.max_requests = 20;  // two projects: the first one broken, the second one not
+  options.frames = 12;
+  options.drawings_svg = {ReadExample("examples/square_hexagon/square.svg"),
+                          ReadExample("examples/square_hexagon/hexagon.svg")};
+  auto report = RunLoad(front_server->InProcessChannel({}), options);
+  front_server->Shutdown();
+  ASSERT_TRUE(report.ok()) << report.status();
+  const std::string table = FormatTable(*report);
+
+  EXPECT_EQ(report->requests, 20);
+  EXPECT_EQ(report->errors, 0) << table;
+  EXPECT_EQ(report->retries, 3) << table;            // two stream resumes, one GetSession
+  EXPECT_EQ(report->rpcs.at("Inbetween").calls, 2);  // a stream is one request, retries included
+  EXPECT_EQ(report->streams_completed, 2);
+  EXPECT_TRUE(report->frames_identical);  // resumed frames == uninterrupted ones
+  EXPECT_EQ(report->lost_sessions, 0);
+  EXPECT_EQ(report->sessions, 2);
+  EXPECT_EQ(front.start_frames, (std::vector<uint32_t>{0, 5, 8, 0}));
+  EXPECT_TRUE(front.missing_session_id.empty())
+      << ::testing::PrintToString(front.missing_session_id);
+}
+
+TEST(LoadGeneratorTest, ManyStudiosRunOnFewThreads) {
+  // Heavy calls wait in the server's queue rather than being refused: no back-pressure errors.
+  ServerProcess server;
+  absl::StatusOr<std::string> address =
+      server.Start({"--solver-threads", "1", "--max-heavy-jobs", "2", "--heavy-queue", "200",
+                    "--max-heavy-jobs-per-token", "202", "--log-level", "warn"});
+  ASSERT_TRUE(address.ok()) << address.status();
+  LoadGenOptions options;
+  options.studios = 64;
+  options.duration = std::chrono::seconds(240);  // the request budget ends the run
+  options.max_requests = 64 * 10;                // about one project per studio
+  options.frames = 6;
+  options.drawings_svg = {ReadExample("examples/square_hexagon/square.svg"),
+                          ReadExample("examples/square_hexagon/hexagon.svg")};
+
+  const int before = ThreadCount();
+  std::atomic<bool> stop{false};
+  std::atomic<int> peak_threads{0};
+  std::thread sampler([&] {  // one more thread of ours, counted too
+    while (!stop) {
+      peak_threads = std::max(peak_threads.load(), ThreadCount());
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  });
+  auto report = RunLoad(grpc::CreateChannel(*address, grpc::InsecureChannelCredentials()), options);
+  stop = true;
+  sampler.join();
+  ASSERT_TRUE(report.ok()) << report.status();
+  const std::string table = FormatTable(*report);
+  std::printf("%s threads: %d before the run, at most %d during it\n", table.c_str(), before,
+              peak_threads.load());
+
+  // Every studio had a call outstanding at once, on a handful of threads.
+  EXPECT_GE(report->peak_in_flight, 48) << table;
+  EXPECT_LE(peak_threads.load(), 24) << table;
+  EXPECT_LT(peak_threads.load(), report->peak_in_flight) << table;
+  // And the results hold: the whole budget, no error, no lost session, identical frames.
+  EXPECT_EQ(report->requests, 640);
+  EXPECT_EQ(report->errors, 0) << table;
+  EXPECT_GE(report->sessions, 64) << table;
+  EXPECT_EQ(report->lost_sessions, 0);
+  EXPECT_GT(report->streams_completed, 0) << table;
+  EXPECT_EQ(report->streams_completed, report->rpcs.at("Inbetween").calls);
+  EXPECT_TRUE(report->frames_identical);
 }
 
 }  // namespace
