@@ -118,9 +118,11 @@ absl::Status UploadCorrespondences(const Project& project, const std::vector<std
 }
 
 // Creates a session and uploads the project's drawings (with their cuts and openings) and
-// correspondences. Errors name the drawing.
+// correspondences. Errors name the drawing. `classes` (may be null) receives each drawing's
+// equivalence class as the server imported it.
 absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::string& name,
-                                          const RunContext& ctx) {
+                                          const RunContext& ctx,
+                                          std::vector<v1::EquivalenceClass>* classes = nullptr) {
   auto session = ctx.client->CreateSession(name, project.parameters);
   if (!session.ok()) return Annotate(session.status(), "create session");
   std::vector<std::string> svgs;
@@ -133,6 +135,7 @@ absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::str
     auto put = ctx.client->PutDrawing(DrawingRequest(d, *session, *std::move(svg)));
     if (!put.ok()) return Annotate(put.status(), where);
     *session = put->session();
+    if (classes != nullptr) classes->push_back(put->equivalence_class());
   }
   if (absl::Status s = UploadCorrespondences(project, svgs, ctx, &*session); !s.ok()) return s;
   if (ctx.remote) std::printf("session %s\n", session->id().c_str());
@@ -480,6 +483,42 @@ absl::Status RunRender(const RenderOptions& options, ProgressBar& progress) {
   return absl::OkStatus();
 }
 
+namespace {
+
+std::string ClassText(const v1::EquivalenceClass& c) {
+  return absl::StrCat(c.components(), c.components() == 1 ? " component, " : " components, ",
+                      c.holes(), c.holes() == 1 ? " hole" : " holes");
+}
+
+// The session's state: stage, drawings (with their classes when known), multimesh statistics.
+void PrintSession(const v1::Session& s, const std::vector<v1::EquivalenceClass>& classes) {
+  std::printf("session %s\nversion %llu\nstage %s\n", s.id().c_str(),
+              static_cast<unsigned long long>(s.version()), v1::Stage_Name(s.stage()).c_str());
+  for (int i = 0; i < s.drawings_size(); ++i) {
+    const v1::Drawing& d = s.drawings(i);
+    int outlines = 0, cuts = 0, openings = 0;
+    for (const auto& e : d.elements()) {
+      outlines += e.kind() == v1::ELEMENT_KIND_OUTLINE;
+      cuts += e.kind() == v1::ELEMENT_KIND_CUT;
+      openings += e.kind() == v1::ELEMENT_KIND_OPENING;
+    }
+    const std::string klass =
+        i < static_cast<int>(classes.size()) ? absl::StrCat("; ", ClassText(classes[i])) : "";
+    std::printf("drawing %d (id %u, %s): %d outlines, %d cuts, %d openings%s\n", i + 1, d.id(),
+                d.name().c_str(), outlines, cuts, openings, klass.c_str());
+  }
+  if (s.stage() >= v1::STAGE_MULTIMESH) {
+    const auto& m = s.multimesh_stats();
+    std::printf(
+        "multimesh: %u shapes, %u vertices, %u triangles, map energy %.4f, "
+        "mesh energy %.4f, %u inverted\n",
+        m.shapes(), m.vertices(), m.triangles(), m.map_energy(), m.mesh_energy(),
+        m.inverted_triangles());
+  }
+}
+
+}  // namespace
+
 absl::Status RunInspect(const std::string& session_id, const RunContext& ctx) {
   if (session_id.empty()) {
     auto sessions = ctx.client->ListSessions();
@@ -493,27 +532,23 @@ absl::Status RunInspect(const std::string& session_id, const RunContext& ctx) {
   }
   auto got = ctx.client->GetSession(session_id, /*full=*/true);
   if (!got.ok()) return got.status();
-  const v1::Session& s = got->session();
-  std::printf("session %s\nversion %llu\nstage %s\n", s.id().c_str(),
-              static_cast<unsigned long long>(s.version()), v1::Stage_Name(s.stage()).c_str());
-  for (int i = 0; i < s.drawings_size(); ++i) {
-    const v1::Drawing& d = s.drawings(i);
-    int outlines = 0, cuts = 0, openings = 0;
-    for (const auto& e : d.elements()) {
-      outlines += e.kind() == v1::ELEMENT_KIND_OUTLINE;
-      cuts += e.kind() == v1::ELEMENT_KIND_CUT;
-      openings += e.kind() == v1::ELEMENT_KIND_OPENING;
-    }
-    std::printf("drawing %d (id %u, %s): %d outlines, %d cuts, %d openings\n", i + 1, d.id(),
-                d.name().c_str(), outlines, cuts, openings);
-  }
-  if (s.stage() >= v1::STAGE_MULTIMESH) {
-    const auto& m = s.multimesh_stats();
-    std::printf(
-        "multimesh: %u shapes, %u vertices, %u triangles, map energy %.4f, "
-        "mesh energy %.4f, %u inverted\n",
-        m.shapes(), m.vertices(), m.triangles(), m.map_energy(), m.mesh_energy(),
-        m.inverted_triangles());
+  PrintSession(got->session(), {});
+  return absl::OkStatus();
+}
+
+absl::Status RunInspectProject(const Inputs& inputs, const RunContext& ctx) {
+  absl::StatusOr<Project> project = ResolveProject(inputs);
+  if (!project.ok()) return project.status();
+  std::vector<v1::EquivalenceClass> classes;
+  auto session = UploadProject(*project, "inbetween inspect", ctx, &classes);
+  if (!session.ok()) return session.status();
+  // The multimesh's numbers (vertex counts, energies) come from building it; drawings whose
+  // classes differ are printed with their classes and the build's reason.
+  auto built = ctx.client->BuildMultimesh(*session, nullptr);
+  if (built.ok()) *session = built->session();
+  PrintSession(*session, classes);
+  if (!built.ok()) {
+    std::printf("multimesh: not built: %s\n", std::string(built.status().message()).c_str());
   }
   return absl::OkStatus();
 }

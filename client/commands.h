@@ -88,6 +88,11 @@ absl::Status RunRender(const RenderOptions& options, ProgressBar& progress);
 // With an id: that session's state. Without: every session of the caller, one per line.
 absl::Status RunInspect(const std::string& session_id, const RunContext& ctx);
 
+// A project's state without keeping a session: its drawings uploaded (embedded, or to --server,
+// which keeps the session and prints its id), each drawing's equivalence class, and the
+// multimesh built from them (vertex counts, energies) or why it cannot be.
+absl::Status RunInspectProject(const Inputs& inputs, const RunContext& ctx);
+
 // Checks the project file and every drawing and reports every problem at once (stdout, one per
 // line); fails with INVALID_ARGUMENT carrying the count when there is any.
 absl::Status RunValidate(const Inputs& inputs, const RunContext& ctx);

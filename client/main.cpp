@@ -228,9 +228,16 @@ int main(int argc, char** argv) {
   CLI::App* inspect_cmd =
       app.add_subcommand("inspect", "Show a session's state, or list your sessions");
   inspect_cmd->add_option("session", inspect_id, "Session id (omit to list every session)");
+  inbetween::client::Inputs inspect_project;
+  inspect_cmd
+      ->add_option("--project", inspect_project.project,
+                   "Inspect a project file instead: classes, multimesh size and energies")
+      ->check(CLI::ExistingFile)
+      ->excludes(inspect_cmd->get_option("session"));
   inspect_cmd->footer(
       "Examples:\n  inbetween --server 127.0.0.1:50051 inspect\n"
-      "  inbetween --server 127.0.0.1:50051 inspect 4f2a9c...");
+      "  inbetween --server 127.0.0.1:50051 inspect 4f2a9c...\n"
+      "  inbetween inspect --project walk.json");
 
   // validate
   inbetween::client::Inputs validate;
@@ -342,7 +349,9 @@ int main(int argc, char** argv) {
   } else if (*optimize_cmd) {
     status = inbetween::client::RunMesh(optimize, ctx);
   } else if (*inspect_cmd) {
-    if (inspect_id.empty() && server.empty()) {
+    if (!inspect_project.project.empty()) {
+      status = inbetween::client::RunInspectProject(inspect_project, ctx);
+    } else if (inspect_id.empty() && server.empty()) {
       status = absl::InvalidArgumentError(
           "inspect without a session id lists a server's sessions: give --server HOST:PORT");
     } else {

@@ -72,4 +72,15 @@ if "$CLI_BIN" validate --project cutproj/nocut.json -q > cutproj/bad.out 2>&1; t
   echo "validate accepted drawings of different topology"; cat cutproj/bad.out; exit 1
 fi
 grep -q "drawing 1" cutproj/bad.out || { cat cutproj/bad.out; exit 1; }
+# inspect --project: each drawing's class (the cut makes drawing 1 two components) and the
+# multimesh's numbers; without the cut, the classes that differ and why it cannot be built.
+"$CLI_BIN" -q inspect --project cutproj/project.json > cutproj/inspect.out 2>/dev/null
+grep -q "^drawing 1 .*1 cuts.*; 2 components, 0 holes$" cutproj/inspect.out &&
+  grep -q "^drawing 2 .*; 2 components, 0 holes$" cutproj/inspect.out &&
+  grep -qE "^multimesh: 2 shapes, [0-9]+ vertices, [0-9]+ triangles, map energy" cutproj/inspect.out ||
+  { echo "inspect --project:"; cat cutproj/inspect.out; exit 1; }
+"$CLI_BIN" -q inspect --project cutproj/nocut.json > cutproj/inspect_bad.out 2>/dev/null
+grep -q "^drawing 1 .*; 1 component, 0 holes$" cutproj/inspect_bad.out &&
+  grep -q "^multimesh: not built: .*same topology" cutproj/inspect_bad.out ||
+  { echo "inspect --project (no cut):"; cat cutproj/inspect_bad.out; exit 1; }
 echo ok
