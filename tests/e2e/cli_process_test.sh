@@ -2,7 +2,8 @@
 # The CLI as a process (docs/cli.md): --progress json prints one JSON object per progress event
 # on stderr; -q prints no progress at all; the documented exit codes 4 (server unreachable),
 # 5 (server failure: a gRPC server without the Inbetween service answers UNIMPLEMENTED) and
-# 130 (Ctrl-C: SIGINT cancels the running stage, and nothing is written).
+# 130 (Ctrl-C: SIGINT cancels the running stage, and nothing is written; against a server the
+# remote call ends CANCELLED).
 source "$(dirname "$0")/lib/common.sh"
 ex="$INBETWEEN_SRC/examples/square_hexagon"
 cd "$WORK"
@@ -78,4 +79,34 @@ done
 [[ -n "$code" ]] || { echo "animate did not stop within 10 s of SIGINT"; exit 1; }
 [[ $code -eq 130 ]] || { echo "SIGINT: exit $code, want 130"; cat interrupted.out; exit 1; }
 [[ ! -e interrupted/frames.json ]] || { echo "an interrupted animate wrote frames.json"; exit 1; }
+
+# Ctrl-C against a server cancels the remote job: the CLI exits 130 and the server's Inbetween
+# call ends CANCELLED (its solver stopped), while the server keeps serving.
+start_server
+"$CLI_BIN" -q --server "$SERVER_ADDR" animate "$ex/square.svg" "$ex/hexagon.svg" \
+  --frames 100000 --format json --out remote_interrupted >remote.out 2>&1 &
+cli=$!
+PIDS+=($cli)
+for _ in $(seq 1 100); do  # until the stream runs (the build finished), at most 10 s
+  grep -q "rpc=BuildMultimesh .*status=OK" "$WORK/server.log" && break
+  sleep 0.1
+done
+sleep 0.5
+kill -INT "$cli"
+code=""
+for _ in $(seq 1 100); do
+  if ! kill -0 "$cli" 2>/dev/null; then
+    set +e; wait "$cli"; code=$?; set -e
+    break
+  fi
+  sleep 0.1
+done
+[[ "$code" == 130 ]] || { echo "remote SIGINT: exit '$code', want 130"; cat remote.out; exit 1; }
+for _ in $(seq 1 50); do
+  grep -q "rpc=Inbetween .*status=CANCELLED" "$WORK/server.log" && break
+  sleep 0.1
+done
+grep -q "rpc=Inbetween .*status=CANCELLED" "$WORK/server.log" ||
+  { echo "the server's Inbetween did not end CANCELLED"; tail -5 "$WORK/server.log"; exit 1; }
+"$CLI_BIN" --server "$SERVER_ADDR" inspect >/dev/null  # still serving
 echo "ok"
