@@ -337,28 +337,41 @@ class Studio {
 
   void Optimize() {
     MeasureHeavy(
-        "OptimizeComesh",
-        [this](Done done) {
-          v1::OptimizeComeshRequest request;
-          request.set_session_id(session_.id());
-          request.set_expected_version(session_.version());
-          auto result = std::make_shared<std::optional<v1::OptimizeComeshResult>>();
-          Stream<v1::OptimizeComeshRequest, v1::OptimizeComeshResponse>(
-              std::move(request),
-              [this](auto* c, auto* q, auto* r) { stub_.async()->OptimizeComesh(c, q, r); },
-              [result](v1::OptimizeComeshResponse& response) {
-                if (response.has_result()) *result = std::move(*response.mutable_result());
-                return absl::OkStatus();
-              },
-              [this, result, done](absl::Status status) {
-                if (status.ok() && !*result) {
-                  status = absl::InternalError("OptimizeComesh stream ended without a result");
-                }
-                if (status.ok()) session_ = (*result)->session();
-                done(status);
-              });
-        },
+        "OptimizeComesh", [this](Done done) { OptimizeAttempt(1, std::move(done)); },
         [this](absl::Status status) { Then(status, [this] { Frames(); }); });
+  }
+
+  // OptimizeComesh with the client library's failover: after a transient failure it is sent
+  // again with resume = true and the version the first attempt started from (the server goes on
+  // from the run's last checkpoint). The result is the last message, sent after the session was
+  // written: the call is done once it arrived, even if the connection broke after it.
+  void OptimizeAttempt(int attempt, Done done) {
+    v1::OptimizeComeshRequest request;
+    request.set_session_id(session_.id());
+    request.set_expected_version(session_.version());
+    request.set_resume(attempt > 1);
+    auto result = std::make_shared<std::optional<v1::OptimizeComeshResult>>();
+    Stream<v1::OptimizeComeshRequest, v1::OptimizeComeshResponse>(
+        std::move(request),
+        [this](auto* c, auto* q, auto* r) { stub_.async()->OptimizeComesh(c, q, r); },
+        [result](v1::OptimizeComeshResponse& response) {
+          if (response.has_result()) *result = std::move(*response.mutable_result());
+          return absl::OkStatus();
+        },
+        [this, attempt, result, done](absl::Status status) {
+          if (*result) {
+            session_ = (*result)->session();
+            return done(absl::OkStatus());
+          }
+          if (status.ok()) {
+            return done(absl::InternalError("OptimizeComesh stream ended without a result"));
+          }
+          const grpc::Status as_grpc(static_cast<grpc::StatusCode>(status.code()),
+                                     std::string(status.message()));
+          std::optional<std::chrono::milliseconds> backoff = Backoff(attempt, as_grpc);
+          if (!backoff) return done(status);
+          timer_.After(*backoff, [this, attempt, done] { OptimizeAttempt(attempt + 1, done); });
+        });
   }
 
   void Frames() {

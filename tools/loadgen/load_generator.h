@@ -3,9 +3,9 @@
 // read it back, edit a drawing, list sessions, delete it) against one target until a duration or a
 // total request count is reached; per-RPC latencies and errors by status code, then a check that
 // every session created is still there. The studios share gRPC's callback threads and one timer
-// thread, however many there are. Streams fail over like the client library's (Inbetween resumed
-// at the next frame after a replica dies; GetSession/ListSessions sent again), so an Inbetween
-// latency includes its retries.
+// thread, however many there are. Calls fail over like the client library's (Inbetween resumed
+// at the next frame and OptimizeComesh from its checkpoint after a replica dies; GetSession and
+// ListSessions sent again), so a stream's latency includes its retries.
 #pragma once
 
 #include <grpcpp/grpcpp.h>

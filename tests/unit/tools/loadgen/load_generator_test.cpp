@@ -2,8 +2,9 @@
 // nearest-rank percentiles, a bounded run against a real in-process server that stops at
 // exactly the request budget, exercises every RPC of the studio loop without errors, loses no
 // session and gets the same frames from every stream, the failover of the client library (through
-// a front that breaks Inbetween streams and a GetSession as a dying replica behind a proxy would:
-// resumed at the next frame, frames identical, x-session-id on every call), and 64 studios against
+// a front that breaks Inbetween streams, an optimization and a GetSession as a dying replica
+// behind a proxy would: resumed at the next frame or the checkpoint, frames identical,
+// x-session-id on every call), and 64 studios against
 // a real inbetween-server process running on far fewer than 64 threads of this process (the
 // callback API), with the same guarantees.
 #include "tools/loadgen/load_generator.h"
@@ -42,7 +43,8 @@ std::string ReadExample(const std::string& relative) {
 
 // Forwards every call of the studio loop to `backend`, recording each call's x-session-id against
 // its request's session id and breaking calls as scripted: the Inbetween streams in `faults`
-// (forward `after_frames` frames, then end with `status`), and `get_session_faults` GetSessions.
+// (forward `after_frames` frames, then end with `status`), the OptimizeComesh streams in
+// `optimize_faults` (`after_frames` iterations) and `get_session_faults` GetSessions.
 class FlakyFront final : public v1::Inbetween::Service {
  public:
   struct Fault {
@@ -52,9 +54,12 @@ class FlakyFront final : public v1::Inbetween::Service {
   explicit FlakyFront(std::shared_ptr<grpc::Channel> backend)
       : backend_(v1::Inbetween::NewStub(std::move(backend))) {}
 
-  std::mutex mu;  // guards the fields below
-  std::deque<Fault> faults;
+  std::mutex mu;                      // guards the fields below
+  std::deque<Fault> faults;           // Inbetween
+  std::deque<Fault> optimize_faults;  // OptimizeComesh: `after_frames` iterations
   int get_session_faults = 0;
+  std::vector<bool> resumes;                    // `resume` of every OptimizeComesh call
+  std::vector<uint64_t> expected_versions;      // of every OptimizeComesh call
   std::vector<uint32_t> start_frames;           // of every Inbetween call
   std::vector<std::string> missing_session_id;  // methods called without the right x-session-id
 
@@ -91,7 +96,29 @@ class FlakyFront final : public v1::Inbetween::Service {
   }
   grpc::Status OptimizeComesh(grpc::ServerContext* c, const v1::OptimizeComeshRequest* q,
                               grpc::ServerWriter<v1::OptimizeComeshResponse>* w) override {
-    return ForwardStream(c, *q, w, &v1::Inbetween::Stub::OptimizeComesh);
+    std::optional<Fault> fault;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      resumes.push_back(q->resume());
+      expected_versions.push_back(q->expected_version());
+      if (!optimize_faults.empty()) {
+        fault = optimize_faults.front();
+        optimize_faults.pop_front();
+      }
+    }
+    if (!fault) return ForwardStream(c, *q, w, &v1::Inbetween::Stub::OptimizeComesh);
+    CheckSessionId(*c, q->session_id(), "OptimizeComesh");
+    grpc::ClientContext upstream;
+    auto reader = backend_->OptimizeComesh(&upstream, *q);
+    v1::OptimizeComeshResponse response;
+    int iterations = 0;
+    while (reader->Read(&response)) {
+      if (response.has_iteration() && iterations++ == fault->after_frames) break;
+      w->Write(response);
+    }
+    upstream.TryCancel();  // the replica is gone: its run stops
+    reader->Finish();
+    return fault->status;
   }
   grpc::Status Inbetween(grpc::ServerContext* c, const v1::InbetweenRequest* q,
                          grpc::ServerWriter<v1::InbetweenResponse>* w) override {
@@ -304,6 +331,7 @@ TEST(LoadGeneratorTest, StreamsFailOverLikeTheClientLibrary) {
                                  "Received RST_STREAM with error code 2");
   front.faults = {{grpc::Status(grpc::StatusCode::UNAVAILABLE, "Socket closed"), 5},
                   {proxy_reset, 3}};
+  front.optimize_faults = {{proxy_reset, 1}};
   front.get_session_faults = 1;
   grpc::ServerBuilder builder;
   builder.RegisterService(&front);
@@ -324,13 +352,18 @@ TEST(LoadGeneratorTest, StreamsFailOverLikeTheClientLibrary) {
 
   EXPECT_EQ(report->requests, 20);
   EXPECT_EQ(report->errors, 0) << table;
-  EXPECT_EQ(report->retries, 3) << table;            // two stream resumes, one GetSession
+  EXPECT_EQ(report->retries, 4) << table;  // two stream resumes, one optimization, one GetSession
   EXPECT_EQ(report->rpcs.at("Inbetween").calls, 2);  // a stream is one request, retries included
   EXPECT_EQ(report->streams_completed, 2);
-  EXPECT_TRUE(report->frames_identical);  // resumed frames == uninterrupted ones
+  // Resumed frames, and the frames of a resumed optimization's multimesh, equal the second
+  // project's unbroken ones.
+  EXPECT_TRUE(report->frames_identical);
   EXPECT_EQ(report->lost_sessions, 0);
   EXPECT_EQ(report->sessions, 2);
   EXPECT_EQ(front.start_frames, (std::vector<uint32_t>{0, 5, 8, 0}));
+  EXPECT_EQ(front.resumes, (std::vector<bool>{false, true, false}));
+  ASSERT_EQ(front.expected_versions.size(), 3u);
+  EXPECT_EQ(front.expected_versions[0], front.expected_versions[1]);  // the first attempt's
   EXPECT_TRUE(front.missing_session_id.empty())
       << ::testing::PrintToString(front.missing_session_id);
 }
