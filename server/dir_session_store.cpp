@@ -273,6 +273,17 @@ absl::StatusOr<SessionState> DirSessionStore::Create(SessionState state) {
 }
 
 absl::StatusOr<SessionState> DirSessionStore::Put(SessionState state, uint64_t expected_version) {
+  return Replace(std::move(state), expected_version, /*same_version=*/false);
+}
+
+// The same version's snapshot file is replaced atomically, like a new version's is written.
+absl::StatusOr<SessionState> DirSessionStore::PutSameVersion(SessionState state,
+                                                             uint64_t expected_version) {
+  return Replace(std::move(state), expected_version, /*same_version=*/true);
+}
+
+absl::StatusOr<SessionState> DirSessionStore::Replace(SessionState state, uint64_t expected_version,
+                                                      bool same_version) {
   std::lock_guard lock(mutex_);
   auto it = by_id_.find(state.session.id());
   if (it == by_id_.end()) return SessionNotFoundError(state.session.id());
@@ -281,7 +292,7 @@ absl::StatusOr<SessionState> DirSessionStore::Put(SessionState state, uint64_t e
       !s.ok()) {
     return s;
   }
-  StampPut(state, entry.summary);
+  StampPut(state, entry.summary, same_version);
   state.owner = entry.owner;
   if (absl::Status s = WriteSnapshotLocked(state); !s.ok()) return s;
   entry.summary = SessionSummary(state.session);

@@ -36,6 +36,8 @@ class DirSessionStore final : public SessionStore {
   absl::StatusOr<SessionState> Get(absl::string_view id) const override;
   absl::StatusOr<SessionState> Create(SessionState state) override;
   absl::StatusOr<SessionState> Put(SessionState state, uint64_t expected_version) override;
+  absl::StatusOr<SessionState> PutSameVersion(SessionState state,
+                                              uint64_t expected_version) override;
   absl::StatusOr<SessionPage> List(size_t page_size, absl::string_view page_token,
                                    absl::string_view owner) const override;
   size_t CountOwned(absl::string_view owner) const override;
@@ -45,6 +47,9 @@ class DirSessionStore final : public SessionStore {
   size_t CachedCount() const override;
 
  private:
+  absl::StatusOr<SessionState> Replace(SessionState state, uint64_t expected_version,
+                                       bool same_version);
+
   struct Entry {
     uint64_t sequence = 0;
     std::string owner;

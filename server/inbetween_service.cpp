@@ -106,10 +106,11 @@ absl::Status RequireSessionId(const std::string& id) {
 }
 
 // Another owner's session is NOT_FOUND, worded exactly like a missing one (no existence leak).
+// `latest`: past replicas' caches (SessionStore::GetLatest), for a stored comesh checkpoint.
 absl::StatusOr<SessionState> Load(const SessionStore& store, const std::string& id,
-                                  const Caller& caller) {
+                                  const Caller& caller, bool latest = false) {
   if (absl::Status s = RequireSessionId(id); !s.ok()) return s;
-  absl::StatusOr<SessionState> state = store.Get(id);
+  absl::StatusOr<SessionState> state = latest ? store.GetLatest(id) : store.Get(id);
   if (state.ok() && state->owner != caller.owner) return SessionNotFoundError(id);
   return state;
 }
@@ -848,19 +849,19 @@ grpc::Status InbetweenService::OptimizeComesh(
   Caller caller;
   return RunRpc(
       options_, context, "OptimizeComesh", request->session_id(), &caller, [&]() -> absl::Status {
-        absl::StatusOr<SessionState> state = Load(*store_, request->session_id(), caller);
+        absl::StatusOr<SessionState> state =
+            Load(*store_, request->session_id(), caller, /*latest=*/request->resume());
         if (!state.ok()) return state.status();
-        // A resumed request carries the version its first attempt started from; the run's own
-        // checkpoint writes have moved the session on since (docs/api.md "Resuming
-        // OptimizeComesh"). Any other write since is a stale version, as always.
+        if (state->session.version() != request->expected_version()) {
+          return StaleVersionError(request->session_id(), state->session.version(),
+                                   request->expected_version());
+        }
+        // Checkpoints are written without moving the version (docs/api.md "Resuming
+        // OptimizeComesh"): one stored at this version is of a run on this multimesh.
         const std::shared_ptr<const StoredComeshCheckpoint> checkpoint = state->comesh_checkpoint;
         const bool own_checkpoint = request->resume() && checkpoint &&
                                     checkpoint->input_version == request->expected_version() &&
                                     checkpoint->stored_version == state->session.version();
-        if (state->session.version() != request->expected_version() && !own_checkpoint) {
-          return StaleVersionError(request->session_id(), state->session.version(),
-                                   request->expected_version());
-        }
         if (state->session.stage() < v1::STAGE_MULTIMESH || !state->multimesh) {
           return absl::FailedPreconditionError(
               absl::StrCat("session ", request->session_id(),
@@ -917,27 +918,25 @@ grpc::Status InbetweenService::OptimizeComesh(
           }
           write(iterations.OnProgress(stage, fraction, detail));
         };
-        // After every topology pass the checkpoint is stored with the session (a write: the
-        // version moves on; the session is otherwise unchanged). A failed write (another writer,
-        // or the store is down) ends the run: its final write would fail the same way.
-        uint64_t version = state->session.version();
+        // After every topology pass the checkpoint is stored with the session, at the same
+        // version (nothing a client reads changes). A failed write (another writer, or the store
+        // is down) ends the run: its final write would fail the same way.
+        const uint64_t version = state->session.version();
         absl::Status checkpoint_status;
         options.on_checkpoint = [&](const solver::ComeshCheckpoint& c) {
           if (token.IsCancelled() || context->IsCancelled()) return;
           auto stored = std::make_shared<StoredComeshCheckpoint>();
-          stored->input_version = request->expected_version();
-          stored->stored_version = version + 1;
+          stored->input_version = version;
+          stored->stored_version = version;
           stored->parameters = parameters_key;
           stored->checkpoint = c;
           SessionState next = *state;
           next.comesh_checkpoint = std::move(stored);
-          absl::StatusOr<SessionState> put = store_->Put(std::move(next), version);
+          absl::StatusOr<SessionState> put = store_->PutSameVersion(std::move(next), version);
           if (!put.ok()) {
             checkpoint_status = put.status();
             token.Cancel();
-            return;
           }
-          version = put->session.version();
         };
         solver::ComeshReport report;
         absl::StatusOr<solver::Multimesh> mesh = solver::OptimizeComesh(

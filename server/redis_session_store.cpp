@@ -253,6 +253,16 @@ void RedisSessionStore::Remember(const SessionState& state) const {
 }
 
 absl::StatusOr<SessionState> RedisSessionStore::Get(absl::string_view id) const {
+  return Load(id, /*use_cache=*/true);
+}
+
+// The cache is valid while the version in Redis is unchanged, which PutSameVersion on another
+// replica does not change: this reads the snapshot whatever the cache holds.
+absl::StatusOr<SessionState> RedisSessionStore::GetLatest(absl::string_view id) const {
+  return Load(id, /*use_cache=*/false);
+}
+
+absl::StatusOr<SessionState> RedisSessionStore::Load(absl::string_view id, bool use_cache) const {
   const std::string key = SessionKey(id);
   absl::StatusOr<Reply> version = Command({"HGET", key, "v"});
   if (!version.ok()) return version.status();
@@ -265,7 +275,7 @@ absl::StatusOr<SessionState> RedisSessionStore::Get(absl::string_view id) const 
   if ((*version)->type != REDIS_REPLY_STRING || !absl::SimpleAtoi(Str(**version), &current)) {
     return Malformed("HGET v");
   }
-  {
+  if (use_cache) {
     std::lock_guard lock(cache_mutex_);
     if (auto it = cache_.find(id);
         it != cache_.end() && it->second.state.session.version() == current) {
@@ -319,6 +329,17 @@ absl::StatusOr<SessionState> RedisSessionStore::Create(SessionState state) {
 }
 
 absl::StatusOr<SessionState> RedisSessionStore::Put(SessionState state, uint64_t expected_version) {
+  return Replace(std::move(state), expected_version, /*same_version=*/false);
+}
+
+absl::StatusOr<SessionState> RedisSessionStore::PutSameVersion(SessionState state,
+                                                               uint64_t expected_version) {
+  return Replace(std::move(state), expected_version, /*same_version=*/true);
+}
+
+absl::StatusOr<SessionState> RedisSessionStore::Replace(SessionState state,
+                                                        uint64_t expected_version,
+                                                        bool same_version) {
   const std::string id = state.session.id();
   const std::string key = SessionKey(id);
   // Owner and created time never change after Create, so reading them outside the script is
@@ -330,7 +351,7 @@ absl::StatusOr<SessionState> RedisSessionStore::Put(SessionState state, uint64_t
   inbetween::v1::Session current;
   current.set_version(expected_version);
   current.set_created_unix_ms(static_cast<int64_t>(ElementU64(**fixed, 1)));
-  StampPut(state, current);
+  StampPut(state, current, same_version);
   state.owner = std::string(Str(*(*fixed)->element[0]));
   absl::StatusOr<Reply> reply =
       Command({"EVAL", kPutScript, "1", key, absl::StrCat(expected_version),

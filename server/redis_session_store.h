@@ -50,6 +50,9 @@ class RedisSessionStore final : public SessionStore {
   absl::StatusOr<SessionState> Get(absl::string_view id) const override;
   absl::StatusOr<SessionState> Create(SessionState state) override;
   absl::StatusOr<SessionState> Put(SessionState state, uint64_t expected_version) override;
+  absl::StatusOr<SessionState> PutSameVersion(SessionState state,
+                                              uint64_t expected_version) override;
+  absl::StatusOr<SessionState> GetLatest(absl::string_view id) const override;
   absl::StatusOr<SessionPage> List(size_t page_size, absl::string_view page_token,
                                    absl::string_view owner) const override;
   size_t CountOwned(absl::string_view owner) const override;
@@ -61,6 +64,10 @@ class RedisSessionStore final : public SessionStore {
   class Reply;  // an owned redisReply
 
  private:
+  absl::StatusOr<SessionState> Load(absl::string_view id, bool use_cache) const;
+  absl::StatusOr<SessionState> Replace(SessionState state, uint64_t expected_version,
+                                       bool same_version);
+
   struct Cached {
     SessionState state;
     uint64_t last_used = 0;

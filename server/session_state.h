@@ -16,10 +16,11 @@ namespace inbetween::server {
 
 // The last checkpoint of an OptimizeComesh run (docs/api.md "Resuming OptimizeComesh"). It
 // belongs to one run: the session version the run started from (its input multimesh) and its
-// effective comesh parameters; usable only while the session is still at stored_version.
+// effective comesh parameters. Stored without moving the version (SessionStore::PutSameVersion),
+// so any later write makes it stale.
 struct StoredComeshCheckpoint {
   uint64_t input_version = 0;   // the request's expected_version
-  uint64_t stored_version = 0;  // the session version the checkpoint write produced
+  uint64_t stored_version = 0;  // the session version it was stored at (== input_version)
   std::string parameters;       // the effective v1::ComeshParameters, serialized
   solver::ComeshCheckpoint checkpoint;
 };

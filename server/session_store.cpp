@@ -66,8 +66,8 @@ void StampCreated(SessionState& state, const std::string& id) {
   state.session.set_updated_unix_ms(now);
 }
 
-void StampPut(SessionState& state, const inbetween::v1::Session& current) {
-  state.session.set_version(current.version() + 1);
+void StampPut(SessionState& state, const inbetween::v1::Session& current, bool same_version) {
+  state.session.set_version(current.version() + (same_version ? 0 : 1));
   state.session.set_created_unix_ms(current.created_unix_ms());
   state.session.set_updated_unix_ms(NowUnixMs());
 }
@@ -134,6 +134,17 @@ absl::StatusOr<SessionState> MemorySessionStore::Create(SessionState state) {
 
 absl::StatusOr<SessionState> MemorySessionStore::Put(SessionState state,
                                                      uint64_t expected_version) {
+  return Replace(std::move(state), expected_version, /*same_version=*/false);
+}
+
+absl::StatusOr<SessionState> MemorySessionStore::PutSameVersion(SessionState state,
+                                                                uint64_t expected_version) {
+  return Replace(std::move(state), expected_version, /*same_version=*/true);
+}
+
+absl::StatusOr<SessionState> MemorySessionStore::Replace(SessionState state,
+                                                         uint64_t expected_version,
+                                                         bool same_version) {
   std::lock_guard lock(mutex_);
   auto it = by_id_.find(state.session.id());
   if (it == by_id_.end()) return NotFound(state.session.id());
@@ -141,7 +152,7 @@ absl::StatusOr<SessionState> MemorySessionStore::Put(SessionState state,
   if (auto s = CheckPutVersion(current.id(), current.version(), expected_version); !s.ok()) {
     return s;
   }
-  StampPut(state, current);
+  StampPut(state, current, same_version);
   it->second.state = std::move(state);
   return it->second.state;
 }

@@ -43,6 +43,15 @@ class SessionStore {
   // version and created fields are ignored. Returns the stored state.
   virtual absl::StatusOr<SessionState> Put(SessionState state, uint64_t expected_version) = 0;
 
+  // Like Put, but the version stays expected_version: for data derived from that version that
+  // no other call reads (OptimizeComesh's checkpoint), so the write moves no client's version
+  // on. Another replica may keep serving its cached copy of that version; GetLatest reads past
+  // such caches.
+  virtual absl::StatusOr<SessionState> PutSameVersion(SessionState state,
+                                                      uint64_t expected_version) = 0;
+  // Like Get, but never a cached copy that another replica's PutSameVersion made stale.
+  virtual absl::StatusOr<SessionState> GetLatest(absl::string_view id) const { return Get(id); }
+
   // Up to page_size sessions of `owner` after page_token (from a previous page; empty = the
   // first page).
   virtual absl::StatusOr<SessionPage> List(size_t page_size, absl::string_view page_token,
@@ -81,8 +90,10 @@ absl::Status CheckDeleteVersion(absl::string_view id, uint64_t current, uint64_t
 
 // Create's stamping: sets the id, version 1 unless given, created (if unset) and updated times.
 void StampCreated(SessionState& state, const std::string& id);
-// Put's stamping: the version after `current`'s, `current`'s created time, updated = now.
-void StampPut(SessionState& state, const inbetween::v1::Session& current);
+// Put's stamping: the version after `current`'s (PutSameVersion: `current`'s), `current`'s
+// created time, updated = now.
+void StampPut(SessionState& state, const inbetween::v1::Session& current,
+              bool same_version = false);
 
 // One List page over an index ordered by sequence (creation order), shared by every store.
 // `listed(id, &state)` fills the state to list and returns true, or returns false for sessions
@@ -106,6 +117,8 @@ class MemorySessionStore final : public SessionStore {
   absl::StatusOr<SessionState> Get(absl::string_view id) const override;
   absl::StatusOr<SessionState> Create(SessionState state) override;
   absl::StatusOr<SessionState> Put(SessionState state, uint64_t expected_version) override;
+  absl::StatusOr<SessionState> PutSameVersion(SessionState state,
+                                              uint64_t expected_version) override;
   absl::StatusOr<SessionPage> List(size_t page_size, absl::string_view page_token,
                                    absl::string_view owner) const override;
   size_t CountOwned(absl::string_view owner) const override;
@@ -113,6 +126,9 @@ class MemorySessionStore final : public SessionStore {
   absl::Status Delete(absl::string_view id, uint64_t expected_version) override;
 
  private:
+  absl::StatusOr<SessionState> Replace(SessionState state, uint64_t expected_version,
+                                       bool same_version);
+
   struct Entry {
     uint64_t sequence;  // insertion order; the List order and the page token
     SessionState state;

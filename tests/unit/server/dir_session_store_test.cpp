@@ -126,5 +126,35 @@ TEST_F(DirSessionStoreTest, IdleSessionsLeaveMemoryAndReload) {
   EXPECT_EQ(got->multimesh->triangles.size(), 2u);
 }
 
+TEST_F(DirSessionStoreTest, PutSameVersionKeepsTheVersionAndSurvivesReopening) {
+  std::string id;
+  {
+    auto store = Open();
+    auto created = store->Create(StoredSessionState("alice"));
+    ASSERT_TRUE(created.ok()) << created.status();
+    id = created->session.id();
+    SessionState next = *created;
+    auto checkpoint = std::make_shared<StoredComeshCheckpoint>();
+    checkpoint->input_version = checkpoint->stored_version = 1;
+    checkpoint->checkpoint.mesh = *created->multimesh;
+    checkpoint->checkpoint.outer = 3;
+    next.comesh_checkpoint = checkpoint;
+    EXPECT_EQ(store->PutSameVersion(next, 2).status().code(), absl::StatusCode::kAborted);
+    auto put = store->PutSameVersion(next, 1);
+    ASSERT_TRUE(put.ok()) << put.status();
+    EXPECT_EQ(put->session.version(), 1u);
+  }
+  auto store = Open();
+  auto got = store->Get(id);
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->session.version(), 1u);
+  ASSERT_NE(got->comesh_checkpoint, nullptr);
+  EXPECT_EQ(got->comesh_checkpoint->checkpoint.outer, 3);
+  // The next ordinary write goes on from the same version.
+  auto put = store->Put(*got, 1);
+  ASSERT_TRUE(put.ok()) << put.status();
+  EXPECT_EQ(put->session.version(), 2u);
+}
+
 }  // namespace
 }  // namespace inbetween::server::testing

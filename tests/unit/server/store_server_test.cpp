@@ -1,5 +1,7 @@
 // InbetweenServer with persistent stores: idle sessions leave memory (--idle-evict-seconds) and
-// reload on the next call; two servers over one Redis act as replicas through real RPCs.
+// reload on the next call; two servers over one Redis act as replicas through real RPCs (an
+// optimization interrupted on one resumes on the other from the checkpoint in Redis).
+#include <google/protobuf/util/message_differencer.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -128,6 +130,108 @@ TEST(StoreServerTest, TwoServersOverOneRedisShareSessionsAndVersions) {
   get.set_session_id(session.id());
   v1::GetSessionResponse got;
   EXPECT_EQ(stub_b->GetSession(&get_context, get, &got).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+// The square -> hexagon examples, built, through `stub`.
+v1::Session BuiltExamples(v1::Inbetween::Stub& stub) {
+  v1::Session session = Create(stub, "square-hexagon");
+  for (const char* name : {"square", "hexagon"}) {
+    grpc::ClientContext context;
+    v1::PutDrawingRequest request;
+    request.set_session_id(session.id());
+    request.set_expected_version(session.version());
+    request.mutable_drawing()->set_name(name);
+    request.mutable_drawing()->set_svg(
+        ReadExample(std::string("examples/square_hexagon/") + name + ".svg"));
+    v1::PutDrawingResponse response;
+    grpc::Status status = stub.PutDrawing(&context, request, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    session = response.session();
+  }
+  grpc::ClientContext context;
+  v1::BuildMultimeshRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  auto reader = stub.BuildMultimesh(&context, request);
+  v1::BuildMultimeshResponse message;
+  while (reader->Read(&message)) {
+    if (message.has_result()) session = message.result().session();
+  }
+  EXPECT_TRUE(reader->Finish().ok());
+  return session;
+}
+
+v1::OptimizeComeshRequest OptimizeRequest(const v1::Session& session, bool resume) {
+  v1::OptimizeComeshRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  request.set_resume(resume);
+  request.mutable_comesh()->set_max_outer_iterations(8);
+  request.mutable_comesh()->set_max_inner_iterations(200);
+  return request;
+}
+
+// Runs the optimization to its end, or (interrupt) cancels it at the first iteration after the
+// first topology pass, whose checkpoint is stored by then.
+grpc::Status Optimize(v1::Inbetween::Stub& stub, const v1::OptimizeComeshRequest& request,
+                      bool interrupt, v1::OptimizeComeshResult* result) {
+  grpc::ClientContext context;
+  auto reader = stub.OptimizeComesh(&context, request);
+  v1::OptimizeComeshResponse message;
+  bool passed = false;
+  while (reader->Read(&message)) {
+    if (message.has_result()) *result = message.result();
+    if (message.has_progress() && message.progress().detail().starts_with("outer ")) passed = true;
+    if (interrupt && passed && message.has_iteration()) {
+      context.TryCancel();
+      break;
+    }
+  }
+  while (reader->Read(&message)) {
+  }
+  return reader->Finish();
+}
+
+TEST(StoreServerTest, OptimizationInterruptedOnOneReplicaResumesOnAnotherOverRedis) {
+  const std::string binary = FindRedisServer();
+  if (binary.empty()) GTEST_SKIP() << "redis-server is not installed";
+  RedisProcess redis(binary);
+  ASSERT_FALSE(redis.url().empty());
+  auto a = StartWithStore(redis.url(), std::chrono::seconds(600));
+  auto b = StartWithStore(redis.url(), std::chrono::seconds(600));
+  ASSERT_TRUE(a && b);
+  auto stub_a = v1::Inbetween::NewStub(a->InProcessChannel());
+  auto stub_b = v1::Inbetween::NewStub(b->InProcessChannel());
+
+  v1::OptimizeComeshResult reference;
+  const v1::Session reference_session = BuiltExamples(*stub_a);
+  ASSERT_TRUE(Optimize(*stub_a, OptimizeRequest(reference_session, false), false, &reference).ok());
+  ASSERT_GE(reference.outer_iterations(), 2u);
+
+  const v1::Session session = BuiltExamples(*stub_a);
+  {
+    // b has the session cached at the version before the optimization.
+    grpc::ClientContext context;
+    v1::GetSessionRequest get;
+    get.set_session_id(session.id());
+    v1::GetSessionResponse got;
+    ASSERT_TRUE(stub_b->GetSession(&context, get, &got).ok());
+    EXPECT_EQ(got.session().version(), session.version());
+  }
+  v1::OptimizeComeshResult unused;
+  EXPECT_EQ(Optimize(*stub_a, OptimizeRequest(session, false), true, &unused).error_code(),
+            grpc::StatusCode::CANCELLED);
+  a.reset();  // the replica goes away (after its grace period)
+
+  v1::OptimizeComeshResult resumed;
+  grpc::Status status = Optimize(*stub_b, OptimizeRequest(session, true), false, &resumed);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(resumed.resumed_outer(), 1u);
+  EXPECT_GT(resumed.resumed_inner(), 0u);
+  EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(resumed.multimesh(),
+                                                                 reference.multimesh()));
+  EXPECT_EQ(resumed.inner_iterations(), reference.inner_iterations());
+  EXPECT_EQ(resumed.session().stage(), v1::STAGE_OPTIMIZED);
 }
 
 }  // namespace

@@ -393,8 +393,8 @@ TEST_F(TopologyServiceTest, OptimizeStreamsIterationsStoresTheResultAndInbetween
   }
   const v1::OptimizeComeshResult& result = run.result;
   EXPECT_EQ(result.session().stage(), v1::STAGE_OPTIMIZED);
-  // One write per checkpoint (after each topology pass), then the result.
-  EXPECT_EQ(result.session().version(), built.session().version() + result.outer_iterations() + 1);
+  // Checkpoints keep the version: the result is the one version step.
+  EXPECT_EQ(result.session().version(), built.session().version() + 1);
   EXPECT_EQ(result.resumed_outer(), 0u);
   EXPECT_EQ(result.inner_iterations(), run.iterations.size());
   EXPECT_GE(result.stats().map_energy(), 2.0 - 1e-9);
@@ -550,12 +550,13 @@ TEST_F(OptimizeResumeTest, ResumeContinuesFromTheStoredCheckpointWithTheSameResu
   const v1::Session session = Built();
   const std::vector<v1::ComeshIteration> before = Interrupt(Request(session, false));
   ASSERT_FALSE(before.empty());
-  // The checkpoint write moved the version on; the session is otherwise unchanged.
+  // The checkpoint is stored at the same version; what clients see is unchanged.
   const v1::Session interrupted = Get(session.id());
-  EXPECT_EQ(interrupted.version(), session.version() + 1);
+  EXPECT_EQ(interrupted.version(), session.version());
   EXPECT_EQ(interrupted.stage(), v1::STAGE_MULTIMESH);
-  // Without resume the request's version is stale.
-  EXPECT_EQ(Optimize(Request(session, false)).status.error_code(), grpc::StatusCode::ABORTED);
+  auto checkpointed = server_->store().Get(session.id());
+  ASSERT_TRUE(checkpointed.ok());
+  ASSERT_NE(checkpointed->comesh_checkpoint, nullptr);
 
   // The same request with resume: continues after pass 1, numbering on.
   const OptimizeRun resumed = Optimize(Request(session, true));
@@ -577,10 +578,9 @@ TEST_F(OptimizeResumeTest, ResumeContinuesFromTheStoredCheckpointWithTheSameResu
         it, reference.iterations[it.inner() - 1]))
         << "iteration " << it.inner();
   }
-  EXPECT_EQ(resumed.result.session().version(),
-            interrupted.version() + (reference.result.outer_iterations() - 1) + 1);
+  EXPECT_EQ(resumed.result.session().version(), session.version() + 1);
   EXPECT_EQ(resumed.result.session().stage(), v1::STAGE_OPTIMIZED);
-  // The checkpoint is gone with the result: resuming again is a stale version.
+  // The result is a new version without the checkpoint: resuming again is a stale version.
   EXPECT_EQ(Optimize(Request(session, true)).status.error_code(), grpc::StatusCode::ABORTED);
   auto stored = server_->store().Get(session.id());
   ASSERT_TRUE(stored.ok());
@@ -642,9 +642,9 @@ TEST_F(OptimizeResumeTest, CheckpointOfAnotherVersionOrOtherParametersIsIgnored)
   // version, i.e. from another multimesh: a request at the current version ignores it.
   SessionState next = *rewritten;
   auto older = std::make_shared<StoredComeshCheckpoint>(*rewritten->comesh_checkpoint);
-  older->stored_version = rewritten->session.version() + 1;
+  older->stored_version = rewritten->session.version();
   next.comesh_checkpoint = older;
-  auto current = server_->store().Put(next, rewritten->session.version());
+  auto current = server_->store().PutSameVersion(next, rewritten->session.version());
   ASSERT_TRUE(current.ok()) << current.status();
   ASSERT_EQ(current->session.version(), older->stored_version);
   const OptimizeRun run = Optimize(Request(current->session, true));
