@@ -175,21 +175,28 @@ absl::StatusOr<v1::Session> InbetweenClient::SetCorrespondences(
 
 absl::StatusOr<v1::BuildMultimeshResult> InbetweenClient::BuildMultimesh(
     const v1::Session& session, const ProgressCallback& progress) {
-  Call call(this, session.id());
   v1::BuildMultimeshRequest request;
   request.set_session_id(session.id());
+  // Every attempt names the same version: a build that died before storing its multimesh left
+  // the session unchanged, so the same request builds it again (deterministically, the same
+  // multimesh); one that stored it before dying makes the retry ABORTED, and the caller re-reads.
   request.set_expected_version(session.version());
-  auto reader = stub_->BuildMultimesh(&call.context, request);
-  v1::BuildMultimeshResponse response;
-  std::optional<v1::BuildMultimeshResult> result;
-  while (reader->Read(&response)) {
-    if (response.has_progress() && progress) progress(response.progress());
-    if (response.has_result()) result = std::move(*response.mutable_result());
+  for (int attempt = 1;; ++attempt) {
+    Call call(this, session.id());
+    auto reader = stub_->BuildMultimesh(&call.context, request);
+    v1::BuildMultimeshResponse response;
+    std::optional<v1::BuildMultimeshResult> result;
+    while (reader->Read(&response)) {
+      if (response.has_progress() && progress) progress(response.progress());
+      if (response.has_result()) result = std::move(*response.mutable_result());
+    }
+    grpc::Status status = reader->Finish();
+    // The result is the last message, sent after the session was written.
+    if (result) return *std::move(result);
+    if (status.ok()) return absl::InternalError("BuildMultimesh stream ended without a result");
+    grpc::Status retry = PrepareRetry("BuildMultimesh", attempt, status, 0, 0);
+    if (!retry.ok()) return FromGrpcStatus(retry);
   }
-  grpc::Status status = reader->Finish();
-  if (!status.ok()) return FromGrpcStatus(status);
-  if (!result) return absl::InternalError("BuildMultimesh stream ended without a result");
-  return *std::move(result);
 }
 
 absl::StatusOr<v1::OptimizeComeshResult> InbetweenClient::OptimizeComesh(

@@ -309,29 +309,40 @@ class Studio {
 
   void Build() {
     MeasureHeavy(
-        "BuildMultimesh",
-        [this](Done done) {
-          v1::BuildMultimeshRequest request;
-          request.set_session_id(session_.id());
-          request.set_expected_version(session_.version());
-          auto result = std::make_shared<std::optional<v1::BuildMultimeshResult>>();
-          Stream<v1::BuildMultimeshRequest, v1::BuildMultimeshResponse>(
-              std::move(request),
-              [this](auto* c, auto* q, auto* r) { stub_.async()->BuildMultimesh(c, q, r); },
-              [result](v1::BuildMultimeshResponse& response) {
-                if (response.has_result()) *result = std::move(*response.mutable_result());
-                return absl::OkStatus();
-              },
-              [this, result, done](absl::Status status) {
-                if (status.ok() && !*result) {
-                  status = absl::InternalError("BuildMultimesh stream ended without a result");
-                }
-                if (status.ok()) session_ = (*result)->session();
-                done(status);
-              });
-        },
+        "BuildMultimesh", [this](Done done) { BuildAttempt(1, std::move(done)); },
         [this](absl::Status status) {
           Then(status, [this] { options_.optimize_outer_iterations > 0 ? Optimize() : Frames(); });
+        });
+  }
+
+  // BuildMultimesh with the client library's failover: after a transient failure the same
+  // request (same expected_version) is sent again; a build that died before storing left the
+  // session unchanged. A result that arrived ends the call.
+  void BuildAttempt(int attempt, Done done) {
+    v1::BuildMultimeshRequest request;
+    request.set_session_id(session_.id());
+    request.set_expected_version(session_.version());
+    auto result = std::make_shared<std::optional<v1::BuildMultimeshResult>>();
+    Stream<v1::BuildMultimeshRequest, v1::BuildMultimeshResponse>(
+        std::move(request),
+        [this](auto* c, auto* q, auto* r) { stub_.async()->BuildMultimesh(c, q, r); },
+        [result](v1::BuildMultimeshResponse& response) {
+          if (response.has_result()) *result = std::move(*response.mutable_result());
+          return absl::OkStatus();
+        },
+        [this, attempt, result, done](absl::Status status) {
+          if (*result) {
+            session_ = (*result)->session();
+            return done(absl::OkStatus());
+          }
+          if (status.ok()) {
+            return done(absl::InternalError("BuildMultimesh stream ended without a result"));
+          }
+          const grpc::Status as_grpc(static_cast<grpc::StatusCode>(status.code()),
+                                     std::string(status.message()));
+          std::optional<std::chrono::milliseconds> backoff = Backoff(attempt, as_grpc);
+          if (!backoff) return done(status);
+          timer_.After(*backoff, [this, attempt, done] { BuildAttempt(attempt + 1, done); });
         });
   }
 

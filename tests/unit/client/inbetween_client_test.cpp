@@ -53,6 +53,7 @@ class FlakyFront final : public v1::Inbetween::Service {
   std::vector<uint32_t> start_frames;       // of every Inbetween call
   std::vector<bool> resumes;                // `resume` of every OptimizeComesh call
   std::vector<uint64_t> expected_versions;  // of every OptimizeComesh call
+  std::vector<uint64_t> build_versions;     // expected_version of every BuildMultimesh call
   std::vector<std::string> session_ids;     // x-session-id of every call ("" when absent)
   int unary_calls = 0;
 
@@ -86,6 +87,28 @@ class FlakyFront final : public v1::Inbetween::Service {
     while (reader->Read(&response)) {
       if (response.has_frame() && fault && frames++ == fault->after_frames) {
         upstream.TryCancel();
+        reader->Finish();
+        return fault->status;
+      }
+      writer->Write(response);
+    }
+    grpc::Status status = reader->Finish();
+    return fault && status.ok() ? fault->status : status;
+  }
+
+  grpc::Status BuildMultimesh(grpc::ServerContext* context,
+                              const v1::BuildMultimeshRequest* request,
+                              grpc::ServerWriter<v1::BuildMultimeshResponse>* writer) override {
+    Record(*context);
+    build_versions.push_back(request->expected_version());
+    std::optional<Fault> fault = NextFault();
+    grpc::ClientContext upstream;
+    auto reader = backend_->BuildMultimesh(&upstream, *request);
+    v1::BuildMultimeshResponse response;
+    int messages = 0;
+    while (reader->Read(&response)) {
+      if (response.has_progress() && fault && messages++ == fault->after_frames) {
+        upstream.TryCancel();  // the replica is gone before it stored anything
         reader->Finish();
         return fault->status;
       }
@@ -212,6 +235,55 @@ class InbetweenClientFailoverTest : public ::testing::Test {
   std::unique_ptr<grpc::Server> front_server_;
   std::vector<RetryEvent> retries_;
 };
+
+// A build whose replica dies after its first progress message (before it stored anything) is
+// sent again with the same expected_version and builds the same multimesh; a non-transient
+// error is not repeated.
+TEST_F(InbetweenClientFailoverTest, BrokenBuildIsSentAgainAndBuildsTheSameMultimesh) {
+  auto fresh = [&](const std::string& name) {
+    auto session = direct_->CreateSession(name);
+    EXPECT_TRUE(session.ok());
+    for (const char* drawing : {"square", "hexagon"}) {
+      v1::PutDrawingRequest request;
+      request.set_session_id(session->id());
+      request.set_expected_version(session->version());
+      request.mutable_drawing()->set_svg(
+          ReadExample(std::string("examples/square_hexagon/") + drawing + ".svg"));
+      auto put = direct_->PutDrawing(request);
+      EXPECT_TRUE(put.ok()) << put.status();
+      *session = put->session();
+    }
+    return *session;
+  };
+  const v1::Session reference_session = fresh("build reference");
+  auto reference = direct_->BuildMultimesh(reference_session, nullptr);
+  ASSERT_TRUE(reference.ok()) << reference.status();
+
+  const v1::Session session = fresh("build broken");
+  front_->faults = {{kUnavailable, 0}, {kProxyReset, 1}};
+  auto client = FrontClient();
+  auto built = client->BuildMultimesh(session, nullptr);
+  ASSERT_TRUE(built.ok()) << built.status();
+  EXPECT_THAT(front_->build_versions,
+              ElementsAre(session.version(), session.version(), session.version()));
+  ASSERT_EQ(retries_.size(), 2u);
+  EXPECT_EQ(retries_[0].method, "BuildMultimesh");
+  EXPECT_EQ(built->session().version(), session.version() + 1);  // built once
+  EXPECT_EQ(built->session().multimesh_stats().vertices(),
+            reference->session().multimesh_stats().vertices());
+  auto mine = direct_->GetSession(session.id(), /*full=*/true);
+  auto theirs = direct_->GetSession(reference_session.id(), /*full=*/true);
+  ASSERT_TRUE(mine.ok() && theirs.ok());
+  ASSERT_GT(mine->multimesh().triangles_size(), 0);
+  EXPECT_EQ(mine->multimesh().SerializeAsString(), theirs->multimesh().SerializeAsString());
+
+  // FAILED_PRECONDITION (not transient) goes straight back.
+  retries_.clear();
+  front_->faults = {{grpc::Status(grpc::StatusCode::FAILED_PRECONDITION, "no"), 0}};
+  auto refused = client->BuildMultimesh(fresh("build refused"), nullptr);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_TRUE(retries_.empty());
+}
 
 TEST_F(InbetweenClientFailoverTest, ResumedStreamDeliversTheFramesOfAnUninterruptedRun) {
   auto uninterrupted = direct_->Inbetween(session_.id(), parameters_, nullptr);

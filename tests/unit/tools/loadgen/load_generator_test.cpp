@@ -54,9 +54,11 @@ class FlakyFront final : public v1::Inbetween::Service {
   explicit FlakyFront(std::shared_ptr<grpc::Channel> backend)
       : backend_(v1::Inbetween::NewStub(std::move(backend))) {}
 
-  std::mutex mu;                      // guards the fields below
-  std::deque<Fault> faults;           // Inbetween
-  std::deque<Fault> optimize_faults;  // OptimizeComesh: `after_frames` iterations
+  std::mutex mu;                         // guards the fields below
+  std::deque<Fault> faults;              // Inbetween
+  std::deque<Fault> optimize_faults;     // OptimizeComesh: `after_frames` iterations
+  std::deque<Fault> build_faults;        // BuildMultimesh: `after_frames` progress messages
+  std::vector<uint64_t> build_versions;  // expected_version of every BuildMultimesh call
   int get_session_faults = 0;
   std::vector<bool> resumes;                    // `resume` of every OptimizeComesh call
   std::vector<uint64_t> expected_versions;      // of every OptimizeComesh call
@@ -92,7 +94,28 @@ class FlakyFront final : public v1::Inbetween::Service {
   }
   grpc::Status BuildMultimesh(grpc::ServerContext* c, const v1::BuildMultimeshRequest* q,
                               grpc::ServerWriter<v1::BuildMultimeshResponse>* w) override {
-    return ForwardStream(c, *q, w, &v1::Inbetween::Stub::BuildMultimesh);
+    std::optional<Fault> fault;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      build_versions.push_back(q->expected_version());
+      if (!build_faults.empty()) {
+        fault = build_faults.front();
+        build_faults.pop_front();
+      }
+    }
+    if (!fault) return ForwardStream(c, *q, w, &v1::Inbetween::Stub::BuildMultimesh);
+    CheckSessionId(*c, q->session_id(), "BuildMultimesh");
+    grpc::ClientContext upstream;
+    auto reader = backend_->BuildMultimesh(&upstream, *q);
+    v1::BuildMultimeshResponse response;
+    int messages = 0;
+    while (reader->Read(&response)) {
+      if (response.has_progress() && messages++ == fault->after_frames) break;
+      w->Write(response);
+    }
+    upstream.TryCancel();  // the replica is gone before it stored the multimesh
+    reader->Finish();
+    return fault->status;
   }
   grpc::Status OptimizeComesh(grpc::ServerContext* c, const v1::OptimizeComeshRequest* q,
                               grpc::ServerWriter<v1::OptimizeComeshResponse>* w) override {
@@ -332,6 +355,7 @@ TEST(LoadGeneratorTest, StreamsFailOverLikeTheClientLibrary) {
   front.faults = {{grpc::Status(grpc::StatusCode::UNAVAILABLE, "Socket closed"), 5},
                   {proxy_reset, 3}};
   front.optimize_faults = {{proxy_reset, 1}};
+  front.build_faults = {{grpc::Status(grpc::StatusCode::UNAVAILABLE, "Socket closed"), 1}};
   front.get_session_faults = 1;
   grpc::ServerBuilder builder;
   builder.RegisterService(&front);
@@ -352,7 +376,8 @@ TEST(LoadGeneratorTest, StreamsFailOverLikeTheClientLibrary) {
 
   EXPECT_EQ(report->requests, 20);
   EXPECT_EQ(report->errors, 0) << table;
-  EXPECT_EQ(report->retries, 4) << table;  // two stream resumes, one optimization, one GetSession
+  // Two stream resumes, one optimization, one build, one GetSession.
+  EXPECT_EQ(report->retries, 5) << table;
   EXPECT_EQ(report->rpcs.at("Inbetween").calls, 2);  // a stream is one request, retries included
   EXPECT_EQ(report->streams_completed, 2);
   // Resumed frames, and the frames of a resumed optimization's multimesh, equal the second
@@ -364,6 +389,8 @@ TEST(LoadGeneratorTest, StreamsFailOverLikeTheClientLibrary) {
   EXPECT_EQ(front.resumes, (std::vector<bool>{false, true, false}));
   ASSERT_EQ(front.expected_versions.size(), 3u);
   EXPECT_EQ(front.expected_versions[0], front.expected_versions[1]);  // the first attempt's
+  ASSERT_EQ(front.build_versions.size(), 3u);  // broken, sent again, the second project's
+  EXPECT_EQ(front.build_versions[0], front.build_versions[1]);
   EXPECT_TRUE(front.missing_session_id.empty())
       << ::testing::PrintToString(front.missing_session_id);
 }
