@@ -15,6 +15,7 @@
 #include <optional>
 #include <set>
 #include <thread>
+#include <type_traits>
 #include <utility>
 
 #include "absl/strings/match.h"
@@ -317,32 +318,45 @@ class Studio {
 
   // BuildMultimesh with the client library's failover: after a transient failure the same
   // request (same expected_version) is sent again; a build that died before storing left the
-  // session unchanged. A result that arrived ends the call.
+  // session unchanged.
   void BuildAttempt(int attempt, Done done) {
     v1::BuildMultimeshRequest request;
     request.set_session_id(session_.id());
     request.set_expected_version(session_.version());
-    auto result = std::make_shared<std::optional<v1::BuildMultimeshResult>>();
-    Stream<v1::BuildMultimeshRequest, v1::BuildMultimeshResponse>(
-        std::move(request),
-        [this](auto* c, auto* q, auto* r) { stub_.async()->BuildMultimesh(c, q, r); },
-        [result](v1::BuildMultimeshResponse& response) {
+    WritingStream<v1::BuildMultimeshResponse>(
+        "BuildMultimesh", std::move(request),
+        [this](auto* c, auto* q, auto* r) { stub_.async()->BuildMultimesh(c, q, r); }, attempt,
+        [this](int next, Done d) { BuildAttempt(next, std::move(d)); }, std::move(done));
+  }
+
+  // One attempt of a stream that writes the session and ends with a `result` holding it: the
+  // result is the last message, sent after the session was written, so the call is done once it
+  // arrived, even if the connection broke after it; otherwise a transient failure is retried by
+  // `again(attempt + 1, done)` after the client library's backoff.
+  template <class Response, class Request, class Start>
+  void WritingStream(const char* rpc, Request request, Start start, int attempt,
+                     std::function<void(int, Done)> again, Done done) {
+    using Result = std::decay_t<decltype(std::declval<Response>().result())>;
+    auto result = std::make_shared<std::optional<Result>>();
+    Stream<Request, Response>(
+        std::move(request), std::move(start),
+        [result](Response& response) {
           if (response.has_result()) *result = std::move(*response.mutable_result());
           return absl::OkStatus();
         },
-        [this, attempt, result, done](absl::Status status) {
+        [this, rpc, attempt, again = std::move(again), result, done](absl::Status status) {
           if (*result) {
             session_ = (*result)->session();
             return done(absl::OkStatus());
           }
           if (status.ok()) {
-            return done(absl::InternalError("BuildMultimesh stream ended without a result"));
+            return done(absl::InternalError(absl::StrCat(rpc, " stream ended without a result")));
           }
           const grpc::Status as_grpc(static_cast<grpc::StatusCode>(status.code()),
                                      std::string(status.message()));
           std::optional<std::chrono::milliseconds> backoff = Backoff(attempt, as_grpc);
           if (!backoff) return done(status);
-          timer_.After(*backoff, [this, attempt, done] { BuildAttempt(attempt + 1, done); });
+          timer_.After(*backoff, [attempt, again, done] { again(attempt + 1, done); });
         });
   }
 
@@ -354,35 +368,16 @@ class Studio {
 
   // OptimizeComesh with the client library's failover: after a transient failure it is sent
   // again with resume = true and the version the first attempt started from (the server goes on
-  // from the run's last checkpoint). The result is the last message, sent after the session was
-  // written: the call is done once it arrived, even if the connection broke after it.
+  // from the run's last checkpoint).
   void OptimizeAttempt(int attempt, Done done) {
     v1::OptimizeComeshRequest request;
     request.set_session_id(session_.id());
     request.set_expected_version(session_.version());
     request.set_resume(attempt > 1);
-    auto result = std::make_shared<std::optional<v1::OptimizeComeshResult>>();
-    Stream<v1::OptimizeComeshRequest, v1::OptimizeComeshResponse>(
-        std::move(request),
-        [this](auto* c, auto* q, auto* r) { stub_.async()->OptimizeComesh(c, q, r); },
-        [result](v1::OptimizeComeshResponse& response) {
-          if (response.has_result()) *result = std::move(*response.mutable_result());
-          return absl::OkStatus();
-        },
-        [this, attempt, result, done](absl::Status status) {
-          if (*result) {
-            session_ = (*result)->session();
-            return done(absl::OkStatus());
-          }
-          if (status.ok()) {
-            return done(absl::InternalError("OptimizeComesh stream ended without a result"));
-          }
-          const grpc::Status as_grpc(static_cast<grpc::StatusCode>(status.code()),
-                                     std::string(status.message()));
-          std::optional<std::chrono::milliseconds> backoff = Backoff(attempt, as_grpc);
-          if (!backoff) return done(status);
-          timer_.After(*backoff, [this, attempt, done] { OptimizeAttempt(attempt + 1, done); });
-        });
+    WritingStream<v1::OptimizeComeshResponse>(
+        "OptimizeComesh", std::move(request),
+        [this](auto* c, auto* q, auto* r) { stub_.async()->OptimizeComesh(c, q, r); }, attempt,
+        [this](int next, Done d) { OptimizeAttempt(next, std::move(d)); }, std::move(done));
   }
 
   void Frames() {
