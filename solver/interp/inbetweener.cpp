@@ -186,9 +186,15 @@ struct Inbetweener::Impl {
   // weights of the last one (warm start without the cold-start check).
   Points last_frame, frame_before_last;
   ExampleWeights last_weights;
-  // Set by Zhu17 when the frame it returns is known to have no boundary vertex inside the shape
-  // (the overlap pass then only counts crossings).
-  bool known_inside_free = false;
+  // What a frame is checked for: inverted triangles and overlaps (W_O).
+  struct Validity {
+    int inverted = 0;
+    int overlaps = 0;
+    bool clean() const { return inverted == 0 && overlaps == 0; }
+  };
+  // Set by Zhu17 when it checked the frame it returns (Solve reports it instead of checking
+  // again).
+  std::optional<Validity> known_validity;
   mutable Eigen::MatrixXd solve_scratch;  // right-hand sides of GlobalSolve
 
   // What one frame's objective is made of (see the header comment).
@@ -225,9 +231,10 @@ struct Inbetweener::Impl {
   absl::StatusOr<Coords> Zhu17(const ExampleWeights& w, const Frame& previous,
                                const Frame& before_previous, const CancelToken* cancel,
                                FrameReport* report);
-  // No inverted triangle and no overlap.
-  bool Clean(const Coords& x) const {
-    return CountInverted(triangles, x) == 0 && overlap->Count(x) == 0;
+  // `inside_free`: x is known to have no boundary vertex inside the shape (only crossings are
+  // counted then).
+  Validity Check(const Coords& x, bool inside_free = false) const {
+    return {CountInverted(triangles, x), inside_free ? overlap->Crossings(x) : overlap->Count(x)};
   }
   // Moves *to back towards the clean `from` until it is clean: the largest fraction t of the
   // step found by bisection (`from` + t (*to - `from`), t in [0, 1]); returns t. *first_bad:
@@ -635,7 +642,7 @@ double Inbetweener::Impl::HoldBack(const Coords& from, Coords* to, Coords* first
   double good = 0.0, bad = 1.0;
   for (int k = 0; k < 12; ++k) {  // 1/4096 of the step
     const double t = 0.5 * (good + bad);
-    if (Clean(from + t * step)) {
+    if (Check(from + t * step).clean()) {
       good = t;
     } else {
       bad = t;
@@ -708,15 +715,18 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
     const Coords unpushed = x;
     absl::StatusOr<bool> inside_free = EnforceNonOverlap(&p, &x, cancel, report);
     if (!inside_free.ok()) return inside_free.status();
-    known_inside_free = *inside_free;
-    if (!Clean(x)) {
+    Validity checked = Check(x, *inside_free);
+    if (!checked.clean()) {
       // The push-out left an overlap (or folded a triangle to make room): the frame stops where
       // the motion from the previous frame first meets one instead, when that frame is clean.
-      if (CountInverted(triangles, x) > 0 && CountInverted(triangles, unpushed) == 0) x = unpushed;
-      if (prev && Clean(*prev)) {
+      if (checked.inverted > 0 && CountInverted(triangles, unpushed) == 0) {
+        x = unpushed;
+        checked = Check(x);
+      }
+      if (prev && Check(*prev).clean()) {
         Coords first_bad;
         report->hold_back = 1.0 - HoldBack(*prev, &x, &first_bad);
-        known_inside_free = true;
+        checked = Validity{};  // HoldBack's point is clean, and so is a resumed push kept
         // Continue from the clean frame where the motion met the overlap, with the contacts of
         // that meeting: the push then starts on the right side of every contact instead of
         // from deep inside. Kept when it comes out clean.
@@ -724,15 +734,16 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
         absl::StatusOr<bool> resumed_free =
             EnforceNonOverlap(&p, &resumed, cancel, report, overlap->Contacts(first_bad));
         if (!resumed_free.ok()) return resumed_free.status();
-        if (Clean(resumed)) {
+        if (Check(resumed).clean()) {
           x = std::move(resumed);
           report->hold_back = 0.0;
         }
       }
     }
+    known_validity = checked;
   }
   if (options.epsilon <= 0.0 || !prev) return x;
-  known_inside_free = false;
+  known_validity.reset();
 
   // Dynamics (S-eq.28/29): x is Phi.
   const Coords& x1 = *prev;
@@ -803,7 +814,7 @@ absl::StatusOr<Frame> Inbetweener::Impl::Solve(const ExampleWeights& weights, co
 
   FrameReport local;
   Coords x;
-  known_inside_free = false;
+  known_validity.reset();
   if (unit >= 0 && options.exact_keys) {
     x = shapes[unit];
   } else if (options.method == InterpMethod::kLinear) {
@@ -821,9 +832,10 @@ absl::StatusOr<Frame> Inbetweener::Impl::Solve(const ExampleWeights& weights, co
   if (options.method != InterpMethod::kZhu17 || (unit >= 0 && options.exact_keys)) {
     local.energy = arap->Value(x, weights);
   }
-  local.inverted = CountInverted(triangles, x);
+  const Validity validity = known_validity ? *known_validity : Check(x);
+  local.inverted = validity.inverted;
+  local.overlaps = validity.overlaps;
   AreaRatios(x, weights, &local);
-  local.overlaps = known_inside_free ? overlap->Crossings(x) : overlap->Count(x);
   local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (report != nullptr) *report = local;
   Frame frame{ToPoints(x)};

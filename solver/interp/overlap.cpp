@@ -302,7 +302,17 @@ std::vector<OverlapContact> OverlapChecker::Contacts(const Coords& x) const {
         queue.emplace(distance, u);  // the shared edge is the nearest u can be reached through
       }
     }
-    if (best_segment < 0) continue;  // enclosed by its own triangles: nowhere to go
+    if (best_segment < 0) {
+      // Every boundary edge the walk can reach is incident to v: the closest segment that is not
+      // (so every vertex inside has a contact, and no contact means none inside).
+      for (int s = 0; s < static_cast<int>(segments_.size()); ++s) {
+        const auto [a, b] = segments_[s];
+        if (a == v || b == v) continue;
+        const Eigen::Vector2d q = ClosestOnSegment(p, P(x, a), P(x, b));
+        if ((q - p).norm() < best) best = (q - p).norm(), best_segment = s, best_point = q;
+      }
+      if (best_segment < 0) continue;  // no boundary but its own: not reachable in a valid mesh
+    }
     const auto [a, b] = segments_[best_segment];
     const Eigen::Vector2d d = P(x, b) - P(x, a);
     // Triangles are positive, so the interior is on the segment's left.

@@ -47,7 +47,8 @@ class OverlapChecker {
   // from the triangle holding the vertex outward (best first by distance, never through the
   // vertex's own triangles), so it is a boundary point of the material the vertex entered. The
   // plain closest boundary point is often the vertex's own side (its neighbours along the
-  // boundary are one edge away), which pushes it along its own boundary instead of out.
+  // boundary are one edge away), which pushes it along its own boundary instead of out. Every
+  // vertex inside gets a contact: an empty result means no boundary vertex is inside.
   std::vector<OverlapContact> Contacts(const Coords& x) const;
 
   const std::vector<int>& boundary_vertices() const { return boundary_vertices_; }
