@@ -117,8 +117,9 @@ absl::StatusOr<SessionState> Load(const SessionStore& store, const std::string& 
 
 // Load for a mutation: also checks expected_version against the current version.
 absl::StatusOr<SessionState> LoadForUpdate(const SessionStore& store, const std::string& id,
-                                           uint64_t expected_version, const Caller& caller) {
-  absl::StatusOr<SessionState> state = Load(store, id, caller);
+                                           uint64_t expected_version, const Caller& caller,
+                                           bool latest = false) {
+  absl::StatusOr<SessionState> state = Load(store, id, caller, latest);
   if (!state.ok()) return state.status();
   if (state->session.version() != expected_version) {
     return StaleVersionError(id, state->session.version(), expected_version);
@@ -850,12 +851,9 @@ grpc::Status InbetweenService::OptimizeComesh(
   return RunRpc(
       options_, context, "OptimizeComesh", request->session_id(), &caller, [&]() -> absl::Status {
         absl::StatusOr<SessionState> state =
-            Load(*store_, request->session_id(), caller, /*latest=*/request->resume());
+            LoadForUpdate(*store_, request->session_id(), request->expected_version(), caller,
+                          /*latest=*/request->resume());
         if (!state.ok()) return state.status();
-        if (state->session.version() != request->expected_version()) {
-          return StaleVersionError(request->session_id(), state->session.version(),
-                                   request->expected_version());
-        }
         // Checkpoints are written without moving the version (docs/api.md "Resuming
         // OptimizeComesh"): one stored at this version is of a run on this multimesh.
         const std::shared_ptr<const StoredComeshCheckpoint> checkpoint = state->comesh_checkpoint;
@@ -1020,8 +1018,7 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
         }
         // Key times: parameters.key_times when set, else the drawings' key_time when every
         // drawing has one, else evenly spaced keys.
-        std::vector<double> key_times(parameters.key_times().begin(),
-                                      parameters.key_times().end());
+        std::vector<double> key_times(parameters.key_times().begin(), parameters.key_times().end());
         const bool from_parameters = !key_times.empty();
         if (!from_parameters) {
           for (const v1::Drawing& drawing : session.drawings()) {
@@ -1040,7 +1037,7 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
             solver::MakeSchedule(num_drawings, plan->frames, key_times, *timing);
         if (!schedule.ok()) {
           return absl::Status(schedule.status().code(),
-                              absl::StrCat(from_parameters      ? "parameters.key_times: "
+                              absl::StrCat(from_parameters     ? "parameters.key_times: "
                                            : key_times.empty() ? "frame schedule: "
                                                                : "drawings' key_time: ",
                                            schedule.status().message()));
