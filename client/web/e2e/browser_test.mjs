@@ -18,9 +18,9 @@ import { parseArgs } from "node:util";
 import { fromBinary } from "@bufbuild/protobuf";
 import { createClient } from "@connectrpc/connect";
 import { createConnectTransport } from "@connectrpc/connect-node";
-import { chromium } from "playwright-core";
 
 import { Inbetween, InbetweenRequestSchema } from "../src/gen/inbetween/v1/inbetween_pb.js";
+import { launchChromium, stepRunner } from "./harness.mjs";
 
 const { values: args } = parseArgs({
   options: {
@@ -39,22 +39,9 @@ for (const k of ["url", "out", "first", "second", "bad", "cut"]) {
 const cut = args.cut.split(",").map(Number);
 
 const STEP_MS = 60_000; // bound on any one wait; the whole test is bounded by ctest's timeout
-let passed = 0;
-let failed = 0;
 const problems = [];
-
-async function step(name, fn) {
-  const t0 = Date.now();
-  try {
-    await fn();
-    passed++;
-    console.log(`ok   ${name} (${Date.now() - t0} ms)`);
-  } catch (err) {
-    failed++;
-    console.log(`FAIL ${name}: ${err.message.split("\n").slice(0, 6).join("\n     ")}`);
-    throw err;
-  }
-}
+// A failed step ends the run: the later steps build on the earlier ones.
+const { step, counts } = stepRunner({ stopOnFailure: true });
 
 const text = (page, sel) => page.locator(sel).textContent();
 
@@ -93,21 +80,7 @@ async function scrubTo(page, i) {
   }, i);
 }
 
-const browser = await chromium.launch({
-  executablePath: args.chromium,
-  // root in containers/CI cannot use Chromium's sandbox; the page only talks to loopback.
-  args: [
-    "--no-sandbox",
-    "--disable-gpu",
-    // No network but loopback here: keep Chromium from reaching out on its own.
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--disable-quic",
-    "--no-first-run",
-  ],
-  timeout: STEP_MS,
-});
+const browser = await launchChromium(args.chromium, STEP_MS);
 const pageErrors = [];
 let exitCode = 1;
 try {
@@ -562,7 +535,8 @@ try {
   exitCode = 1;
 } finally {
   await browser.close();
-  console.log(`${passed} passed, ${failed} failed`);
-  writeFileSync(join(args.out, "result.txt"), `${passed} passed, ${failed} failed\n`);
+  const summary = `${counts.passed} passed, ${counts.failed} failed`;
+  console.log(summary);
+  writeFileSync(join(args.out, "result.txt"), `${summary}\n`);
 }
 process.exit(exitCode);

@@ -16,7 +16,7 @@ import { basename, dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
 import { parseArgs } from "node:util";
 
-import { chromium } from "playwright-core";
+import { launchChromium, stepRunner } from "./harness.mjs";
 
 const { values: args, positionals: files } = parseArgs({
   options: {
@@ -115,19 +115,8 @@ const server = createServer((req, res) => {
 await new Promise((resolve) => server.listen(0, "127.0.0.1", resolve));
 const base = `http://127.0.0.1:${server.address().port}`;
 
-let passed = 0;
-let failed = 0;
-async function step(name, fn) {
-  const t0 = Date.now();
-  try {
-    await fn();
-    passed++;
-    console.log(`ok   ${name} (${Date.now() - t0} ms)`);
-  } catch (err) {
-    failed++;
-    console.log(`FAIL ${name}: ${err.message.split("\n").slice(0, 6).join("\n     ")}`);
-  }
-}
+// Every step runs: one broken file does not hide the others.
+const { step, counts } = stepRunner({ stopOnFailure: false });
 
 // The first vertex of the first path at frame k as the file gives it: keyframes sit on whole
 // frames, so frame k shows the last keyframe with t <= k.
@@ -183,23 +172,7 @@ async function checkAnimation(name, bytes) {
   return infos;
 }
 
-const browser = await chromium.launch({
-  executablePath: args.chromium,
-  headless: true,
-  // root in containers/CI cannot use Chromium's sandbox; the page only talks to loopback.
-  args: [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    // No network but loopback here: keep Chromium from reaching out on its own.
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-  ],
-  timeout: STEP_MS,
-});
+const browser = await launchChromium(args.chromium, STEP_MS);
 const offsite = [];
 try {
   const context = await browser.newContext();
@@ -261,5 +234,5 @@ try {
   await browser.close();
   server.close();
 }
-console.log(`${passed} passed, ${failed} failed`);
-process.exit(failed === 0 ? 0 : 1);
+console.log(`${counts.passed} passed, ${counts.failed} failed`);
+process.exit(counts.failed === 0 ? 0 : 1);
