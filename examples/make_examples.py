@@ -216,3 +216,20 @@ write('principles_overlapping_action', [
     ('3_settle.svg', block_svg('Overlapping action key 3: the short strand settles first', 130, [(-42, -12, 26, 6), (-20, -32, 38, 6)], '#508050')),
     ('4_rest.svg', block_svg('Overlapping action key 4: both at rest', 130, [(-42, -20, 26, 6), (-20, -46, 38, 6)], '#508050')),
 ])
+
+# Timing: a bouncing ball whose keys are spaced in time as a falling ball is (fall time ~ sqrt of
+# the height): the long first fall takes most of the frames, the lower hop fewer. The key times
+# are the principle; the ball moves on at a steady pace across (x follows the key time).
+def bounce_key(t, cy):
+    return '  <circle id="ball" fill="#3070c0" cx="%s" cy="%s" r="12"/>\n' % (f(20 + 160 * t), f(cy))
+ground, top1, hop = 96, 24, 32  # ball centre on the ground, at the drop, and height of the second hop
+fall1, fall2 = math.sqrt(ground - top1), math.sqrt(hop)
+k = [0, fall1, fall1 + fall2, fall1 + 2 * fall2]
+k = [round(v / k[-1], 2) for v in k]
+timing_keys = [('1_drop.svg', 'Timing key 1: the ball dropped from high (key time 0)', top1),
+               ('2_bounce.svg', 'Timing key 2: first bounce at key time %s: the long fall takes most of the frames' % k[1], ground),
+               ('3_hop.svg', 'Timing key 3: top of a lower hop at key time %s: a shorter hop, fewer frames' % k[2], ground - hop),
+               ('4_land.svg', 'Timing key 4: lands again (key time 1)', ground)]
+write('principles_timing',
+      [(fn, svg(200, 120, title, bounce_key(t, cy))) for (fn, title, cy), t in zip(timing_keys, k)],
+      drawings=[{'file': fn, 'key_time': t} for (fn, _, _), t in zip(timing_keys, k)])
