@@ -233,3 +233,18 @@ timing_keys = [('1_drop.svg', 'Timing key 1: the ball dropped from high (key tim
 write('principles_timing',
       [(fn, svg(200, 120, title, bounce_key(t, cy))) for (fn, title, cy), t in zip(timing_keys, k)],
       drawings=[{'file': fn, 'key_time': t} for (fn, _, _), t in zip(timing_keys, k)])
+
+# Exaggeration: the squash and stretch ball pushed far beyond a natural squash (area kept). Marks
+# every 22.5 degrees of the ellipse's parameter keep the arc-length correspondence from sliding
+# round the ends, which would fold the ball into a diamond between the stretch and the splat.
+def exaggerated(cx, cy, rx, ry):
+    b = ellipse(cx, cy, rx, ry, '#c8408a')
+    for i in range(16):
+        a = math.radians(22.5 * i)
+        b += '  <circle data-corr="%d" cx="%s" cy="%s" r="1" fill="red"/>\n' % (i + 1, f(cx + rx * math.cos(a)), f(cy - ry * math.sin(a)))
+    return b
+write('principles_exaggeration', [
+    ('1_round.svg', svg(140, 120, 'Exaggeration key 1: ball at the top', exaggerated(70, 24, 20, 20))),
+    ('2_stretch.svg', svg(140, 120, 'Exaggeration key 2: stretched to twice its height as it falls', exaggerated(70, 62, 10, 40))),
+    ('3_splat.svg', svg(140, 120, 'Exaggeration key 3: splatted flat on the ground, five times its width', exaggerated(70, 110, 50, 8))),
+])
