@@ -248,3 +248,16 @@ write('principles_exaggeration', [
     ('2_stretch.svg', svg(140, 120, 'Exaggeration key 2: stretched to twice its height as it falls', exaggerated(70, 62, 10, 40))),
     ('3_splat.svg', svg(140, 120, 'Exaggeration key 3: splatted flat on the ground, five times its width', exaggerated(70, 110, 50, 8))),
 ])
+
+# Secondary action: the block character walks right (the primary action: steps and a bob) while
+# it waves hello, a motion of its own that the walk does not cause (unlike follow-through). The
+# arm is a tail of block() on its front edge: the drawing is block() mirrored.
+def waver_svg(title, x, bob, arm):
+    return svg(190, 100, title, '  <path id="body" fill="#d08a30" transform="translate(190 %s) scale(-1 1)"\n        d="%s"/>\n'
+               % (f(90 + bob), block(190 - x, [(-40, arm, 28, 6)])))
+write('principles_secondary_action', [
+    ('1_wave_up.svg', waver_svg('Secondary action key 1: walking right, the hand waves up', 35, 0, 60)),
+    ('2_wave_out.svg', waver_svg('Secondary action key 2: a step on, the hand waves out', 65, -4, 22)),
+    ('3_wave_up.svg', waver_svg('Secondary action key 3: another step, the hand up again', 95, 0, 60)),
+    ('4_wave_out.svg', waver_svg('Secondary action key 4: last step, the hand out again', 125, -4, 22)),
+])
