@@ -261,3 +261,40 @@ write('principles_secondary_action', [
     ('3_wave_up.svg', waver_svg('Secondary action key 3: another step, the hand up again', 95, 0, 60)),
     ('4_wave_out.svg', waver_svg('Secondary action key 4: last step, the hand out again', 125, -4, 22)),
 ])
+
+# Staging: a figure shows us a ball. Held in front of its chest the ball is lost in the
+# silhouette (only a bump); held out at arm's length, then up and away from the body, the action
+# reads in silhouette alone. The arm leaves the front edge (x = 76) at angle a (degrees up from
+# +x) and ends in the ball; marks: the neck, the arm's (or the bump's) ends on the body, the far
+# side of the ball and the feet.
+def holder(a, length, r=10):
+    d = (math.cos(math.radians(a)), -math.sin(math.radians(a)))
+    n = (-d[1], d[0])  # d turned a quarter clockwise on screen
+    A = (76, 80)
+    C = add(A, d, length)
+    if length <= r:  # the ball on the body edge: its part beyond x = 76
+        h = math.sqrt(r * r - (76 - C[0]) ** 2)
+        ends = [(76, C[1] - h), (76, C[1] + h)]
+        p = [ends[0]]
+    else:
+        w = 4
+        root = [(76, A[1] - w / math.cos(math.radians(a))), (76, A[1] + w / math.cos(math.radians(a)))]
+        c = math.sqrt(r * r - w * w)
+        ends = [add(add(C, d, -c), n, -w), add(add(C, d, -c), n, w)]
+        p = [root[0], ends[0]]
+    a0 = math.atan2(ends[0][1] - C[1], ends[0][0] - C[0])
+    a1 = math.atan2(ends[1][1] - C[1], ends[1][0] - C[0])
+    while a1 < a0:
+        a1 += 2 * math.pi
+    k = 16
+    p += [(C[0] + r * math.cos(a0 + (a1 - a0) * i / k), C[1] + r * math.sin(a0 + (a1 - a0) * i / k)) for i in range(1, k)]
+    p += [ends[1]] + ([] if length <= r else [root[1]])
+    marks = [(76, 60), p[0], add(C, d, r), p[-1], (76, 120), (40, 120)]
+    dpath = 'M 40 120 L 40 60 A 20 20 0 1 1 76 60 L ' + ' L '.join('%s %s' % (f(x), f(y)) for x, y in p) + ' L 76 120 Z'
+    return ('  <path id="figure" fill="#407a68" d="%s"/>\n' % dpath +
+            ''.join('  <circle data-corr="%d" cx="%s" cy="%s" r="1" fill="red"/>\n' % (i + 1, f(x), f(y)) for i, (x, y) in enumerate(marks)))
+write('principles_staging', [
+    ('1_hidden.svg', svg(150, 125, 'Staging key 1: the ball held in front of the chest is lost in the silhouette', holder(0, 4))),
+    ('2_out.svg', svg(150, 125, 'Staging key 2: the arm brings the ball out to the side, clear of the body', holder(5, 34))),
+    ('3_shown.svg', svg(150, 125, 'Staging key 3: the ball held up and away: the action reads in silhouette alone', holder(40, 38))),
+], {'meshing': {'boundary_vertices': 120, 'max_edge_relative': 0.1}})
