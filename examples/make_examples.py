@@ -298,3 +298,29 @@ write('principles_staging', [
     ('2_out.svg', svg(150, 125, 'Staging key 2: the arm brings the ball out to the side, clear of the body', holder(5, 34))),
     ('3_shown.svg', svg(150, 125, 'Staging key 3: the ball held up and away: the action reads in silhouette alone', holder(40, 38))),
 ], {'meshing': {'boundary_vertices': 120, 'max_edge_relative': 0.1}})
+
+# Straight ahead action (and pose to pose): a flame flickers, a motion drawn straight ahead, each
+# key drawn on from the one before with no pose planned ahead (the other principles examples are
+# pose to pose: extremes first, then the inbetweens). The outline is a closed Catmull-Rom spline
+# through the points (smooth tips, no spikes): base, left side, left tongue, notch, main tip,
+# notch, right tongue, right side.
+def flame_path(tip, left, right, notches=((48, 66), (70, 62))):
+    p = [(60, 112), (38, 100), (32, 80), left, notches[0], tip, notches[1], right, (88, 82), (82, 100)]
+    n = len(p)
+    d = 'M %s %s' % (f(p[0][0]), f(p[0][1]))
+    for i in range(n):
+        a, b, c, e = p[i - 1], p[i], p[(i + 1) % n], p[(i + 2) % n]
+        c1 = (b[0] + (c[0] - a[0]) / 6, b[1] + (c[1] - a[1]) / 6)
+        c2 = (c[0] - (e[0] - b[0]) / 6, c[1] - (e[1] - b[1]) / 6)
+        d += ' C %s %s %s %s %s %s' % (f(c1[0]), f(c1[1]), f(c2[0]), f(c2[1]), f(c[0]), f(c[1]))
+    return '  <path id="flame" fill="#e8762a" d="%s Z"/>\n' % d
+write('principles_straight_ahead_pose_to_pose', [
+    ('1_flame.svg', svg(120, 120, 'Straight ahead key 1: the flame as first drawn',
+                        flame_path((58, 14), (36, 50), (84, 42)))),
+    ('2_flame.svg', svg(120, 120, 'Straight ahead key 2: drawn on from key 1: the tip licks left, the right tongue rises',
+                        flame_path((44, 20), (34, 56), (88, 32), ((46, 70), (68, 58))))),
+    ('3_flame.svg', svg(120, 120, 'Straight ahead key 3: drawn on from key 2: the tip leaps up and right, the left tongue rises',
+                        flame_path((70, 6), (30, 40), (86, 52), ((50, 62), (74, 66))))),
+    ('4_flame.svg', svg(120, 120, 'Straight ahead key 4: drawn on from key 3: the flame sinks and leans left',
+                        flame_path((50, 22), (32, 48), (82, 46), ((46, 66), (66, 64))))),
+], {'meshing': {'boundary_vertices': 120, 'max_edge_relative': 0.1}})
