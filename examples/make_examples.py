@@ -324,3 +324,34 @@ write('principles_straight_ahead_pose_to_pose', [
     ('4_flame.svg', svg(120, 120, 'Straight ahead key 4: drawn on from key 3: the flame sinks and leans left',
                         flame_path((50, 22), (32, 48), (82, 46), ((46, 66), (66, 64))))),
 ], {'meshing': {'boundary_vertices': 120, 'max_edge_relative': 0.1}})
+
+# Solid drawing: an open box (a cube without its lid, seen from 35 degrees above) turns about
+# its vertical axis; its outline and its opening (a hole: the top face inset by the wall
+# thickness) foreshorten together as a solid's would. For turns between 0 and 90 degrees the
+# outline is always the same six corners of the cube (the left, back and right ones of the top,
+# the right, front and left ones of the foot) and the opening the four inset ones: all ten are
+# marks, so corners map to corners and turn instead of being rounded off between the keys.
+def box_corners(psi, half, y, elev=35):
+    e = math.radians(elev)
+    out = []
+    for a in (135, 225, 315, 45):  # left, back, right, front at psi = 0 (x right, z towards us)
+        t = math.radians(a + psi)
+        x, z = half * math.sqrt(2) * math.cos(t), half * math.sqrt(2) * math.sin(t)
+        out.append((70 + x, 92 - (y * math.cos(e) - z * math.sin(e))))
+    return out
+
+def open_box(psi, side=56, wall=6):
+    bottom, top = box_corners(psi, side / 2, 0), box_corners(psi, side / 2, side)
+    inner = box_corners(psi, side / 2 - wall, side)
+    outline = [bottom[0], top[0], top[1], top[2], bottom[2], bottom[3]]
+    d = 'M ' + ' L '.join('%s %s' % (f(x), f(y)) for x, y in outline) + ' Z'
+    d += ' M ' + ' L '.join('%s %s' % (f(x), f(y)) for x, y in inner) + ' Z'
+    b = '  <path id="box" fill="#7a6a58" fill-rule="evenodd" d="%s"/>\n' % d
+    for i, p in enumerate(outline + inner):
+        b += '  <circle data-corr="%d" cx="%s" cy="%s" r="1" fill="red"/>\n' % (i + 1, f(p[0]), f(p[1]))
+    return b
+write('principles_solid_drawing', [
+    ('1_turn15.svg', svg(140, 120, 'Solid drawing key 1: an open box, turned 15 degrees', open_box(15))),
+    ('2_turn45.svg', svg(140, 120, 'Solid drawing key 2: turned 45 degrees, corner on', open_box(45))),
+    ('3_turn75.svg', svg(140, 120, 'Solid drawing key 3: turned 75 degrees', open_box(75))),
+])
