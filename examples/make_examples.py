@@ -355,3 +355,27 @@ write('principles_solid_drawing', [
     ('2_turn45.svg', svg(140, 120, 'Solid drawing key 2: turned 45 degrees, corner on', open_box(45))),
     ('3_turn75.svg', svg(140, 120, 'Solid drawing key 3: turned 75 degrees', open_box(75))),
 ])
+
+# Appeal: the same face redesigned to charm: from a long head with small eyes set high and a flat
+# mouth to a round head, big eyes set lower and a wide smile, with a tilt. One path, the eyes and
+# the mouth its holes; marks 1 and 2 are the corners of the mouth.
+def oval(cx, cy, rx, ry):
+    return 'M %s %s A %s %s 0 1 0 %s %s A %s %s 0 1 0 %s %s Z' % (
+        f(cx - rx), f(cy), f(rx), f(ry), f(cx + rx), f(cy), f(rx), f(ry), f(cx - rx), f(cy))
+
+def face_svg(title, head, eye, eye_dx, eye_y, mouth, tilt=0):
+    (l, y), (r, _) = mouth[0], mouth[1]
+    d = oval(60, 60, *head) + ' ' + oval(60 - eye_dx, eye_y, *eye) + ' ' + oval(60 + eye_dx, eye_y, *eye)
+    d += ' M %s %s Q 60 %s %s %s Q 60 %s %s %s Z' % (f(l), f(y), f(mouth[2]), f(r), f(y), f(mouth[3]), f(l), f(y))
+    b = '  <g transform="rotate(%s 60 60)">\n' % f(tilt)
+    b += '    <path id="face" fill="#e0a070" fill-rule="evenodd" d="%s"/>\n' % d
+    b += ''.join('    <circle data-corr="%d" cx="%s" cy="%s" r="1" fill="red"/>\n' % (i + 1, f(x), f(y)) for i, x in enumerate((l, r)))
+    return svg(120, 110, title, b + '  </g>\n')
+write('principles_appeal', [
+    ('1_plain.svg', face_svg('Appeal key 1: a plain face: long head, small eyes set high, a flat mouth',
+                             (30, 42), (4, 4.5), 14, 44, ((50, 80), (70, 80), 78, 86))),
+    ('2_rounder.svg', face_svg('Appeal key 2: a rounder head, bigger eyes set lower, the mouth starts to smile',
+                               (36, 38), (7, 8.5), 14, 54, ((46, 80), (74, 80), 83, 92))),
+    ('3_appealing.svg', face_svg('Appeal key 3: round head, big eyes, a wide smile and a tilt of the head',
+                                 (38, 36), (8.5, 10.5), 15, 56, ((42, 77), (78, 77), 84, 100), -6)),
+], {'meshing': {'boundary_vertices': 120, 'max_edge_relative': 0.1}})
