@@ -62,20 +62,47 @@ def intersect(p, d, q, e):
     s = ((q[0] - p[0]) * e[1] - (q[1] - p[1]) * e[0]) / den
     return add(p, d, s)
 
-# --- walking character, half a walk cycle (contact, passing, up, contact); a "down" pose
-#     (20, -24) did not build with the others (see the closing note)
+# --- walking character, a whole walk cycle in 16 keys (two steps: contact, down, passing, up).
+#     Side-view silhouette: head, torso, one arm, two legs. Where a limb lies across the body the
+#     silhouette alone loses it, so a cut draws its edge inside the body: the legs in the passing
+#     poses (one strip, cut down the middle) and the arm while it swings back across the torso
+#     (a cut along its hand end and inner edge). Marks: 1 the crotch (the tip of the legs'
+#     cut when they pass), 2 the armpit (the tip of the arm's cut when it lies on the torso), 3 the
+#     front hip.
+ARM_W, ARM_L = 7, 34
+
 def walker(front, back, arm, passing=False):
     P = (0, -6); w = 9; L = 54
     out = []
+    cuts = []
+    marks = {}
     # head (arc) and neck, walked clockwise on screen from the back of the neck
     head = 'M -3 -66 A 11 11 0 1 1 5 -66'
     out_pts = [(5, -62), (9, -60)]
-    # arm on the torso front (x = 9) from the shoulder
-    T = (9, -60); d = unit(arm); n = (-math.cos(math.radians(arm)), math.sin(math.radians(arm)))
-    wa, La = 7, 34
-    hand = add(T, d, La)
-    out_pts += [hand, add(add(hand, n, wa), d, 2), intersect(add(T, n, wa), d, T, (0, 1))]
+    d = unit(arm); n = (-math.cos(math.radians(arm)), math.sin(math.radians(arm)))
+    T = (9, -60)
+    hand = add(T, d, ARM_L)
+    corner = add(add(hand, n, ARM_W), d, 2)
+    marks[8] = hand
+    marks[10] = (1, -66 - math.sqrt(105) - 11)  # the top of the head
+    if corner[0] > 9:
+        # arm held in front of the torso (x = 9): the armpit where its inner edge meets the front
+        armpit = intersect(add(T, n, ARM_W), d, T, (0, 1))
+        out_pts += [hand, corner, armpit]
+        marks[2] = armpit
+        marks[13] = corner
+    else:
+        # arm hanging over the torso front: only the hand shows past the front; the arm's hand
+        # end and inner edge are a cut from where the hand meets the front up to below the
+        # shoulder (the arm stays attached there)
+        x = intersect(hand, add(corner, hand, -1), T, (0, 1))
+        tip = add(add(T, n, ARM_W), d, 6)
+        out_pts += [hand, x]
+        cuts.append([x, corner, tip])
+        marks[2] = tip
+        marks[13] = corner  # on the cut: the arm's side is the first on the boundary
     out_pts += [(9, -10)]
+    marks[3] = (9, -10)  # where the torso front meets the front leg
     def leg_edges(a):
         d = unit(a); n = (math.cos(math.radians(a)), -math.sin(math.radians(a)))
         fr = add(P, n, w / 2); bk = add(P, n, -w / 2)
@@ -84,37 +111,47 @@ def walker(front, back, arm, passing=False):
     db, nb, bf, bb = leg_edges(back)
     toe = lambda e, d, n: add(add(e, n, 8), d, 2)
     if passing:
-        ef, eb = add(ff, df, L), add(fb, df, L)
-        out_pts += [ff, ef, toe(ef, df, nf), add(eb, df, 2), eb, bb]
+        # legs side by side, each as wide as in the other keys: the front leg planted, the back
+        # one lifted a little; a cut between them up to the crotch
+        out_pts += [(9, 48), (17, 50), (0, 50), (0, 46), (-9, 46)]
+        cuts.append([(0, 46), (0, 2)])
+        marks[1] = (0, 2)
+        marks[6] = (17, 50)  # front toe
+        marks[7] = (-9, 46)  # back heel
     else:
         crotch = intersect(fb, df, bf, db)
         ef, eb = add(ff, df, L), add(fb, df, L)
         out_pts += [ff, ef, toe(ef, df, nf), add(eb, df, 2), eb, crotch]
+        marks.update({1: crotch, 6: toe(ef, df, nf), 11: ff, 14: ef, 15: add(eb, df, 2), 16: eb})
         ef, eb = add(bf, db, L), add(bb, db, L)
         out_pts += [ef, toe(ef, db, nb), add(eb, db, 2), eb, bb]
+        marks.update({7: eb, 9: toe(ef, db, nb), 12: bb, 17: ef, 18: add(eb, db, 2)})
     out_pts += [(-9, -10), (-10, -56), (-3, -62)]
+    marks[4] = (-9, -10)  # where the back leg meets the torso
+    marks[5] = (9, -60)  # the shoulder
     dpath = head + ' L ' + ' L '.join('%s %s' % (f(x), f(y)) for x, y in out_pts) + ' Z'
-    return dpath
+    return dpath, cuts, marks
 
-poses = [('contact', 28, -28, 48, 0), ('passing', 0, 0, 32, -1),
-         ('up', 20, -18, 40, -4), ('contact2', 28, -28, 48, 0)]
+# (name, front leg, back leg, arm, body bob): legs in degrees from straight down, arm likewise
+# (below about 11 the arm hangs over the torso front), bob in y (down is positive)
+step = [('contact', 28, -28, 0), ('down', 25, -27, 3), ('rise', 21, -21, 1), ('lift', 17, -17, 0),
+        ('passing', 14, -14, -1), ('up', 17, -16, -3), ('reach', 21, -20, -2), ('fall', 25, -24, -1)]
+arms = [48, 44, 40, 36, 32, 28, 4, 4, 4, 4, 28, 32, 36, 40, 44, 48]
 files = []
-for i, (name, fr, bk, arm, bob) in enumerate(poses):
+for i in range(16):
+    name, fr, bk, bob = step[i % 8]
+    dpath, cuts, marks = walker(fr, bk, arms[i])
     body = '  <g transform="translate(40 %s)">\n' % f(96 + bob)
-    body += '    <path id="walker" fill="#3a3a48" d="%s"/>\n' % walker(fr, bk, arm, name == 'passing')
-    if name == 'passing':
-        body += '    <path class="cut" d="M 0 56 L 0 4" stroke="red" fill="none"/>\n'
-        body += '    <circle data-corr="1" cx="0" cy="4" r="1" fill="red"/>\n'
-    else:
-        P = (0, -6); w = 9
-        fb = add(P, (math.cos(math.radians(fr)), -math.sin(math.radians(fr))), -w / 2)
-        bf = add(P, (math.cos(math.radians(bk)), -math.sin(math.radians(bk))), w / 2)
-        c = intersect(fb, unit(fr), bf, unit(bk))
-        body += '    <circle data-corr="1" cx="%s" cy="%s" r="1" fill="red"/>\n' % (f(c[0]), f(c[1]))
+    body += '    <path id="walker" fill="#3a3a48" d="%s"/>\n' % dpath
+    for c in cuts:
+        body += '    <path class="cut" d="M %s" stroke="red" fill="none"/>\n' % ' L '.join('%s %s' % (f(x), f(y)) for x, y in c)
+    for k in sorted(marks):
+        body += '    <circle data-corr="%d" cx="%s" cy="%s" r="1" fill="red"/>\n' % (k, f(marks[k][0]), f(marks[k][1]))
     body += '  </g>\n'
-    files.append(('%d_%s.svg' % (i + 1, name),
-                  svg(100, 160, 'Walk cycle key %d: %s (side view silhouette)' % (i + 1, name), body)))
-write('walk', files, {'inbetween': {'timing': 'catmull_rom'}})
+    files.append(('%02d_%s.svg' % (i + 1, name),
+                  svg(100, 160, 'Walk cycle key %d of 16: %s, arm at %d degrees (side view silhouette)' % (i + 1, name, arms[i]), body)))
+write('walk', files, {'inbetween': {'timing': 'catmull_rom', 'frames': 91},
+                      'meshing': {'boundary_vertices': 560, 'max_edge_relative': 0.016}})
 
 # --- flying bird: the wing folded onto the body (a cut) opens up and away
 def bird(wing_tip1, wing_tip2, folded):

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -373,8 +374,17 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   }
   mesh.shapes.assign(num_shapes, {});
   mesh.shapes[ref] = targets_of(ref);
-  for (int d = 0, done = 0; d < num_shapes; ++d) {
-    if (d == ref) continue;
+  // Drawings are mapped outward from the reference in key order (ref - 1, ref + 1, ref - 2, ...),
+  // so that a pose the reference's mesh cannot reach directly finds a mapped neighbour to start
+  // from (below).
+  std::vector<int> order;
+  for (int d = 0; d < num_shapes; ++d) {
+    if (d != ref) order.push_back(d);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [ref](int a, int b) { return std::abs(a - ref) < std::abs(b - ref); });
+  int done = 0;
+  for (const int d : order) {
     if (cancelled()) return absl::CancelledError("BuildMultimesh cancelled");
     notify("map", 0.2 + 0.75 * done++ / (num_shapes - 1), absl::StrCat("drawing ", d + 1));
     Points shape = targets_of(d);
@@ -410,9 +420,11 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       // boundary directly; start instead from the map into an already mapped drawing, nearest
       // in key order first (neighbouring keys are usually similar poses).
       std::vector<int> mapped_before;
-      for (int e = d - 1; e >= 0; --e) {
-        if (e != ref && !mesh.shapes[e].empty()) mapped_before.push_back(e);
+      for (int e = 0; e < num_shapes; ++e) {
+        if (e != ref && e != d && !mesh.shapes[e].empty()) mapped_before.push_back(e);
       }
+      std::stable_sort(mapped_before.begin(), mapped_before.end(),
+                       [d](int a, int b) { return std::abs(a - d) < std::abs(b - d); });
       for (size_t k = 0; k < mapped_before.size() && k < 3 && !mapped.ok() &&
                          !absl::IsCancelled(mapped.status());
            ++k) {

@@ -42,7 +42,7 @@ done
 
 # The long stream: walk, 1200 frames (~20 MB of frames, far more than the buffers between the
 # replica and a paused CLI hold).
-WALK=("$INBETWEEN_SRC"/examples/walk/[1-4]_*.svg)
+WALK=("$INBETWEEN_SRC"/examples/walk/0[1-8]_*.svg)
 LONG=(animate "${WALK[@]}" --frames 1200 --format json)
 cli -q "${LONG[@]}" --out "$WORK/reference" >"$WORK/reference.out"
 SESSIONS+=("$(session_of "$WORK/reference.out")")
