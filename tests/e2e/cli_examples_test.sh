@@ -6,10 +6,12 @@
 source "$(dirname "$0")/lib/common.sh"
 lib="$INBETWEEN_SRC/tests/e2e/lib"
 here="$INBETWEEN_SRC/tests/e2e"
-frames=6
 count=0
 while IFS= read -r project; do
   name=$(dirname "${project#"$INBETWEEN_SRC/examples/"}" | tr / _)
+  # 6 frames, or one inbetween between every two keys where there are more keys (walk: 16)
+  keys=$(python3 -c 'import json, sys; print(len(json.load(open(sys.argv[1]))["drawings"]))' "$project")
+  frames=$(( 2 * keys - 1 > 6 ? 2 * keys - 1 : 6 ))
   out="$WORK/$name"
   if ! "$CLI_BIN" animate --project "$project" --frames "$frames" --format json --out "$out" \
       -q > "$WORK/$name.log" 2>&1; then
