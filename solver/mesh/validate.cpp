@@ -1,6 +1,8 @@
 // Validators for meshes and multimeshes: orientation of every triangle in every shape.
 #include "solver/mesh/validate.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
 #include <utility>
@@ -58,7 +60,47 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
           absl::StrCat("multimesh boundary vertex ", v, " out of range [0, ", n, ")"));
     }
   }
+  // Shared topology: one consistently oriented manifold, so each directed edge belongs to one
+  // triangle (a repeated or overlapping triangle or a non-manifold edge uses one twice).
+  std::vector<std::array<int, 3>> directed;  // {from, to, triangle}, sorted
+  directed.reserve(3 * mesh.triangles.size());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    for (int k = 0; k < 3; ++k) directed.push_back({tri[k], tri[(k + 1) % 3], static_cast<int>(t)});
+  }
+  std::sort(directed.begin(), directed.end());
+  for (size_t i = 1; i < directed.size(); ++i) {
+    if (directed[i][0] == directed[i - 1][0] && directed[i][1] == directed[i - 1][1]) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "multimesh triangles ", directed[i - 1][2], " and ", directed[i][2], " both have edge ",
+          directed[i][0], "-", directed[i][1], " (overlapping or non-manifold)"));
+    }
+  }
+  // Boundary vertices on the boundary: each on an edge with a triangle on one side only.
+  std::vector<bool> on_boundary(n, false);
+  for (const auto& [a, b, t] : directed) {
+    const std::array<int, 3> reverse = {b, a, -1};
+    auto it = std::lower_bound(directed.begin(), directed.end(), reverse);
+    if (it == directed.end() || (*it)[0] != b || (*it)[1] != a)
+      on_boundary[a] = on_boundary[b] = true;
+  }
+  for (size_t k = 0; k < mesh.boundary.size(); ++k) {
+    if (!on_boundary[mesh.boundary[k]]) {
+      return absl::InvalidArgumentError(absl::StrCat("multimesh boundary vertex ", mesh.boundary[k],
+                                                     " (boundary[", k,
+                                                     "]) is not on the boundary"));
+    }
+  }
   if (absl::Status s = ValidateBoundaryLoops(mesh); !s.ok()) return s;
+  if (!mesh.boundary_loops.empty()) {
+    std::vector<int> concatenation;
+    for (const std::vector<int>& loop : mesh.boundary_loops) {
+      concatenation.insert(concatenation.end(), loop.begin(), loop.end());
+    }
+    if (concatenation != mesh.boundary) {
+      return absl::InvalidArgumentError("multimesh boundary is not the concatenation of its loops");
+    }
+  }
   if (absl::Status s = ValidateCohesiveEdges(mesh); !s.ok()) return s;
   for (int s = 0; s < mesh.num_shapes(); ++s) {
     for (size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -81,6 +123,7 @@ absl::Status ValidateBoundaryLoops(const Multimesh& mesh) {
     for (int k = 0; k < 3; ++k) directed.insert({t[k], t[(k + 1) % 3]});
   }
   size_t on_loops = 0;
+  std::set<std::pair<int, int>> listed;
   for (size_t l = 0; l < mesh.boundary_loops.size(); ++l) {
     const std::vector<int>& loop = mesh.boundary_loops[l];
     on_loops += loop.size();
@@ -94,6 +137,10 @@ absl::Status ValidateBoundaryLoops(const Multimesh& mesh) {
       if (!directed.count({a, b}) || directed.count({b, a})) {
         return absl::InvalidArgumentError(absl::StrCat("multimesh boundary loop ", l, ": edge ", a,
                                                        "-", b, " is not a boundary edge"));
+      }
+      if (!listed.insert({a, b}).second) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("multimesh boundary loop ", l, ": edge ", a, "-", b, " is listed twice"));
       }
     }
   }
@@ -132,7 +179,8 @@ absl::Status ValidateCohesiveEdges(const Multimesh& mesh, double relative_tolera
             absl::StrCat("multimesh shape ", s, " lists cohesive edge ", c, " out of range"));
       }
       const auto& [a, b, cc, d] = mesh.cohesive_edges[c];
-      if ((x[a] - x[cc]).norm() > tolerance || (x[b] - x[d]).norm() > tolerance) {
+      // Written so that a NaN distance (non-finite coordinates) is not collocated either.
+      if (!((x[a] - x[cc]).norm() <= tolerance && (x[b] - x[d]).norm() <= tolerance)) {
         return absl::InvalidArgumentError(absl::StrCat(
             "multimesh shape ", s, ": cohesive edge ", c, " is closed there but its sides are ",
             std::max((x[a] - x[cc]).norm(), (x[b] - x[d]).norm()), " apart"));

@@ -16,13 +16,16 @@ double SignedArea2(const Triangle& t, const Points& x);
 // Number of triangles with signed area <= min_area2 / 2 (inverted or degenerate).
 int CountInverted(const std::vector<Triangle>& triangles, const Points& x, double min_area2 = 0.0);
 
-// Checks shared topology (indices in range, every shape has the same vertex count), boundary
-// loops and cohesive edges (below, when present), no inverted or degenerate triangle in any
-// shape. Errors name the shape and the triangle.
+// Checks shared topology (indices in range, every shape has the same vertex count, each directed
+// edge in one triangle only: no repeated or overlapping triangle), `boundary` vertices on the
+// boundary (and `boundary` the loops' concatenation when loops are given), boundary loops and
+// cohesive edges (below, when present), no inverted or degenerate triangle in any shape. Errors
+// name the shape and the triangle.
 absl::Status ValidateMultimesh(const Multimesh& mesh);
 
 // Boundary vertices on their boundaries: every consecutive pair of every boundary loop is an
-// edge with a triangle on its left only, and the loops hold every boundary edge of the mesh.
+// edge with a triangle on its left only, and the loops hold every boundary edge of the mesh, each
+// once.
 // OK when boundary_loops is empty.
 absl::Status ValidateBoundaryLoops(const Multimesh& mesh);
 
