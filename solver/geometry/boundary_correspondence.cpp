@@ -473,6 +473,17 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     const double eps = 1e-9 * p.length;
     return a > r.a0 + eps && a < r.a1 - eps;
   };
+  // Cuts of several drawings along the same stretch of boundary agree only where their ends sit
+  // at the same common parameter (marks at both ends, or identical geometry between marks);
+  // otherwise each mirror adds points the other mirrors again, without end. Bounded: beyond
+  // kMaxMirrorGrowth times the breakpoints before mirroring (and at least kMinMirrorBreaks in
+  // all) the drawings are refused with what to do, before the correspondence takes minutes and
+  // the mesh explodes.
+  constexpr int kMaxMirrorGrowth = 8, kMinMirrorBreaks = 4096;
+  size_t primary_breaks = 0;
+  for (const std::vector<double>& b : breaks) primary_breaks += b.size();
+  const size_t max_breaks =
+      std::max<size_t>(kMinMirrorBreaks, kMaxMirrorGrowth * primary_breaks);
   for (int round = 0; round < 16; ++round) {
     bool added = false;
     for (int d = 0; d < num_shapes; ++d) {
@@ -486,6 +497,23 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
       }
     }
     if (!added) break;
+    size_t total = 0;
+    for (const std::vector<double>& b : breaks) total += b.size();
+    if (total > max_breaks) {
+      std::string with_cuts;
+      int listed = 0;
+      for (int d = 0; d < num_shapes; ++d) {
+        if (runs[d].empty()) continue;
+        if (listed++ < 6) absl::StrAppend(&with_cuts, listed > 1 ? ", " : "", d + 1);
+      }
+      if (listed > 6) absl::StrAppend(&with_cuts, ", ...");
+      return absl::InvalidArgumentError(absl::StrCat(
+          "the cuts or openings of drawings ", with_cuts,
+          " run along the same boundary but end at different places relative to the "
+          "correspondence marks, so their two sides cannot share one set of boundary vertices; "
+          "pin both ends of every cut with a correspondence mark (data-corr) in every drawing, "
+          "or mark the corners around them"));
+    }
   }
 
   // Intervals, their twins and vertex counts.

@@ -1,0 +1,51 @@
+// Cuts of several drawings along the same stretch of boundary (boundary_correspondence.cpp,
+// "Cuts of several drawings ..."): slits that end at the same places relative to the marks
+// build; slits whose ends differ from drawing to drawing are refused with what to do, instead of
+// the breakpoint mirroring running for minutes and exploding the mesh (a 16-key walk did so).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "solver/mesh/build_multimesh.h"
+#include "solver/mesh/validate.h"
+
+namespace inbetween::solver {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A 10 x 10 square with a slit from (x, 0) on its bottom edge up to (x + lean, depth).
+Drawing SlitSquare(double x, double lean, double depth) {
+  Drawing d;
+  d.outlines.push_back({{{0, 0}, {10, 0}, {10, 10}, {0, 10}}});
+  d.cuts.push_back({{x, 0}, {x + lean, depth}});
+  return d;
+}
+
+TEST(BuildMultimeshCutEndsTest, SlitsEndingAtTheSamePlacesBuild) {
+  // The same slit in three drawings, the drawings moved: every mirror agrees.
+  std::vector<Drawing> drawings;
+  for (int k = 0; k < 3; ++k) {
+    Drawing d = SlitSquare(4, 1, 6);
+    for (Point& p : d.outlines[0].points) p += Point(20.0 * k, 0);
+    for (Point& p : d.cuts[0]) p += Point(20.0 * k, 0);
+    drawings.push_back(d);
+  }
+  absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, {});
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_TRUE(ValidateMultimesh(*mesh).ok());
+}
+
+TEST(BuildMultimeshCutEndsTest, SlitsEndingAtDifferentPlacesAreRefusedWithWhatToDo) {
+  // Slits at different places and of different depths in four drawings, nothing marked: each
+  // drawing's mirror maps the others' breakpoints somewhere new.
+  const std::vector<Drawing> drawings = {SlitSquare(3.1, 0.3, 5.3), SlitSquare(4.7, -0.4, 6.9),
+                                         SlitSquare(5.9, 0.8, 4.1), SlitSquare(3.8, 0.1, 7.7)};
+  const absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, {});
+  ASSERT_FALSE(mesh.ok()) << mesh->shapes[0].size() << " vertices";
+  EXPECT_EQ(mesh.status().code(), absl::StatusCode::kInvalidArgument) << mesh.status();
+  EXPECT_THAT(mesh.status().message(), HasSubstr("cuts or openings of drawings 1, 2, 3, 4"));
+  EXPECT_THAT(mesh.status().message(), HasSubstr("pin both ends of every cut"));
+}
+
+}  // namespace
+}  // namespace inbetween::solver
