@@ -1,0 +1,84 @@
+// Property (issue "Comesh optimization"): on every example under examples/, no accepted iterate
+// of the optimizer inverts or degenerates a triangle in any shape, and every topology pass hands
+// on a valid multimesh. Short runs (the property, not convergence, is under test; the benchmarks
+// measure convergence).
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <string>
+
+#include "solver/comesh/comesh_optimizer.h"
+#include "solver/mesh/build_multimesh.h"
+#include "solver/mesh/validate.h"
+#include "tests/unit/solver/comesh/comesh_test_meshes.h"
+#include "tests/unit/solver/mesh/example_projects.h"
+
+namespace inbetween::solver {
+namespace {
+
+class ComeshExamplesTest : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    absl::StatusOr<example_projects::Example> example = example_projects::Load(GetParam());
+    ASSERT_TRUE(example.ok()) << example.status();
+    absl::StatusOr<Multimesh> mesh = BuildMultimesh(example->drawings, example->options);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    mesh_ = *std::move(mesh);
+  }
+  Multimesh mesh_;
+};
+
+TEST_P(ComeshExamplesTest, NoAcceptedIterateInvertsAnyShape) {
+  ComeshOptions options;
+  options.max_outer = 0;  // topology fixed: every iterate is a position set of mesh_.triangles
+  options.max_iterations = 25;
+  int iterates = 0, bad = 0;
+  options.on_iterate = [&](int, const std::vector<Points>& shapes) {
+    ++iterates;
+    ASSERT_EQ(shapes.size(), mesh_.shapes.size());
+    for (const Points& x : shapes) bad += testing::CountNonPositive(mesh_.triangles, x);
+  };
+  ComeshReport report;
+  absl::StatusOr<Multimesh> out = OptimizeComesh(mesh_, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_EQ(bad, 0) << "non-positive triangles summed over " << iterates << " iterates";
+  EXPECT_EQ(iterates, report.inner);
+  EXPECT_GT(iterates, 0);
+  EXPECT_LE(report.objective_after, report.objective_before);
+  EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
+}
+
+TEST_P(ComeshExamplesTest, EveryTopologyPassLeavesAValidMultimesh) {
+  ComeshOptions options;
+  options.max_outer = 3;
+  options.outer_inner_iterations = 5;
+  options.max_iterations = 10;
+  int passes = 0;
+  options.on_checkpoint = [&](const ComeshCheckpoint& checkpoint) {
+    ++passes;
+    const absl::Status valid = ValidateMultimesh(checkpoint.mesh);
+    EXPECT_TRUE(valid.ok()) << "after pass " << checkpoint.outer << ": " << valid;
+    for (const Points& x : checkpoint.mesh.shapes) {
+      EXPECT_EQ(testing::CountNonPositive(checkpoint.mesh.triangles, x), 0);
+    }
+  };
+  ComeshReport report;
+  absl::StatusOr<Multimesh> out = OptimizeComesh(mesh_, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_EQ(passes, report.outer);
+  EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
+  for (const Points& x : out->shapes) EXPECT_EQ(testing::CountNonPositive(out->triangles, x), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Examples, ComeshExamplesTest,
+                         ::testing::ValuesIn(example_projects::List()),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           std::string name = info.param;
+                           for (char& c : name) {
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           }
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace inbetween::solver
