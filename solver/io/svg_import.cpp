@@ -386,6 +386,33 @@ class Context {
     return out;
   }
 
+  // Whether outline `a` lies inside outline `b`, for outlines that do not cross but may touch
+  // (share a vertex, or run along each other): decided at the midpoint of the first of a's
+  // edges (at most 16 tried) that is not on b's boundary, not at a's first point, which may be
+  // a vertex of b (bootstrap-icons' dropbox: the answer there went either way).
+  static bool NestedIn(const Points& a, const Points& b) {
+    Point lo = b[0], hi = b[0];
+    for (const Point& p : b) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double eps = 1e-9 * (hi - lo).norm();
+    const size_t n = a.size(), m = b.size();
+    for (size_t k = 0; k < std::min<size_t>(n, 16); ++k) {
+      const Point q = 0.5 * (a[k] + a[(k + 1) % n]);
+      if (q.x() < lo.x() - eps || q.y() < lo.y() - eps || q.x() > hi.x() + eps ||
+          q.y() > hi.y() + eps) {
+        return false;  // a point of a outside b's box: a is not inside b
+      }
+      double distance = kInf;
+      for (size_t j = 0; j < m && distance > eps; ++j) {
+        const Point s = b[j], d = b[(j + 1) % m] - s;
+        const double len2 = d.squaredNorm();
+        const double t = len2 > 0 ? std::clamp((q - s).dot(d) / len2, 0.0, 1.0) : 0.0;
+        distance = std::min(distance, (s + t * d - q).norm());
+      }
+      if (distance > eps) return PolygonContains(b, q);
+    }
+    return PolygonContains(b, a[0]);
+  }
+
   // fill-rule nonzero: a subpath nested in this element's others is a boundary only if the
   // winding number changes between zero and non-zero across it (a same-direction subpath inside
   // a filled one is filled on both sides and dropped). Subpaths that cross are left as they
@@ -398,9 +425,8 @@ class Context {
     std::vector<bool> boundary(n);
     for (size_t i = 0; i < n; ++i) {
       int winding = sign[i];  // just inside outline i
-      const Point probe = (*outlines)[i].points[0];
       for (size_t j = 0; j < n; ++j) {
-        if (j != i && PolygonContains((*outlines)[j].points, probe)) winding += sign[j];
+        if (j != i && NestedIn((*outlines)[i].points, (*outlines)[j].points)) winding += sign[j];
       }
       boundary[i] = (winding != 0) != (winding - sign[i] != 0);
     }
@@ -411,6 +437,16 @@ class Context {
     *outlines = std::move(kept);
   }
 
+  // Whether the closed polyline has an area that is not zero up to rounding: above 1e-9 of its
+  // bounding box's diagonal squared (a width above 1e-9 of its length). Three collinear points
+  // (bootstrap-icons' emoji-kiss has such a subpath) have an area of about 1e-17 from rounding,
+  // or exactly 0 depending on the transform: the icon and its rotated copy differed by a hole.
+  static bool EnclosesArea(const Points& points) {
+    Point lo = points[0], hi = points[0];
+    for (const Point& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    return std::abs(PolygonSignedArea(points)) > 1e-9 * (hi - lo).squaredNorm();
+  }
+
   // Flattens and closes one subpath; keeps it when it encloses some area.
   void Emit(const Subpath& subpath, std::vector<Outline>* outlines) const {
     // A fill closes every subpath implicitly; drop the repeated closing point.
@@ -419,7 +455,7 @@ class Context {
     while (outline.points.size() > 1 && outline.points.back() == outline.points.front()) {
       outline.points.pop_back();
     }
-    if (outline.points.size() >= 3 && PolygonSignedArea(outline.points) != 0.0) {
+    if (outline.points.size() >= 3 && EnclosesArea(outline.points)) {
       outlines->push_back(std::move(outline));
     }
   }
