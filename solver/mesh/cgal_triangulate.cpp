@@ -18,6 +18,7 @@
 #include <exception>
 #include <limits>
 #include <map>
+#include <stdexcept>
 
 #include "absl/strings/str_cat.h"
 #include "solver/geometry/polygon.h"
@@ -26,18 +27,91 @@ namespace inbetween::solver {
 namespace {
 
 // The kernel and data structures, named once.
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Delaunay_mesh_vertex_base_2<K>;
+using Epick = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+// A refinement point is a circumcentre (or an edge midpoint) constructed in doubles. For a face
+// that is flat to double precision the circumcentre overflows to inf or lands absurdly far away,
+// and the mesher then hands it to the exact predicates, whose conversion of inf to a GMP
+// rational raises SIGFPE (seen on real icons with near-zero-angle cusps). The kernel below
+// refuses such a point with an exception, caught by the triangulation functions.
+struct RefinementPointError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+struct GuardedKernel : public Epick {
+  struct Construct_circumcenter_2 : public Epick::Construct_circumcenter_2 {
+    using Base = Epick::Construct_circumcenter_2;
+    using Base::operator();
+    Epick::Point_2 operator()(const Epick::Point_2& p, const Epick::Point_2& q,
+                              const Epick::Point_2& r) const {
+      const Epick::Point_2 c = Base::operator()(p, q, r);
+      const double scale = std::max({std::abs(p.x()), std::abs(p.y()), std::abs(q.x()),
+                                     std::abs(q.y()), std::abs(r.x()), std::abs(r.y()), 1.0});
+      if (!std::isfinite(c.x()) || !std::isfinite(c.y()) || std::abs(c.x()) > 1e12 * scale ||
+          std::abs(c.y()) > 1e12 * scale) {
+        throw RefinementPointError(absl::StrCat(
+            "triangulate: the drawing has a cusp or boundaries that nearly touch near (", p.x(),
+            ", ", p.y(), "): a triangle there is flat to double precision; widen the cusp or "
+            "separate the boundaries"));
+      }
+      return c;
+    }
+  };
+  Construct_circumcenter_2 construct_circumcenter_2_object() const { return {}; }
+};
+using K = GuardedKernel;
+
+// Where the refinement put its last point: the mesher offers no hook per inserted point, but
+// every insertion sets the new vertex's point (Triangulation_2::insert*), so a vertex base that
+// records set_point sees each one (per thread: a server meshes on several threads at once).
+struct LastInserted {
+  bool set = false;
+  double x = 0.0, y = 0.0;
+};
+thread_local LastInserted last_inserted;
+
+template <class Gt, class Vb0 = CGAL::Triangulation_vertex_base_2<Gt>>
+class RecordingVertexBase : public CGAL::Delaunay_mesh_vertex_base_2<Gt, Vb0> {
+  using Base = CGAL::Delaunay_mesh_vertex_base_2<Gt, Vb0>;
+
+ public:
+  template <typename TDS2>
+  struct Rebind_TDS {
+    using Vb2 = typename Vb0::template Rebind_TDS<TDS2>::Other;
+    using Other = RecordingVertexBase<Gt, Vb2>;
+  };
+  using Base::Base;
+  void set_point(const typename Base::Point& p) {
+    Base::set_point(p);
+    last_inserted = {true, CGAL::to_double(p.x()), CGAL::to_double(p.y())};
+  }
+};
+
+using Vb = RecordingVertexBase<K>;
 using Fb = CGAL::Delaunay_mesh_face_base_2<K>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
 using Cdt = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
 using Criteria = CGAL::Delaunay_mesh_size_criteria_2<Cdt>;
 
-// CGAL::refine_Delaunay_mesh_2, one step at a time so that it can stop at `max_vertices`.
-absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices) {
+using CgalPoint = K::Point_2;
+using VertexHandle = Cdt::Vertex_handle;
+
+// Refinement stops when a new point lands closer than this to a neighbour, relative to the
+// input's bounding-box diagonal. Delaunay refinement cannot resolve a cusp (two boundary edges at
+// a near-zero angle) or boundaries that nearly touch: it splits ever smaller edges there until
+// the inexact constructions give coincident points and CGAL's data structure breaks (a crash,
+// seen on real icons). 1e-7 is far below any spacing a mesh within max_vertices needs and far
+// above where double constructions fail.
+constexpr double kMinRefinementSpacing = 1e-7;
+
+// CGAL::refine_Delaunay_mesh_2, one step at a time so that it can stop at `max_vertices` and
+// before a point closer than `min_spacing` to its neighbours.
+absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices,
+                           double min_spacing) {
   CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, criteria);
   mesher.init();
+  Cdt::Face_handle hint;
   while (!mesher.is_refinement_done()) {
+    last_inserted.set = false;
     mesher.try_one_step_refine_mesh();
     if (max_vertices > 0 && cdt.number_of_vertices() > static_cast<size_t>(max_vertices)) {
       return absl::ResourceExhaustedError(absl::StrCat(
@@ -45,11 +119,43 @@ absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices)
           " vertices (a part of the drawing is far thinner than the rest: a sliver, a spike or "
           "boundaries that nearly touch)"));
     }
+    if (!last_inserted.set) continue;
+    if (!std::isfinite(last_inserted.x) || !std::isfinite(last_inserted.y)) {
+      return absl::InvalidArgumentError(
+          "triangulate: the refinement constructed a point at infinity (a cusp or boundaries "
+          "that nearly touch)");
+    }
+    const CgalPoint p(last_inserted.x, last_inserted.y);
+    Cdt::Locate_type type;
+    int li;
+    hint = cdt.locate(p, type, li, hint);
+    if (type != Cdt::VERTEX) continue;
+    const VertexHandle v = hint->vertex(li);
+    double nearest = std::numeric_limits<double>::infinity();
+    auto w = cdt.incident_vertices(v), done = w;
+    do {
+      if (!cdt.is_infinite(w)) nearest = std::min(nearest, std::sqrt(CGAL::to_double(
+                                                               CGAL::squared_distance(p, w->point()))));
+    } while (++w != done);
+    if (nearest < min_spacing) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "triangulate: the drawing has a cusp or boundaries that nearly touch near (",
+          last_inserted.x, ", ", last_inserted.y,
+          "): the mesh would need triangles smaller than ", min_spacing,
+          " there; widen the cusp or separate the boundaries"));
+    }
   }
   return absl::OkStatus();
 }
-using CgalPoint = K::Point_2;
-using VertexHandle = Cdt::Vertex_handle;
+
+double Diagonal(const std::vector<Points>& loops) {
+  Point lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+  Point hi = -lo;
+  for (const Points& loop : loops) {
+    for (const Point& p : loop) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  }
+  return (hi - lo).norm();
+}
 
 double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
 
@@ -85,8 +191,9 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
     }
 
     const double size = options.max_edge > 0 ? options.max_edge : 0.0;
-    if (absl::Status s =
-            RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices);
+    if (absl::Status s = RefineBounded(cdt, Criteria(options.shape_bound, size),
+                                       options.max_vertices,
+                                       kMinRefinementSpacing * Diagonal({boundary}));
         !s.ok()) {
       return s;
     }
@@ -135,6 +242,8 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
               [](const BoundarySteiner& a, const BoundarySteiner& b) {
                 return a.segment < b.segment || (a.segment == b.segment && a.t < b.t);
               });
+  } catch (const RefinementPointError& e) {
+    return absl::InvalidArgumentError(e.what());
   } catch (const std::exception& e) {
     return absl::InternalError(absl::StrCat("triangulate: CGAL failed: ", e.what()));
   }
@@ -184,7 +293,8 @@ absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Poin
     // then faces kept by the even-odd rule at their centroid.
     const double size = options.max_edge > 0 ? options.max_edge : 0.0;
     if (absl::Status s =
-            RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices);
+            RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices,
+                          kMinRefinementSpacing * Diagonal(loops));
         !s.ok()) {
       return s;
     }
@@ -250,6 +360,8 @@ absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Poin
         out.edge_chain[l].push_back(std::move(chain));
       }
     }
+  } catch (const RefinementPointError& e) {
+    return absl::InvalidArgumentError(e.what());
   } catch (const std::exception& e) {
     return absl::InternalError(absl::StrCat("triangulate: CGAL failed: ", e.what()));
   }
