@@ -49,7 +49,8 @@ struct CutMesh {
 
 // Duplicates every vertex along the cut/opening sides (one copy per fan of triangles between
 // constrained edges) and lists the boundary vertices of each correspondence edge.
-CutMesh CutAlongSeams(const DomainTriangulation& dt, const BoundaryCorrespondence& bc) {
+absl::StatusOr<CutMesh> CutAlongSeams(const DomainTriangulation& dt,
+                                     const BoundaryCorrespondence& bc) {
   const int num_tri = static_cast<int>(dt.triangles.size());
   using Edge = std::pair<int, int>;
   std::map<Edge, bool> constrained;
@@ -101,7 +102,17 @@ CutMesh CutAlongSeams(const DomainTriangulation& dt, const BoundaryCorrespondenc
       const int e = bc.loop_start[g] + static_cast<int>(k);
       const Point a = dt.vertices[c.front()], d = dt.vertices[c.back()] - a;
       for (size_t j = 0; j + 1 < c.size(); ++j) {
-        const auto [t, corner] = directed.at({c[j], c[j + 1]});
+        const auto found = directed.find({c[j], c[j + 1]});
+        if (found == directed.end()) {
+          // The triangulation's inside is not on the boundary's inside here (nested loops the
+          // even-odd domain and the loop orientation disagree on, typically tiny loops).
+          const Point& p = dt.vertices[c[j]];
+          return absl::InvalidArgumentError(absl::StrCat(
+              "triangulate: the mesh does not lie inside boundary loop ", g + 1, " near (", p.x(),
+              ", ", p.y(), ") (loops too small or too close for the boundary vertices: try more "
+              "boundary vertices, meshing.boundary_vertices)"));
+        }
+        const auto [t, corner] = found->second;
         const double param = j == 0 ? 0.0 : (dt.vertices[c[j]] - a).dot(d) / d.squaredNorm();
         out.entries[e].push_back({copy[corners.Find(3 * t + corner)], e, param});
       }
@@ -287,7 +298,12 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     return absl::Status(triangulation.status().code(),
                         absl::StrCat("drawing ", ref + 1, ": ", triangulation.status().message()));
   }
-  CutMesh cut = CutAlongSeams(*triangulation, *bc);
+  absl::StatusOr<CutMesh> cut_or = CutAlongSeams(*triangulation, *bc);
+  if (!cut_or.ok()) {
+    return absl::Status(cut_or.status().code(),
+                        absl::StrCat("drawing ", ref + 1, ": ", cut_or.status().message()));
+  }
+  CutMesh cut = *std::move(cut_or);
 
   // Mirror boundary Steiner points across every pair of twin edges of every drawing.
   for (int round = 0; round < 8; ++round) {
@@ -414,8 +430,18 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       }
       MapToBoundaryOptions map_options;
       map_options.tutte_when_convex = loops.size() == 1;
-      absl::StatusOr<Points> mapped =
-          MapToBoundary(source, triangles, boundary, target_boundary, map_options, cancel);
+      // Every triangle positive does not make a map injective: the boundary may fold over
+      // itself (seen on a real icon's cusp). Such a map counts as not found.
+      auto injective = [&](absl::StatusOr<Points> m) -> absl::StatusOr<Points> {
+        if (!m.ok()) return m;
+        if (absl::Status s = ValidateBoundaryDoesNotCross(triangles, *m); !s.ok()) {
+          return absl::FailedPreconditionError(
+              absl::StrCat("the map folds the boundary over itself: ", s.message()));
+        }
+        return m;
+      };
+      absl::StatusOr<Points> mapped = injective(
+          MapToBoundary(source, triangles, boundary, target_boundary, map_options, cancel));
       // A pose far from the reference drawing may not be reachable by pulling the reference's
       // boundary directly; start instead from the map into an already mapped drawing, nearest
       // in key order first (neighbouring keys are usually similar poses).
@@ -433,8 +459,8 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
         MapToBoundaryOptions chained = map_options;
         chained.tutte_when_convex = chained.tutte_first_always = false;
         chained.start = &start;
-        absl::StatusOr<Points> retry =
-            MapToBoundary(source, triangles, boundary, target_boundary, chained, cancel);
+        absl::StatusOr<Points> retry = injective(
+            MapToBoundary(source, triangles, boundary, target_boundary, chained, cancel));
         if (retry.ok() || absl::IsCancelled(retry.status())) mapped = std::move(retry);
       }
       if (!mapped.ok()) {

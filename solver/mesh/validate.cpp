@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "solver/mesh/cgal_predicates.h"
 
 namespace inbetween::solver {
 
@@ -24,6 +25,63 @@ int CountInverted(const std::vector<Triangle>& triangles, const Points& x, doubl
     if (!(a > min_area2)) ++count;  // NaN counts as inverted
   }
   return count;
+}
+
+absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles,
+                                          const Points& x) {
+  std::set<std::pair<int, int>> directed;
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) directed.insert({t[k], t[(k + 1) % 3]});
+  }
+  std::vector<std::pair<int, int>> edges;
+  for (const auto& [a, b] : directed) {
+    if (!directed.count({b, a})) edges.push_back({a, b});
+  }
+  if (edges.size() < 4) return absl::OkStatus();
+  Point lo = x[edges[0].first], hi = lo;
+  double total = 0.0;
+  for (const auto& [a, b] : edges) {
+    lo = lo.cwiseMin(x[a]).cwiseMin(x[b]), hi = hi.cwiseMax(x[a]).cwiseMax(x[b]);
+    total += (x[b] - x[a]).norm();
+  }
+  // Cells about as wide as an average edge, at most 2048 a side.
+  const double cell = std::max(total / edges.size(), 1e-12 * std::max(1.0, (hi - lo).norm()));
+  const int nx = std::clamp(static_cast<int>((hi.x() - lo.x()) / cell) + 1, 1, 2048);
+  const int ny = std::clamp(static_cast<int>((hi.y() - lo.y()) / cell) + 1, 1, 2048);
+  const double cx = (hi.x() - lo.x()) / nx + 1e-300, cy = (hi.y() - lo.y()) / ny + 1e-300;
+  auto cell_of = [&](double v, double origin, double size, int count) {
+    return std::clamp(static_cast<int>((v - origin) / size), 0, count - 1);
+  };
+  std::vector<std::vector<int>> grid(static_cast<size_t>(nx) * ny);
+  for (size_t e = 0; e < edges.size(); ++e) {
+    const Point& p = x[edges[e].first];
+    const Point& q = x[edges[e].second];
+    const int x0 = cell_of(std::min(p.x(), q.x()), lo.x(), cx, nx);
+    const int x1 = cell_of(std::max(p.x(), q.x()), lo.x(), cx, nx);
+    const int y0 = cell_of(std::min(p.y(), q.y()), lo.y(), cy, ny);
+    const int y1 = cell_of(std::max(p.y(), q.y()), lo.y(), cy, ny);
+    for (int i = x0; i <= x1; ++i) {
+      for (int j = y0; j <= y1; ++j) grid[static_cast<size_t>(j) * nx + i].push_back(static_cast<int>(e));
+    }
+  }
+  for (const std::vector<int>& bucket : grid) {
+    for (size_t i = 0; i < bucket.size(); ++i) {
+      for (size_t j = i + 1; j < bucket.size(); ++j) {
+        const auto [a, b] = edges[bucket[i]];
+        const auto [c, d] = edges[bucket[j]];
+        if (a == c || a == d || b == c || b == d) continue;
+        const int o1 = ExactOrientation(x[a], x[b], x[c]), o2 = ExactOrientation(x[a], x[b], x[d]);
+        if (o1 * o2 >= 0) continue;
+        const int o3 = ExactOrientation(x[c], x[d], x[a]), o4 = ExactOrientation(x[c], x[d], x[b]);
+        if (o3 * o4 >= 0) continue;
+        const Point at = 0.25 * (x[a] + x[b] + x[c] + x[d]);
+        return absl::InvalidArgumentError(absl::StrCat(
+            "boundary edges ", a, "-", b, " and ", c, "-", d, " cross near (", at.x(), ", ",
+            at.y(), ")"));
+      }
+    }
+  }
+  return absl::OkStatus();
 }
 
 absl::Status ValidateMultimesh(const Multimesh& mesh) {
@@ -110,6 +168,11 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
                                                        a == 0 ? " is degenerate" : " is inverted",
                                                        " (signed area ", 0.5 * a, ")"));
       }
+    }
+    if (absl::Status crossing = ValidateBoundaryDoesNotCross(mesh.triangles, mesh.shapes[s]);
+        !crossing.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("multimesh shape ", s, ": ", crossing.message()));
     }
   }
   return absl::OkStatus();

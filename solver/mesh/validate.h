@@ -16,11 +16,19 @@ double SignedArea2(const Triangle& t, const Points& x);
 // Number of triangles with signed area <= min_area2 / 2 (inverted or degenerate).
 int CountInverted(const std::vector<Triangle>& triangles, const Points& x, double min_area2 = 0.0);
 
+// No two boundary edges of the mesh cross in geometry x (a proper crossing, decided with exact
+// predicates; touching and collinear overlap, as of the collocated sides of a closed cut, are
+// allowed). With every triangle positive this is what is left of injectivity: a map can fold the
+// boundary over itself with no triangle inverted. InvalidArgument naming the two edges and where.
+// Expects valid indices. O(B) for B boundary edges of about equal length (a uniform grid).
+absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles,
+                                          const Points& x);
+
 // Checks shared topology (indices in range, every shape has the same vertex count, each directed
 // edge in one triangle only: no repeated or overlapping triangle), `boundary` vertices on the
 // boundary (and `boundary` the loops' concatenation when loops are given), boundary loops and
-// cohesive edges (below, when present), no inverted or degenerate triangle in any shape. Errors
-// name the shape and the triangle.
+// cohesive edges (below, when present), no inverted or degenerate triangle and no crossing
+// boundary (above) in any shape. Errors name the shape and the triangle.
 absl::Status ValidateMultimesh(const Multimesh& mesh);
 
 // Boundary vertices on their boundaries: every consecutive pair of every boundary loop is an

@@ -49,7 +49,7 @@ total=$(wc -l < "$WORK/sample")
 # Refusal reasons (exit 3) that name the drawing and say what is wrong with it, and the one that
 # says the mesh of drawing 1 could not be mapped into drawing 2 (an affine copy always can be:
 # counted apart, a limitation of the map, docs/svg-convention.md).
-reasons='crosses itself: segments [0-9]+ and [0-9]+ meet at|outline [0-9]+ and outline [0-9]+ touch or cross at|triangulate: boundary loops cross each other|triangulate: the drawing has a cusp or boundaries that nearly touch near|has zero area|needs at least 3'
+reasons='crosses itself: segments [0-9]+ and [0-9]+ meet at|outline [0-9]+ and outline [0-9]+ touch or cross at|triangulate: boundary loops cross each other|triangulate: the drawing has a cusp or boundaries that nearly touch near|triangulate: the mesh does not lie inside boundary loop|has zero area|needs at least 3'
 unmapped_reason="cannot map drawing 1's mesh into drawing 2"
 meshed=0 refused=0 unmapped=0 known=0 failed=0
 : > "$WORK/manifest"
