@@ -482,8 +482,7 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
   constexpr int kMaxMirrorGrowth = 8, kMinMirrorBreaks = 4096;
   size_t primary_breaks = 0;
   for (const std::vector<double>& b : breaks) primary_breaks += b.size();
-  const size_t max_breaks =
-      std::max<size_t>(kMinMirrorBreaks, kMaxMirrorGrowth * primary_breaks);
+  const size_t max_breaks = std::max<size_t>(kMinMirrorBreaks, kMaxMirrorGrowth * primary_breaks);
   for (int round = 0; round < 16; ++round) {
     bool added = false;
     for (int d = 0; d < num_shapes; ++d) {

@@ -50,7 +50,7 @@ struct CutMesh {
 // Duplicates every vertex along the cut/opening sides (one copy per fan of triangles between
 // constrained edges) and lists the boundary vertices of each correspondence edge.
 absl::StatusOr<CutMesh> CutAlongSeams(const DomainTriangulation& dt,
-                                     const BoundaryCorrespondence& bc) {
+                                      const BoundaryCorrespondence& bc) {
   const int num_tri = static_cast<int>(dt.triangles.size());
   using Edge = std::pair<int, int>;
   std::map<Edge, bool> constrained;
@@ -107,10 +107,11 @@ absl::StatusOr<CutMesh> CutAlongSeams(const DomainTriangulation& dt,
           // The triangulation's inside is not on the boundary's inside here (nested loops the
           // even-odd domain and the loop orientation disagree on, typically tiny loops).
           const Point& p = dt.vertices[c[j]];
-          return absl::InvalidArgumentError(absl::StrCat(
-              "triangulate: the mesh does not lie inside boundary loop ", g + 1, " near (", p.x(),
-              ", ", p.y(), ") (loops too small or too close for the boundary vertices: try more "
-              "boundary vertices, meshing.boundary_vertices)"));
+          return absl::InvalidArgumentError(
+              absl::StrCat("triangulate: the mesh does not lie inside boundary loop ", g + 1,
+                           " near (", p.x(), ", ", p.y(),
+                           ") (loops too small or too close for the boundary vertices: try more "
+                           "boundary vertices, meshing.boundary_vertices)"));
         }
         const auto [t, corner] = found->second;
         const double param = j == 0 ? 0.0 : (dt.vertices[c[j]] - a).dot(d) / d.squaredNorm();
@@ -451,16 +452,16 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       }
       std::stable_sort(mapped_before.begin(), mapped_before.end(),
                        [d](int a, int b) { return std::abs(a - d) < std::abs(b - d); });
-      for (size_t k = 0; k < mapped_before.size() && k < 3 && !mapped.ok() &&
-                         !absl::IsCancelled(mapped.status());
+      for (size_t k = 0;
+           k < mapped_before.size() && k < 3 && !mapped.ok() && !absl::IsCancelled(mapped.status());
            ++k) {
         Points start;
         for (int v : global) start.push_back(mesh.shapes[mapped_before[k]][v]);
         MapToBoundaryOptions chained = map_options;
         chained.tutte_when_convex = chained.tutte_first_always = false;
         chained.start = &start;
-        absl::StatusOr<Points> retry = injective(
-            MapToBoundary(source, triangles, boundary, target_boundary, chained, cancel));
+        absl::StatusOr<Points> retry =
+            injective(MapToBoundary(source, triangles, boundary, target_boundary, chained, cancel));
         if (retry.ok() || absl::IsCancelled(retry.status())) mapped = std::move(retry);
       }
       if (!mapped.ok()) {

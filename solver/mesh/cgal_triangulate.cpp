@@ -50,7 +50,8 @@ struct GuardedKernel : public Epick {
           std::abs(c.y()) > 1e12 * scale) {
         throw RefinementPointError(absl::StrCat(
             "triangulate: the drawing has a cusp or boundaries that nearly touch near (", p.x(),
-            ", ", p.y(), "): a triangle there is flat to double precision; widen the cusp or "
+            ", ", p.y(),
+            "): a triangle there is flat to double precision; widen the cusp or "
             "separate the boundaries"));
       }
       return c;
@@ -134,15 +135,15 @@ absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices,
     double nearest = std::numeric_limits<double>::infinity();
     auto w = cdt.incident_vertices(v), done = w;
     do {
-      if (!cdt.is_infinite(w)) nearest = std::min(nearest, std::sqrt(CGAL::to_double(
-                                                               CGAL::squared_distance(p, w->point()))));
+      if (!cdt.is_infinite(w))
+        nearest =
+            std::min(nearest, std::sqrt(CGAL::to_double(CGAL::squared_distance(p, w->point()))));
     } while (++w != done);
     if (nearest < min_spacing) {
       return absl::InvalidArgumentError(absl::StrCat(
           "triangulate: the drawing has a cusp or boundaries that nearly touch near (",
-          last_inserted.x, ", ", last_inserted.y,
-          "): the mesh would need triangles smaller than ", min_spacing,
-          " there; widen the cusp or separate the boundaries"));
+          last_inserted.x, ", ", last_inserted.y, "): the mesh would need triangles smaller than ",
+          min_spacing, " there; widen the cusp or separate the boundaries"));
     }
   }
   return absl::OkStatus();
@@ -191,9 +192,9 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
     }
 
     const double size = options.max_edge > 0 ? options.max_edge : 0.0;
-    if (absl::Status s = RefineBounded(cdt, Criteria(options.shape_bound, size),
-                                       options.max_vertices,
-                                       kMinRefinementSpacing * Diagonal({boundary}));
+    if (absl::Status s =
+            RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices,
+                          kMinRefinementSpacing * Diagonal({boundary}));
         !s.ok()) {
       return s;
     }

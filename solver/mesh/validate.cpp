@@ -27,8 +27,7 @@ int CountInverted(const std::vector<Triangle>& triangles, const Points& x, doubl
   return count;
 }
 
-absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles,
-                                          const Points& x) {
+absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles, const Points& x) {
   std::set<std::pair<int, int>> directed;
   for (const Triangle& t : triangles) {
     for (int k = 0; k < 3; ++k) directed.insert({t[k], t[(k + 1) % 3]});
@@ -61,7 +60,8 @@ absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles
     const int y0 = cell_of(std::min(p.y(), q.y()), lo.y(), cy, ny);
     const int y1 = cell_of(std::max(p.y(), q.y()), lo.y(), cy, ny);
     for (int i = x0; i <= x1; ++i) {
-      for (int j = y0; j <= y1; ++j) grid[static_cast<size_t>(j) * nx + i].push_back(static_cast<int>(e));
+      for (int j = y0; j <= y1; ++j)
+        grid[static_cast<size_t>(j) * nx + i].push_back(static_cast<int>(e));
     }
   }
   for (const std::vector<int>& bucket : grid) {
@@ -75,9 +75,9 @@ absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles
         const int o3 = ExactOrientation(x[c], x[d], x[a]), o4 = ExactOrientation(x[c], x[d], x[b]);
         if (o3 * o4 >= 0) continue;
         const Point at = 0.25 * (x[a] + x[b] + x[c] + x[d]);
-        return absl::InvalidArgumentError(absl::StrCat(
-            "boundary edges ", a, "-", b, " and ", c, "-", d, " cross near (", at.x(), ", ",
-            at.y(), ")"));
+        return absl::InvalidArgumentError(absl::StrCat("boundary edges ", a, "-", b, " and ", c,
+                                                       "-", d, " cross near (", at.x(), ", ",
+                                                       at.y(), ")"));
       }
     }
   }

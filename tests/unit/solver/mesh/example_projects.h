@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -32,6 +33,17 @@ inline std::vector<std::string> List() {
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+// A gtest parameter name for example NAME (pentagon_star/hard1 -> pentagon_star_hard1); `info` is
+// a ::testing::TestParamInfo<std::string> (a template here so that benchmarks need no gtest).
+template <class ParamInfo>
+std::string TestName(const ParamInfo& info) {
+  std::string name = info.param;
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
 }
 
 inline std::string ReadFile(const std::filesystem::path& path) {

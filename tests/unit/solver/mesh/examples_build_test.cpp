@@ -47,13 +47,7 @@ TEST_P(ExamplesBuildTest, BuildsAValidMultimesh) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Examples, ExamplesBuildTest, ::testing::ValuesIn(example_projects::List()),
-                         [](const ::testing::TestParamInfo<std::string>& info) {
-                           std::string name = info.param;
-                           for (char& c : name) {
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           }
-                           return name;
-                         });
+                         example_projects::TestName<::testing::TestParamInfo<std::string>>);
 
 }  // namespace
 }  // namespace inbetween::solver
