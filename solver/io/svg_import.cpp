@@ -455,6 +455,20 @@ class Context {
     while (outline.points.size() > 1 && outline.points.back() == outline.points.front()) {
       outline.points.pop_back();
     }
+    // A subpath that ends a hair short of its start (path data rounded to three decimals:
+    // "...h-.668z" stopping 0.001 before the first point) would close with a segment folding
+    // back along its neighbours, far below what the flattening resolves: the last point is
+    // dropped while it lies within the flatten tolerance and within 1e-3 of the subpath's size
+    // of the first (docs/svg-convention.md).
+    if (outline.points.size() > 3) {
+      Point lo = outline.points[0], hi = lo;
+      for (const Point& p : outline.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+      const double gap = std::min(collector_->tolerance, 1e-3 * (hi - lo).norm());
+      while (outline.points.size() > 3 &&
+             (outline.points.back() - outline.points.front()).norm() <= gap) {
+        outline.points.pop_back();
+      }
+    }
     if (outline.points.size() >= 3 && EnclosesArea(outline.points)) {
       outlines->push_back(std::move(outline));
     }
