@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "server/cancel_watcher.h"
@@ -811,6 +812,14 @@ grpc::Status InbetweenService::BuildMultimesh(
           return StoppedStatus(*context, "BuildMultimesh");
         }
         if (options_.metrics) options_.metrics->ObserveStage("build", seconds);
+        // The mesher's refinement stops at --max-mesh-vertices; say which limit it hit.
+        if (absl::IsResourceExhausted(mesh.status()) &&
+            absl::StrContains(mesh.status().message(), "refinement needs more than")) {
+          return absl::ResourceExhaustedError(absl::StrCat(
+              mesh.status().message(), "; the limit is ", options_.limits.max_mesh_vertices,
+              " mesh vertices (--max-mesh-vertices): use fewer boundary_vertices or a larger "
+              "max_edge_relative"));
+        }
         if (!mesh.ok()) return mesh.status();
         if (absl::Status s = CheckMeshVertices(*mesh, options_, "the multimesh"); !s.ok()) return s;
         // The solver promises a valid mesh; a stored multimesh is never silently flipped.
