@@ -442,9 +442,17 @@ class Context {
   // (bootstrap-icons' emoji-kiss has such a subpath) have an area of about 1e-17 from rounding,
   // or exactly 0 depending on the transform: the icon and its rotated copy differed by a hole.
   static bool EnclosesArea(const Points& points) {
-    Point lo = points[0], hi = points[0];
-    for (const Point& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-    return std::abs(PolygonSignedArea(points)) > 1e-9 * (hi - lo).squaredNorm();
+    // Measured on the points scaled into [-1, 1]: huge coordinates (1e308, refused later with
+    // their own message) would overflow the area and the diagonal to inf.
+    double scale = 0.0;
+    for (const Point& p : points) scale = std::max(scale, p.cwiseAbs().maxCoeff());
+    if (!(scale > 0) || !std::isfinite(scale)) return scale > 0;
+    Points unit;
+    unit.reserve(points.size());
+    for (const Point& p : points) unit.push_back(p / scale);
+    Point lo = unit[0], hi = unit[0];
+    for (const Point& p : unit) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    return std::abs(PolygonSignedArea(unit)) > 1e-9 * (hi - lo).squaredNorm();
   }
 
   // Flattens and closes one subpath; keeps it when it encloses some area.
