@@ -121,11 +121,6 @@ absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices,
           "boundaries that nearly touch)"));
     }
     if (!last_inserted.set) continue;
-    if (!std::isfinite(last_inserted.x) || !std::isfinite(last_inserted.y)) {
-      return absl::InvalidArgumentError(
-          "triangulate: the refinement constructed a point at infinity (a cusp or boundaries "
-          "that nearly touch)");
-    }
     const CgalPoint p(last_inserted.x, last_inserted.y);
     Cdt::Locate_type type;
     int li;

@@ -27,15 +27,11 @@ int CountInverted(const std::vector<Triangle>& triangles, const Points& x, doubl
   return count;
 }
 
-absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles, const Points& x) {
-  std::set<std::pair<int, int>> directed;
-  for (const Triangle& t : triangles) {
-    for (int k = 0; k < 3; ++k) directed.insert({t[k], t[(k + 1) % 3]});
-  }
-  std::vector<std::pair<int, int>> edges;
-  for (const auto& [a, b] : directed) {
-    if (!directed.count({b, a})) edges.push_back({a, b});
-  }
+namespace {
+
+// No two of the boundary `edges` (directed, in (from, to) order) cross properly in geometry x.
+absl::Status BoundaryEdgesDoNotCross(const std::vector<std::pair<int, int>>& edges,
+                                     const Points& x) {
   if (edges.size() < 4) return absl::OkStatus();
   Point lo = x[edges[0].first], hi = lo;
   double total = 0.0;
@@ -82,6 +78,20 @@ absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles
     }
   }
   return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles, const Points& x) {
+  std::set<std::pair<int, int>> directed;
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) directed.insert({t[k], t[(k + 1) % 3]});
+  }
+  std::vector<std::pair<int, int>> edges;
+  for (const auto& [a, b] : directed) {
+    if (!directed.count({b, a})) edges.push_back({a, b});
+  }
+  return BoundaryEdgesDoNotCross(edges, x);
 }
 
 absl::Status ValidateMultimesh(const Multimesh& mesh) {
@@ -136,11 +146,14 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
   }
   // Boundary vertices on the boundary: each on an edge with a triangle on one side only.
   std::vector<bool> on_boundary(n, false);
+  std::vector<std::pair<int, int>> boundary_edges;  // in (from, to) order, for the crossing check
   for (const auto& [a, b, t] : directed) {
     const std::array<int, 3> reverse = {b, a, -1};
     auto it = std::lower_bound(directed.begin(), directed.end(), reverse);
-    if (it == directed.end() || (*it)[0] != b || (*it)[1] != a)
+    if (it == directed.end() || (*it)[0] != b || (*it)[1] != a) {
       on_boundary[a] = on_boundary[b] = true;
+      boundary_edges.push_back({a, b});
+    }
   }
   for (size_t k = 0; k < mesh.boundary.size(); ++k) {
     if (!on_boundary[mesh.boundary[k]]) {
@@ -169,7 +182,7 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
                                                        " (signed area ", 0.5 * a, ")"));
       }
     }
-    if (absl::Status crossing = ValidateBoundaryDoesNotCross(mesh.triangles, mesh.shapes[s]);
+    if (absl::Status crossing = BoundaryEdgesDoNotCross(boundary_edges, mesh.shapes[s]);
         !crossing.ok()) {
       return absl::InvalidArgumentError(
           absl::StrCat("multimesh shape ", s, ": ", crossing.message()));
