@@ -11,12 +11,14 @@
 #include <deque>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "solver/comesh/comesh_hessian.h"
 #include "solver/comesh/comesh_objective.h"
 #include "solver/comesh/comesh_topology.h"
 #include "solver/core/parallel_chunks.h"
@@ -394,6 +396,170 @@ class InitialHessian {
   std::unique_ptr<SparseCholesky> solver_;  // by pointer: keeps InitialHessian movable
 };
 
+// Newton-type initial Hessian: the comesh objective's Hessian, block diagonal by shape (the mixed
+// shape-shape MIPS blocks are left out) and made positive definite per triangle and shape
+// (comesh_hessian.h: the edge-space 4 x 4 sum of that shape's ODT term and its two MIPS terms,
+// projected), in the reduced unknowns (a slider's row is the 2D row projected on its direction).
+// Its sparsity pattern (unknowns of one shape adjacent in the mesh) is built once per inner run;
+// Update() recomputes the values at new positions and refactors on the same pattern (CHOLMOD,
+// one symbolic analysis). Shapes are assembled on separate threads: each writes only its own
+// rows, in triangle order, so the matrix is the same for any thread count.
+class HessianPreconditioner {
+ public:
+  static absl::StatusOr<HessianPreconditioner> Create(const std::vector<Triangle>& triangles,
+                                                      const Layout& layout,
+                                                      const ComeshObjective& objective,
+                                                      const std::vector<Points>& shapes) {
+    HessianPreconditioner h;
+    h.triangles_ = &triangles;
+    h.layout_ = &layout;
+    h.objective_ = &objective;
+    const int n = layout.num_vertices();
+    std::vector<std::vector<int>> nbrs(n);
+    for (const Triangle& t : triangles) {
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) nbrs[t[a]].push_back(t[b]);
+      }
+    }
+    for (auto& list : nbrs) {
+      std::sort(list.begin(), list.end());
+      list.erase(std::unique(list.begin(), list.end()), list.end());
+    }
+    // Column-major pattern of the symmetric matrix: column j = unknown j, rows = the unknowns of
+    // the same shape at the vertex and its neighbours, ascending (offsets grow with the vertex).
+    const int size = layout.size();
+    std::vector<int> outer(size + 1, 0), inner;
+    for (const Layout::Var& var : layout.vars()) {
+      const int m = var.slider ? 1 : 2;
+      for (int c = 0; c < m; ++c) {
+        const int col = var.offset + c;
+        outer[col] = static_cast<int>(inner.size());
+        for (int w : nbrs[var.vertex]) {
+          const int i = layout.index(var.shape, w);
+          if (i < 0) continue;
+          const Layout::Var& other = layout.vars()[i];
+          inner.push_back(other.offset);
+          if (!other.slider) inner.push_back(other.offset + 1);
+        }
+      }
+    }
+    outer[size] = static_cast<int>(inner.size());
+    h.matrix_.resize(size, size);
+    h.matrix_.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
+    std::copy(outer.begin(), outer.end(), h.matrix_.outerIndexPtr());
+    std::copy(inner.begin(), inner.end(), h.matrix_.innerIndexPtr());
+    h.solver_ = std::make_unique<SparseCholesky>();
+    h.Assemble(shapes);
+    if (absl::Status st = h.solver_->Analyze(h.matrix_); !st.ok()) {
+      return absl::InternalError(absl::StrCat("analyzing the comesh Hessian: ", st.message()));
+    }
+    if (absl::Status st = h.solver_->Factorize(h.matrix_); !st.ok()) {
+      return absl::InternalError(absl::StrCat("factorizing the comesh Hessian: ", st.message()));
+    }
+    return h;
+  }
+
+  absl::Status Update(const std::vector<Points>& shapes) {
+    Assemble(shapes);
+    if (absl::Status st = solver_->Factorize(matrix_); !st.ok()) {
+      return absl::InternalError(absl::StrCat("factorizing the comesh Hessian: ", st.message()));
+    }
+    return absl::OkStatus();
+  }
+
+  VectorXd ApplyInverse(const VectorXd& g) const {
+    Eigen::MatrixXd x = g;
+    (void)solver_->SolveInPlace(&x);  // cannot fail after a successful factorization
+    return x.col(0);
+  }
+  VectorXd Apply(const VectorXd& x) const { return matrix_ * x; }
+
+ private:
+  static Eigen::Matrix2d Edges(const Points& x, const Triangle& t) {
+    Eigen::Matrix2d e;
+    e.col(0) = x[t[1]] - x[t[0]];
+    e.col(1) = x[t[2]] - x[t[0]];
+    return e;
+  }
+
+  // Adds `value` at (row, col), both in one shape's rows (binary search in the column).
+  void Add(int row, int col, double value) {
+    const int* begin = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col];
+    const int* end = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col + 1];
+    matrix_.valuePtr()[std::lower_bound(begin, end, row) - matrix_.innerIndexPtr()] += value;
+  }
+
+  void AssembleShape(int s, const std::vector<Points>& shapes) {
+    const Layout& layout = *layout_;
+    const ComeshObjective& obj = *objective_;
+    const int num_shapes = layout.num_shapes();
+    const double w = obj.map_weight();
+    const int next = (s + 1) % num_shapes, prev = (s + num_shapes - 1) % num_shapes;
+    for (const Triangle& t : *triangles_) {
+      int vars[3];
+      bool any = false;
+      for (int k = 0; k < 3; ++k) {
+        vars[k] = layout.index(s, t[k]);
+        any |= vars[k] >= 0;
+      }
+      if (!any) continue;
+      const Eigen::Matrix2d e = Edges(shapes[s], t);
+      Matrix4 h4 = ((1.0 - w) / obj.odt_normalizer(s)) * OdtEdgeHessian(e);
+      if (num_shapes > 1 && w > 0.0) {
+        Matrix4 hp, hq;
+        MipsEdgeHessians(e, Edges(shapes[next], t), &hp, nullptr);
+        MipsEdgeHessians(Edges(shapes[prev], t), e, nullptr, &hq);
+        h4 += (w / obj.rest_area(s)) * hp + (w / obj.rest_area(prev)) * hq;
+      }
+      const Matrix6 h6 = CornerHessian(ProjectPositiveDefinite(h4, 1e-8));
+      for (int a = 0; a < 3; ++a) {
+        if (vars[a] < 0) continue;
+        const Layout::Var& va = layout.vars()[vars[a]];
+        for (int b = 0; b < 3; ++b) {
+          if (vars[b] < 0) continue;
+          const Layout::Var& vb = layout.vars()[vars[b]];
+          Eigen::Matrix2d block = h6.block<2, 2>(2 * a, 2 * b);
+          if (va.slider && vb.slider) {
+            Add(va.offset, vb.offset, va.direction.dot(block * vb.direction));
+          } else if (va.slider) {
+            const Eigen::RowVector2d r = va.direction.transpose() * block;
+            Add(va.offset, vb.offset, r[0]);
+            Add(va.offset, vb.offset + 1, r[1]);
+          } else if (vb.slider) {
+            const Eigen::Vector2d c = block * vb.direction;
+            Add(va.offset, vb.offset, c[0]);
+            Add(va.offset + 1, vb.offset, c[1]);
+          } else {
+            for (int i = 0; i < 2; ++i) {
+              for (int j = 0; j < 2; ++j) Add(va.offset + i, vb.offset + j, block(i, j));
+            }
+          }
+        }
+      }
+    }
+  }
+
+  void Assemble(const std::vector<Points>& shapes) {
+    std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
+    const int num_shapes = layout_->num_shapes();
+    // One chunk per shape (its rows only), so any thread count gives the same matrix.
+    ParallelChunks(
+        num_shapes, 1, objective_->threads(),
+        [&](int s, int, int) { AssembleShape(s, shapes); }, /*min_parallel=*/2);
+    // A tiny diagonal shift keeps the factor definite where the projection left a null direction
+    // (e.g. a vertex whose every triangle has all other corners fixed along one line).
+    double top = 0.0;
+    for (int c = 0; c < matrix_.cols(); ++c) top = std::max(top, matrix_.coeff(c, c));
+    for (int c = 0; c < matrix_.cols(); ++c) Add(c, c, 1e-10 * top);
+  }
+
+  const std::vector<Triangle>* triangles_ = nullptr;
+  const Layout* layout_ = nullptr;
+  const ComeshObjective* objective_ = nullptr;
+  Eigen::SparseMatrix<double> matrix_;
+  std::unique_ptr<SparseCholesky> solver_;
+};
+
 // BCQN-style curing of a search direction: for every triangle of every shape, the linearised
 // doubled area along d is c0 + c1 t. If the unit step would shrink it below cure_keep * c0, the
 // displacements of its moving corners are scaled by (1 - cure_keep) c0 / (-c1) (the factor that
@@ -465,9 +631,24 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   }
   std::vector<double> areas;
   for (int s = 0; s < mesh->num_shapes(); ++s) areas.push_back(objective->rest_area(s));
-  absl::StatusOr<InitialHessian> h0 = InitialHessian::Create(
-      mesh->triangles, layout, std::move(areas), options.laplacian_preconditioner);
-  if (!h0.ok()) return h0.status();
+  // H0: the shape-block Hessian (Newton-type) or the Laplacian model (BCQN).
+  std::optional<HessianPreconditioner> hessian;
+  std::optional<InitialHessian> laplacian;
+  if (options.hessian_preconditioner) {
+    absl::StatusOr<HessianPreconditioner> h =
+        HessianPreconditioner::Create(mesh->triangles, layout, *objective, shapes);
+    if (!h.ok()) return h.status();
+    hessian.emplace(*std::move(h));
+  } else {
+    absl::StatusOr<InitialHessian> h = InitialHessian::Create(
+        mesh->triangles, layout, std::move(areas), options.laplacian_preconditioner);
+    if (!h.ok()) return h.status();
+    laplacian.emplace(*std::move(h));
+  }
+  auto apply_inverse = [&](const VectorXd& v) {
+    return hessian ? hessian->ApplyInverse(v) : laplacian->ApplyInverse(v);
+  };
+  auto apply = [&](const VectorXd& v) { return hessian ? hessian->Apply(v) : laplacian->Apply(v); };
 
   VectorXd z = layout.Gather(shapes);
   VectorXd g = layout.GatherGradient(grad_shapes);
@@ -497,6 +678,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       return absl::OkStatus();
     }
 
+    if (hessian && options.hessian_refresh > 0 && iter > 0 && iter % options.hessian_refresh == 0) {
+      if (absl::Status st = hessian->Update(shapes); !st.ok()) return st;
+    }
     // L-BFGS two-loop recursion with H0 = B0^{-1} / beta.
     auto direction = [&]() {
       VectorXd q = g;
@@ -505,7 +689,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
         alpha[i] = pairs[i].rho * pairs[i].s.dot(q);
         q -= alpha[i] * pairs[i].y;
       }
-      VectorXd r = h0->ApplyInverse(q) / beta;
+      VectorXd r = apply_inverse(q) / beta;
       for (size_t i = 0; i < pairs.size(); ++i) {
         const double b = pairs[i].rho * pairs[i].y.dot(r);
         r += (alpha[i] - b) * pairs[i].s;
@@ -569,9 +753,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     Pair p{z_new - z, g_new - g, 0.0};
     const double sy = p.s.dot(p.y);
     if (sy > 1e-12 * p.s.norm() * p.y.norm() && options.history > 0) {
-      const VectorXd b0s = h0->Apply(p.s);
+      const VectorXd b0s = apply(p.s);
       if (options.scaling_by_inverse) {
-        beta = p.y.dot(h0->ApplyInverse(p.y)) / sy;
+        beta = p.y.dot(apply_inverse(p.y)) / sy;
       } else {
         beta = sy / p.s.dot(b0s);
       }
@@ -702,6 +886,11 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     ++rep.outer;
     current = *std::move(improved);
     rep.objective_trace.push_back(topo.objective_after);
+    // The pass itself (not the short run after it) gained little: the topology has settled, and
+    // further passes would only interleave restarts with the inner run (on large meshes the
+    // short runs keep gaining, so the pass + run test alone keeps the loop going far too long).
+    const bool settled = topo.objective_before - topo.objective_after <=
+                         options.outer_tolerance * std::abs(topo.objective_after);
     if (progress) {
       progress(
           "comesh", 1.0,
@@ -719,6 +908,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
                                              .pass_start_objective = pass_start_objective,
                                              .objective_trace = rep.objective_trace});
     }
+    if (settled) break;
   }
   if (absl::Status st = inner(options.max_iterations); !st.ok()) return st;
   rep.inner = stats.iterations;

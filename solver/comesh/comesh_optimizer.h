@@ -24,7 +24,8 @@
 //
 // Outer loop: a short inner run (outer_inner_iterations) then one topology pass (flips,
 // collapses, splits; each accepted only if valid in every shape and the objective does not
-// increase), repeated until a pass changes nothing, max_outer passes were made, or a pass plus
+// increase), repeated until a pass changes nothing, max_outer passes were made, a pass by itself
+// lowered the objective by at most outer_tolerance (relative; that pass is kept), or a pass plus
 // its short run lowered the objective by less than outer_tolerance (relative); then one inner run
 // to convergence on the final topology. The objective is a mean quality (the ODT normalizer uses
 // the current triangle count), so it is comparable across passes and never increases.
@@ -75,6 +76,10 @@ struct ComeshOptions {
   int decrease_window = 10;
   int history = 8;                       // L-BFGS curvature pairs kept
   bool laplacian_preconditioner = true;  // false: H0 = identity (plain L-BFGS)
+  // H0 = the shape-block Hessian (see "Hessian preconditioner" above) instead of the Laplacian
+  // model; refactored every hessian_refresh iterations of an inner run (0: once per run).
+  bool hessian_preconditioner = true;
+  int hessian_refresh = 0;
   bool scaling_by_inverse = false;       // beta = y^T H0 y / s^T y (else s^T y / s^T B0 s)
   double blend = 1.0;                    // blending strength (0 = plain L-BFGS pairs), see above
   bool cure = true;                      // BCQN curing of the direction
@@ -86,7 +91,7 @@ struct ComeshOptions {
   int threads = 0;  // <= 0: hardware concurrency; results do not depend on it
   // Outer topology loop: 0 = inner loop only (topology and vertex count unchanged).
   int max_outer = 30;
-  double outer_tolerance = 1e-4;    // stop when a pass + short run gains less (relative)
+  double outer_tolerance = 1e-4;    // stop when a pass (or pass + short run) gains less
   int outer_inner_iterations = 20;  // inner iterations between topology passes
   TopologyOptions topology;
   // Called after every accepted inner iterate (numbered globally from 1) with all shapes'

@@ -22,14 +22,15 @@ struct ComeshBenchArgs {
 };
 
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
-// --scale-by-inverse, --history M, --tolerance R,
+// --scale-by-inverse, --history M, --tolerance R, --laplacian (BCQN's H0), --refresh K,
 // --verbose and (when `with_max_vertices`) --max-vertices N; exits 2 with a usage line otherwise.
 inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max_vertices) {
   ComeshBenchArgs args;
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
-                 "[--scale-by-inverse] [--history M] [--tolerance R] [--verbose] [--json FILE]\n",
+                 "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
+                 "[--verbose] [--json FILE]\n",
                  argv[0], with_max_vertices ? "[--max-vertices N] " : "");
     std::exit(2);
   };
@@ -52,6 +53,10 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.scaling_by_inverse = true;
     } else if (a == "--history") {
       args.options.history = std::atoi(next());
+    } else if (a == "--laplacian") {
+      args.options.hessian_preconditioner = false;
+    } else if (a == "--refresh") {
+      args.options.hessian_refresh = std::atoi(next());
     } else if (a == "--no-cure") {
       args.options.cure = false;
     } else if (a == "--tolerance") {

@@ -293,13 +293,13 @@ TEST(ComeshOptimizerTest, RejectsBadOuterOptions) {
 // Resuming from a checkpoint in the middle gives the uninterrupted run, bit for bit: the same
 // multimesh, the same report (seconds aside), the same iterates numbered on.
 TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun) {
-  auto m = BuiltSquareToHexagon(48);
+  auto m = BuiltSquareToHexagon(160);
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
-  // Short runs between passes and a low outer tolerance: several passes, so that a checkpoint
-  // in the middle has passes (and the outer_tolerance stop) after it.
+  // Short runs between passes and no outer tolerance: several passes, so that a checkpoint in
+  // the middle has passes (and the outer stops) after it.
   options.outer_inner_iterations = 5;
-  options.outer_tolerance = 1e-7;
+  options.outer_tolerance = 0.0;
   std::vector<ComeshCheckpoint> checkpoints;
   std::vector<std::pair<int, std::vector<Points>>> iterates;
   options.on_checkpoint = [&](const ComeshCheckpoint& c) { checkpoints.push_back(c); };
