@@ -35,7 +35,9 @@ void MipsEdgeHessians(const Eigen::Matrix2d& p, const Eigen::Matrix2d& q, Matrix
 
 // The nearest positive semidefinite matrix in the Frobenius norm (negative eigenvalues set to 0)
 // of a symmetric 4 x 4 matrix, plus floor * (largest eigenvalue) on every eigenvalue so that the
-// result is positive definite whenever the input has a positive eigenvalue.
+// result is positive definite whenever the input has a positive eigenvalue. A clearly definite
+// input (its Cholesky factor has no tiny pivot) skips the eigensolver and gets floor times an
+// upper bound of its largest eigenvalue (the largest absolute row sum) instead.
 Matrix4 ProjectPositiveDefinite(const Matrix4& h, double floor);
 
 // D^T h D: the corner Hessian (corners 0, 1, 2; x and y interleaved) of an edge-space Hessian.

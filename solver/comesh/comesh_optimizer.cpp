@@ -544,8 +544,8 @@ class HessianPreconditioner {
     const int num_shapes = layout_->num_shapes();
     // One chunk per shape (its rows only), so any thread count gives the same matrix.
     ParallelChunks(
-        num_shapes, 1, objective_->threads(),
-        [&](int s, int, int) { AssembleShape(s, shapes); }, /*min_parallel=*/2);
+        num_shapes, 1, objective_->threads(), [&](int s, int, int) { AssembleShape(s, shapes); },
+        /*min_parallel=*/2);
     // A tiny diagonal shift keeps the factor definite where the projection left a null direction
     // (e.g. a vertex whose every triangle has all other corners fixed along one line).
     double top = 0.0;
@@ -772,12 +772,15 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     }
     history.push_back(f_new);
     const int window = std::max(1, options.decrease_window);
-    // A step capped by the inversion bound is "blocked": slow progress there is not convergence.
+    // A step capped by the inversion bound is "blocked": slow progress there may be one blocking
+    // triangle rather than convergence, so it only counts as a stall over twice the window.
     const bool blocked = options.max_step_fraction * max_step < 1.0;
-    const bool stalled =
-        !blocked && static_cast<int>(history.size()) > window &&
-        history[history.size() - 1 - window] - f_new <=
-            options.relative_decrease_tolerance * std::max(std::abs(f_new), 1e-300);
+    auto small_decrease = [&](int over) {
+      return static_cast<int>(history.size()) > over &&
+             history[history.size() - 1 - over] - f_new <=
+                 options.relative_decrease_tolerance * std::max(std::abs(f_new), 1e-300);
+    };
+    const bool stalled = (!blocked && small_decrease(window)) || small_decrease(2 * window);
     z = z_new;
     g = g_new;
     f = f_new;

@@ -19,7 +19,8 @@
 //   (smallest positive root of a quadratic per triangle); start at min(1, max_step_fraction *
 //   t_max) and backtrack (Armijo). Every accepted iterate is strictly positive everywhere.
 // - stops when (first that holds): ||g|| <= gradient_tolerance ||g_0||; the relative decrease
-//   over the last decrease_window iterations is below relative_decrease_tolerance; max_iterations
+//   over the last decrease_window iterations is below relative_decrease_tolerance (over twice
+//   that window if the last step was capped by the inversion bound); max_iterations
 //   (per inner run) is reached; or the line search finds no decrease.
 //
 // Outer loop: a short inner run (outer_inner_iterations) then one topology pass (flips,

@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     sv::ComeshReport r;
-    absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(*mesh, options, nullptr, progress, &r);
+    absl::StatusOr<sv::Multimesh> out =
+        inbetween::bench::TimedOptimize(*mesh, options, progress, args.repeat, &r);
     if (!out.ok()) {
       std::fprintf(stderr, "%s: %s\n", name.c_str(), out.status().ToString().c_str());
       return 1;

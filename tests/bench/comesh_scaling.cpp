@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     sv::ComeshReport r;
-    absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(*mesh, options, nullptr, progress, &r);
+    absl::StatusOr<sv::Multimesh> out =
+        inbetween::bench::TimedOptimize(*mesh, options, progress, args.repeat, &r);
     if (!out.ok()) {
       std::fprintf(stderr, "%d vertices: %s\n", paper.before, out.status().ToString().c_str());
       return 1;
@@ -67,8 +68,7 @@ int main(int argc, char** argv) {
     std::printf("%-22s %6d/%-6d %6d/%-6d %5d/%-5d %5d/%-5d %6d %9.3f %9.3f %7.1f %7.4f %7.4f\n",
                 name.c_str(), r.vertices_before, r.vertices_after, paper.before, paper.after,
                 r.inner, paper.inner, r.outer, paper.outer, r.energy_evaluations, r.seconds,
-                paper.seconds,
-                paper.seconds / r.seconds, r.map_energy, r.mesh_energy);
+                paper.seconds, paper.seconds / r.seconds, r.map_energy, r.mesh_energy);
     std::fflush(stdout);
     rows.push_back(inbetween::bench::ComeshRow(name, r, paper.seconds));
   }

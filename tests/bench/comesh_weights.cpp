@@ -48,7 +48,8 @@ int main(int argc, char** argv) {
   for (const PaperRow& paper : kPaper) {
     options.map_weight = paper.weight;
     sv::ComeshReport r;
-    absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(*mesh, options, nullptr, progress, &r);
+    absl::StatusOr<sv::Multimesh> out =
+        inbetween::bench::TimedOptimize(*mesh, options, progress, args.repeat, &r);
     if (!out.ok()) {
       std::fprintf(stderr, "w = %g: %s\n", paper.weight, out.status().ToString().c_str());
       return 1;
@@ -58,7 +59,8 @@ int main(int argc, char** argv) {
                 r.seconds, paper.seconds, paper.seconds / r.seconds, r.map_energy, paper.map,
                 r.mesh_energy, paper.mesh);
     std::fflush(stdout);
-    rows.push_back(inbetween::bench::ComeshRow("square-hexagon-w" + std::to_string(paper.weight).substr(0, 4), r, paper.seconds));
+    rows.push_back(inbetween::bench::ComeshRow(
+        "square-hexagon-w" + std::to_string(paper.weight).substr(0, 4), r, paper.seconds));
   }
   inbetween::bench::WriteRows(args.json_path, rows);
   return 0;
