@@ -30,8 +30,7 @@ Matrix4 OdtEdgeHessian(const Eigen::Matrix2d& e);
 
 // d^2 C_t / du_P^2 (in *hp) and d^2 C_t / du_Q^2 (in *hq) for source edges p and target edges q;
 // requires det q > 0. Either pointer may be null.
-void MipsEdgeHessians(const Eigen::Matrix2d& p, const Eigen::Matrix2d& q, Matrix4* hp,
-                      Matrix4* hq);
+void MipsEdgeHessians(const Eigen::Matrix2d& p, const Eigen::Matrix2d& q, Matrix4* hp, Matrix4* hq);
 
 // The nearest positive semidefinite matrix in the Frobenius norm (negative eigenvalues set to 0)
 // of a symmetric 4 x 4 matrix, plus floor * (largest eigenvalue) on every eigenvalue so that the

@@ -12,7 +12,6 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <set>
 #include <string>
 #include <utility>
 
@@ -84,18 +83,15 @@ class Layout {
     num_vertices_ = n;
     num_shapes_ = mesh.num_shapes();
     std::vector<char> used(n, 0), pinned(n, 0);
-    std::set<std::pair<int, int>> once;
     for (const Triangle& t : mesh.triangles) {
-      for (int k = 0; k < 3; ++k) {
-        used[t[k]] = 1;
-        const std::pair<int, int> e = std::minmax(t[k], t[(k + 1) % 3]);
-        if (!once.insert(e).second) once.erase(e);
-      }
+      for (int k = 0; k < 3; ++k) used[t[k]] = 1;
     }
     std::vector<std::vector<int>> boundary_nbrs(n);
-    for (const auto& [a, b] : once) {
-      boundary_nbrs[a].push_back(b);
-      boundary_nbrs[b].push_back(a);
+    for (const auto& [edge, count] :
+         EdgeUses(mesh.triangles, std::vector<char>(mesh.triangles.size(), 1))) {
+      if (count % 2 == 0) continue;  // as before: an edge used an odd number of times
+      boundary_nbrs[edge.first].push_back(edge.second);
+      boundary_nbrs[edge.second].push_back(edge.first);
     }
     std::vector<char> on_boundary(n, 0);
     for (int v = 0; v < n; ++v) on_boundary[v] = !boundary_nbrs[v].empty();
@@ -400,10 +396,12 @@ class InitialHessian {
 // shape-shape MIPS blocks are left out) and made positive definite per triangle and shape
 // (comesh_hessian.h: the edge-space 4 x 4 sum of that shape's ODT term and its two MIPS terms,
 // projected), in the reduced unknowns (a slider's row is the 2D row projected on its direction).
-// Its sparsity pattern (unknowns of one shape adjacent in the mesh) is built once per inner run;
-// Update() recomputes the values at new positions and refactors on the same pattern (CHOLMOD,
-// one symbolic analysis). Shapes are assembled on separate threads: each writes only its own
-// rows, in triangle order, so the matrix is the same for any thread count.
+// Each shape's unknowns are contiguous in z, so every shape has its own sparse matrix and
+// CHOLMOD factor; their sparsity patterns (unknowns adjacent in the mesh) are built once per
+// inner run, and Update() recomputes the values at new positions and refactors on the same
+// patterns. Shapes are assembled, factored and solved on separate threads (large meshes only):
+// each touches only its own block, in a fixed order, so results do not depend on the thread
+// count.
 class HessianPreconditioner {
  public:
   static absl::StatusOr<HessianPreconditioner> Create(const std::vector<Triangle>& triangles,
@@ -415,6 +413,7 @@ class HessianPreconditioner {
     h.layout_ = &layout;
     h.objective_ = &objective;
     const int n = layout.num_vertices();
+    const int num_shapes = layout.num_shapes();
     std::vector<std::vector<int>> nbrs(n);
     for (const Triangle& t : triangles) {
       for (int a = 0; a < 3; ++a) {
@@ -425,56 +424,102 @@ class HessianPreconditioner {
       std::sort(list.begin(), list.end());
       list.erase(std::unique(list.begin(), list.end()), list.end());
     }
-    // Column-major pattern of the symmetric matrix: column j = unknown j, rows = the unknowns of
+    // Shape s's unknowns are z[begin_[s], begin_[s + 1]) (Layout numbers them shape by shape).
+    h.begin_.assign(num_shapes + 1, layout.size());
+    for (int i = static_cast<int>(layout.vars().size()) - 1; i >= 0; --i) {
+      h.begin_[layout.vars()[i].shape] = layout.vars()[i].offset;
+    }
+    for (int s = num_shapes - 1; s >= 0; --s) h.begin_[s] = std::min(h.begin_[s], h.begin_[s + 1]);
+    h.blocks_.resize(num_shapes);
+    // Column-major pattern of each symmetric block: column j = unknown j, rows = the unknowns of
     // the same shape at the vertex and its neighbours, ascending (offsets grow with the vertex).
-    const int size = layout.size();
-    std::vector<int> outer(size + 1, 0), inner;
+    std::vector<std::vector<int>> outer(num_shapes), inner(num_shapes);
+    for (int s = 0; s < num_shapes; ++s) outer[s].assign(h.begin_[s + 1] - h.begin_[s] + 1, 0);
     for (const Layout::Var& var : layout.vars()) {
-      const int m = var.slider ? 1 : 2;
-      for (int c = 0; c < m; ++c) {
-        const int col = var.offset + c;
-        outer[col] = static_cast<int>(inner.size());
+      const int s = var.shape;
+      for (int c = 0; c < (var.slider ? 1 : 2); ++c) {
+        outer[s][var.offset + c - h.begin_[s]] = static_cast<int>(inner[s].size());
         for (int w : nbrs[var.vertex]) {
-          const int i = layout.index(var.shape, w);
+          const int i = layout.index(s, w);
           if (i < 0) continue;
           const Layout::Var& other = layout.vars()[i];
-          inner.push_back(other.offset);
-          if (!other.slider) inner.push_back(other.offset + 1);
+          inner[s].push_back(other.offset - h.begin_[s]);
+          if (!other.slider) inner[s].push_back(other.offset + 1 - h.begin_[s]);
         }
       }
     }
-    outer[size] = static_cast<int>(inner.size());
-    h.matrix_.resize(size, size);
-    h.matrix_.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
-    std::copy(outer.begin(), outer.end(), h.matrix_.outerIndexPtr());
-    std::copy(inner.begin(), inner.end(), h.matrix_.innerIndexPtr());
-    h.solver_ = std::make_unique<SparseCholesky>();
-    h.Assemble(shapes);
-    if (absl::Status st = h.solver_->Analyze(h.matrix_); !st.ok()) {
-      return absl::InternalError(absl::StrCat("analyzing the comesh Hessian: ", st.message()));
+    for (int s = 0; s < num_shapes; ++s) {
+      Block& block = h.blocks_[s];
+      const int size = h.begin_[s + 1] - h.begin_[s];
+      outer[s][size] = static_cast<int>(inner[s].size());
+      block.matrix.resize(size, size);
+      block.matrix.resizeNonZeros(static_cast<Eigen::Index>(inner[s].size()));
+      std::copy(outer[s].begin(), outer[s].end(), block.matrix.outerIndexPtr());
+      std::copy(inner[s].begin(), inner[s].end(), block.matrix.innerIndexPtr());
+      block.solver = std::make_unique<SparseCholesky>();
     }
-    if (absl::Status st = h.solver_->Factorize(h.matrix_); !st.ok()) {
-      return absl::InternalError(absl::StrCat("factorizing the comesh Hessian: ", st.message()));
-    }
+    h.threads_ = layout.size() >= kParallelUnknowns ? objective.threads() : 1;
+    if (absl::Status st = h.Refactor(shapes, /*analyze=*/true); !st.ok()) return st;
     return h;
   }
 
-  absl::Status Update(const std::vector<Points>& shapes) {
-    Assemble(shapes);
-    if (absl::Status st = solver_->Factorize(matrix_); !st.ok()) {
-      return absl::InternalError(absl::StrCat("factorizing the comesh Hessian: ", st.message()));
+  absl::Status Update(const std::vector<Points>& shapes) { return Refactor(shapes, false); }
+
+  VectorXd ApplyInverse(const VectorXd& g) const {
+    VectorXd x = g;
+    ForEachShape([&](int s) {
+      const int size = begin_[s + 1] - begin_[s];
+      if (size == 0) return;
+      Eigen::MatrixXd part = x.segment(begin_[s], size);
+      (void)blocks_[s].solver->SolveInPlace(&part);  // cannot fail after a factorization
+      x.segment(begin_[s], size) = part.col(0);
+    });
+    return x;
+  }
+  VectorXd Apply(const VectorXd& x) const {
+    VectorXd out(x.size());
+    ForEachShape([&](int s) {
+      const int size = begin_[s + 1] - begin_[s];
+      if (size > 0) out.segment(begin_[s], size) = blocks_[s].matrix * x.segment(begin_[s], size);
+    });
+    return out;
+  }
+
+ private:
+  // Below this many unknowns a thread start costs more than it saves.
+  static constexpr int kParallelUnknowns = 20000;
+
+  struct Block {
+    Eigen::SparseMatrix<double> matrix;
+    std::unique_ptr<SparseCholesky> solver;  // by pointer: keeps the class movable
+    absl::Status status;
+  };
+
+  template <typename F>
+  void ForEachShape(F&& f) const {
+    ParallelChunks(
+        static_cast<int>(blocks_.size()), 1, threads_, [&](int s, int, int) { f(s); },
+        /*min_parallel=*/2);
+  }
+
+  absl::Status Refactor(const std::vector<Points>& shapes, bool analyze) {
+    ForEachShape([&](int s) {
+      Block& block = blocks_[s];
+      AssembleShape(s, shapes);
+      if (block.matrix.rows() == 0) return;
+      block.status = analyze ? block.solver->Analyze(block.matrix) : absl::OkStatus();
+      if (block.status.ok()) block.status = block.solver->Factorize(block.matrix);
+    });
+    for (size_t s = 0; s < blocks_.size(); ++s) {
+      if (!blocks_[s].status.ok()) {
+        return absl::Status(
+            blocks_[s].status.code(),
+            absl::StrCat("comesh Hessian of shape ", s, ": ", blocks_[s].status.message()));
+      }
     }
     return absl::OkStatus();
   }
 
-  VectorXd ApplyInverse(const VectorXd& g) const {
-    Eigen::MatrixXd x = g;
-    (void)solver_->SolveInPlace(&x);  // cannot fail after a successful factorization
-    return x.col(0);
-  }
-  VectorXd Apply(const VectorXd& x) const { return matrix_ * x; }
-
- private:
   static Eigen::Matrix2d Edges(const Points& x, const Triangle& t) {
     Eigen::Matrix2d e;
     e.col(0) = x[t[1]] - x[t[0]];
@@ -482,19 +527,22 @@ class HessianPreconditioner {
     return e;
   }
 
-  // Adds `value` at (row, col), both in one shape's rows (binary search in the column).
-  void Add(int row, int col, double value) {
-    const int* begin = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col];
-    const int* end = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col + 1];
-    matrix_.valuePtr()[std::lower_bound(begin, end, row) - matrix_.innerIndexPtr()] += value;
+  // Adds `value` at (row, col) of a block (binary search in the column).
+  static void Add(Eigen::SparseMatrix<double>* m, int row, int col, double value) {
+    const int* begin = m->innerIndexPtr() + m->outerIndexPtr()[col];
+    const int* end = m->innerIndexPtr() + m->outerIndexPtr()[col + 1];
+    m->valuePtr()[std::lower_bound(begin, end, row) - m->innerIndexPtr()] += value;
   }
 
   void AssembleShape(int s, const std::vector<Points>& shapes) {
     const Layout& layout = *layout_;
     const ComeshObjective& obj = *objective_;
+    Eigen::SparseMatrix<double>* m = &blocks_[s].matrix;
+    std::fill(m->valuePtr(), m->valuePtr() + m->nonZeros(), 0.0);
     const int num_shapes = layout.num_shapes();
     const double w = obj.map_weight();
     const int next = (s + 1) % num_shapes, prev = (s + num_shapes - 1) % num_shapes;
+    const int base = begin_[s];
     for (const Triangle& t : *triangles_) {
       int vars[3];
       bool any = false;
@@ -515,49 +563,43 @@ class HessianPreconditioner {
       for (int a = 0; a < 3; ++a) {
         if (vars[a] < 0) continue;
         const Layout::Var& va = layout.vars()[vars[a]];
+        const int ra = va.offset - base;
         for (int b = 0; b < 3; ++b) {
           if (vars[b] < 0) continue;
           const Layout::Var& vb = layout.vars()[vars[b]];
-          Eigen::Matrix2d block = h6.block<2, 2>(2 * a, 2 * b);
+          const int cb = vb.offset - base;
+          const Eigen::Matrix2d block = h6.block<2, 2>(2 * a, 2 * b);
           if (va.slider && vb.slider) {
-            Add(va.offset, vb.offset, va.direction.dot(block * vb.direction));
+            Add(m, ra, cb, va.direction.dot(block * vb.direction));
           } else if (va.slider) {
             const Eigen::RowVector2d r = va.direction.transpose() * block;
-            Add(va.offset, vb.offset, r[0]);
-            Add(va.offset, vb.offset + 1, r[1]);
+            Add(m, ra, cb, r[0]);
+            Add(m, ra, cb + 1, r[1]);
           } else if (vb.slider) {
             const Eigen::Vector2d c = block * vb.direction;
-            Add(va.offset, vb.offset, c[0]);
-            Add(va.offset + 1, vb.offset, c[1]);
+            Add(m, ra, cb, c[0]);
+            Add(m, ra + 1, cb, c[1]);
           } else {
             for (int i = 0; i < 2; ++i) {
-              for (int j = 0; j < 2; ++j) Add(va.offset + i, vb.offset + j, block(i, j));
+              for (int j = 0; j < 2; ++j) Add(m, ra + i, cb + j, block(i, j));
             }
           }
         }
       }
     }
-  }
-
-  void Assemble(const std::vector<Points>& shapes) {
-    std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
-    const int num_shapes = layout_->num_shapes();
-    // One chunk per shape (its rows only), so any thread count gives the same matrix.
-    ParallelChunks(
-        num_shapes, 1, objective_->threads(), [&](int s, int, int) { AssembleShape(s, shapes); },
-        /*min_parallel=*/2);
     // A tiny diagonal shift keeps the factor definite where the projection left a null direction
     // (e.g. a vertex whose every triangle has all other corners fixed along one line).
     double top = 0.0;
-    for (int c = 0; c < matrix_.cols(); ++c) top = std::max(top, matrix_.coeff(c, c));
-    for (int c = 0; c < matrix_.cols(); ++c) Add(c, c, 1e-10 * top);
+    for (int c = 0; c < m->cols(); ++c) top = std::max(top, m->coeff(c, c));
+    for (int c = 0; c < m->cols(); ++c) Add(m, c, c, 1e-10 * top);
   }
 
   const std::vector<Triangle>* triangles_ = nullptr;
   const Layout* layout_ = nullptr;
   const ComeshObjective* objective_ = nullptr;
-  Eigen::SparseMatrix<double> matrix_;
-  std::unique_ptr<SparseCholesky> solver_;
+  std::vector<int> begin_;  // shape s: unknowns [begin_[s], begin_[s + 1])
+  std::vector<Block> blocks_;
+  int threads_ = 1;
 };
 
 // BCQN-style curing of a search direction: for every triangle of every shape, the linearised

@@ -81,13 +81,13 @@ struct ComeshOptions {
   // model; refactored every hessian_refresh iterations of an inner run (0: once per run).
   bool hessian_preconditioner = true;
   int hessian_refresh = 0;
-  bool scaling_by_inverse = false;       // beta = y^T H0 y / s^T y (else s^T y / s^T B0 s)
-  double blend = 1.0;                    // blending strength (0 = plain L-BFGS pairs), see above
-  bool cure = true;                      // BCQN curing of the direction
-  double cure_keep = 0.5;          // curing keeps at least this fraction of each linearised area
-  bool slide_boundary = true;      // boundary vertices on straight runs slide (see above)
-  double max_step_fraction = 0.8;  // line search starts at this fraction of the inversion bound
-  double armijo = 1e-4;            // sufficient decrease constant c1
+  bool scaling_by_inverse = false;  // beta = y^T H0 y / s^T y (else s^T y / s^T B0 s)
+  double blend = 1.0;               // blending strength (0 = plain L-BFGS pairs), see above
+  bool cure = true;                 // BCQN curing of the direction
+  double cure_keep = 0.5;           // curing keeps at least this fraction of each linearised area
+  bool slide_boundary = true;       // boundary vertices on straight runs slide (see above)
+  double max_step_fraction = 0.8;   // line search starts at this fraction of the inversion bound
+  double armijo = 1e-4;             // sufficient decrease constant c1
   int max_backtracks = 50;
   int threads = 0;  // <= 0: hardware concurrency; results do not depend on it
   // Outer topology loop: 0 = inner loop only (topology and vertex count unchanged).

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <utility>
 #include <vector>
 
@@ -36,12 +35,9 @@ class Editor {
     removed_.assign(n, 0);
     locked_.assign(n, 0);
     protected_.assign(n, 0);
-    std::map<std::pair<int, int>, int> uses;
+    const auto uses = EdgeUses(triangles_, alive_);
     for (size_t t = 0; t < triangles_.size(); ++t) {
-      for (int k = 0; k < 3; ++k) {
-        incident_[triangles_[t][k]].push_back(static_cast<int>(t));
-        ++uses[std::minmax(triangles_[t][k], triangles_[t][(k + 1) % 3])];
-      }
+      for (int k = 0; k < 3; ++k) incident_[triangles_[t][k]].push_back(static_cast<int>(t));
       double odt, mips;
       objective_.TriangleTerms(triangles_[t], shapes_, &odt, &mips);
       odt_sum_ += odt;
@@ -71,13 +67,8 @@ class Editor {
 
   // Interior edges (each once) as (a, b) with a < b.
   std::vector<std::pair<int, int>> InteriorEdges() const {
-    std::map<std::pair<int, int>, int> uses;
-    for (size_t t = 0; t < triangles_.size(); ++t) {
-      if (!alive_[t]) continue;
-      for (int k = 0; k < 3; ++k) ++uses[std::minmax(triangles_[t][k], triangles_[t][(k + 1) % 3])];
-    }
     std::vector<std::pair<int, int>> edges;
-    for (const auto& [edge, count] : uses) {
+    for (const auto& [edge, count] : EdgeUses(triangles_, alive_)) {
       if (count == 2) edges.push_back(edge);
     }
     return edges;
@@ -375,6 +366,26 @@ class Editor {
 };
 
 }  // namespace
+
+std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Triangle>& triangles,
+                                                          const std::vector<char>& alive) {
+  std::vector<std::pair<int, int>> all;
+  all.reserve(3 * triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    if (!alive[t]) continue;
+    for (int k = 0; k < 3; ++k)
+      all.push_back(std::minmax(triangles[t][k], triangles[t][(k + 1) % 3]));
+  }
+  std::sort(all.begin(), all.end());
+  std::vector<std::pair<std::pair<int, int>, int>> uses;
+  for (size_t i = 0; i < all.size();) {
+    size_t j = i;
+    while (j < all.size() && all[j] == all[i]) ++j;
+    uses.push_back({all[i], static_cast<int>(j - i)});
+    i = j;
+  }
+  return uses;
+}
 
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
                                           const TopologyOptions& options, TopologyReport* report) {

@@ -17,6 +17,9 @@
 // Multimesh::boundary and cohesive_edges are remapped.
 #pragma once
 
+#include <utility>
+#include <vector>
+
 #include "absl/status/statusor.h"
 #include "solver/mesh/multimesh.h"
 
@@ -42,6 +45,12 @@ struct TopologyReport {
   double objective_before = 0.0;  // E of the input (for its own triangle count)
   double objective_after = 0.0;   // E of the output (for its own triangle count)
 };
+
+// Every edge (a, b), a < b, of the triangles t with alive[t] != 0, with the number of those
+// triangles using it (1 = boundary, 2 = interior), in increasing (a, b) order. One sort of 3T
+// pairs: the topology pass and the optimizer list edges often.
+std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Triangle>& triangles,
+                                                          const std::vector<char>& alive);
 
 // One topology pass. `mesh` must be valid (positive triangles in every shape). The returned
 // multimesh is valid too and has objective_after <= objective_before.

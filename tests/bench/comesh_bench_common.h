@@ -17,6 +17,7 @@ namespace inbetween::bench {
 
 struct ComeshBenchArgs {
   int max_vertices = 40000;
+  int min_vertices = 0;  // rows below it are skipped (e.g. to run the 311k row alone)
   std::string json_path;
   bool verbose = false;
   int repeat = 5;  // runs shorter than a second are repeated; the median time is reported
@@ -26,7 +27,7 @@ struct ComeshBenchArgs {
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
 // --scale-by-inverse, --history M, --tolerance R, --laplacian (BCQN's H0), --refresh K,
 // --outer-inner K,
-// --repeat N, --verbose and (when `with_max_vertices`) --max-vertices N; exits 2 with a usage line
+// --repeat N, --verbose and (when `with_max_vertices`) --max-vertices N and --min-vertices N; exits 2 with a usage line
 // otherwise.
 inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max_vertices) {
   ComeshBenchArgs args;
@@ -35,7 +36,7 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
                  "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
                  "[--repeat N] [--verbose] [--json FILE]\n",
-                 argv[0], with_max_vertices ? "[--max-vertices N] " : "");
+                 argv[0], with_max_vertices ? "[--max-vertices N] [--min-vertices N] " : "");
     std::exit(2);
   };
   for (int i = 1; i < argc; ++i) {
@@ -43,6 +44,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
     auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : (usage(), ""); };
     if (a == "--max-vertices" && with_max_vertices) {
       args.max_vertices = std::atoi(next());
+    } else if (a == "--min-vertices" && with_max_vertices) {
+      args.min_vertices = std::atoi(next());
     } else if (a == "--json") {
       args.json_path = next();
     } else if (a == "--threads") {
