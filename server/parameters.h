@@ -19,7 +19,7 @@ inline constexpr int kMaxFrames = 100000;
 inline constexpr double kDefaultMapWeight = 0.5;
 inline constexpr int kDefaultMaxOuterIterations = 50;
 inline constexpr int kDefaultMaxInnerIterations = 200;
-inline constexpr double kDefaultComeshTolerance = 1e-6;
+inline constexpr double kDefaultComeshTolerance = 1e-5;
 
 // Range checks of every field (the ranges in inbetween.proto). Errors are INVALID_ARGUMENT
 // naming `field`.subfield, or RESOURCE_EXHAUSTED for frames above kMaxFrames.

@@ -534,6 +534,16 @@ class HessianPreconditioner {
     m->valuePtr()[std::lower_bound(begin, end, row) - m->innerIndexPtr()] += value;
   }
 
+  // Adds a at (row, col) and b at (row + 1, col): the rows of a free vertex's two unknowns are
+  // next to each other in every column.
+  static void AddPair(Eigen::SparseMatrix<double>* m, int row, int col, double a, double b) {
+    const int* begin = m->innerIndexPtr() + m->outerIndexPtr()[col];
+    const int* end = m->innerIndexPtr() + m->outerIndexPtr()[col + 1];
+    double* v = m->valuePtr() + (std::lower_bound(begin, end, row) - m->innerIndexPtr());
+    v[0] += a;
+    v[1] += b;
+  }
+
   void AssembleShape(int s, const std::vector<Points>& shapes) {
     const Layout& layout = *layout_;
     const ComeshObjective& obj = *objective_;
@@ -577,12 +587,10 @@ class HessianPreconditioner {
             Add(m, ra, cb + 1, r[1]);
           } else if (vb.slider) {
             const Eigen::Vector2d c = block * vb.direction;
-            Add(m, ra, cb, c[0]);
-            Add(m, ra + 1, cb, c[1]);
+            AddPair(m, ra, cb, c[0], c[1]);
           } else {
-            for (int i = 0; i < 2; ++i) {
-              for (int j = 0; j < 2; ++j) Add(m, ra + i, cb + j, block(i, j));
-            }
+            AddPair(m, ra, cb, block(0, 0), block(1, 0));
+            AddPair(m, ra, cb + 1, block(0, 1), block(1, 1));
           }
         }
       }
