@@ -3,18 +3,25 @@
 // quasi-Newton loop on a fixed topology with an outer loop of topology operations applied
 // identically to every shape (comesh_topology.h).
 //
-// Inner loop: Blended Cured Quasi-Newton (after Zhu, Bridson & Kaufman 2018), i.e. L-BFGS with
-// - initial inverse Hessian H0_s = A_s J_s^T L^{-1} J_s / beta: L the uniform graph Laplacian of
-//   the shared topology restricted to the vertices movable in every shape, factored ONCE as a
-//   scalar matrix (CHOLMOD, solver/core/sparse_cholesky.h) and applied to x and y of all shapes
-//   in one multi-column solve; J_s lifts a sliding boundary unknown to 2D along its line (so the
-//   solved 2D direction is projected onto the slider tangent). Vertices movable only in some
-//   shapes get the Jacobi value A_s / deg. beta = s^T y / s^T B0 s from the newest pair.
+// Inner loop: L-BFGS after Blended Cured Quasi-Newton (Zhu, Bridson & Kaufman 2018), with
+// - initial Hessian B0 (default, hessian_preconditioner): the objective's own Hessian, block
+//   diagonal by shape (the shape-shape MIPS blocks dropped), projected positive definite per
+//   triangle and shape (comesh_hessian.h), in the reduced unknowns (a slider's row projected on
+//   its direction); one sparse matrix and CHOLMOD factor per shape, built and factored once per
+//   inner run (every hessian_refresh iterations if set). A Newton-type model: inner iterations
+//   grow far more slowly with the mesh size than with BCQN's Laplacian (docs/benchmarks.md).
+//   With hessian_preconditioner = false, BCQN's model: H0_s = A_s J_s^T L^{-1} J_s / beta, L the
+//   uniform graph Laplacian of the shared topology restricted to the vertices movable in every
+//   shape, factored ONCE as a scalar matrix (CHOLMOD, solver/core/sparse_cholesky.h) and applied
+//   to x and y of all shapes in one multi-column solve; J_s lifts a sliding boundary unknown to
+//   2D along its line. Vertices movable only in some shapes get the Jacobi value A_s / deg.
+//   Either way H0 = B0^{-1} / beta with beta = s^T y / s^T B0 s from the newest pair.
 // - blending: y <- (1 - theta) y + theta beta B0 s with theta = min(1, blend ||g|| / ||g_0||):
-//   the Sobolev (Laplacian) model dominates far from the minimum, measured curvature near it.
+//   the model dominates far from the minimum, measured curvature near it.
 // - curing: per triangle and shape, corners whose unit step would shrink the linearised area
 //   below cure_keep of its current value are scaled down (CureDirection), so a few blocking
 //   triangles do not shrink the step of the whole mesh; kept only if still a descent direction.
+//   (Tried and measured worse on the 35k row: the exact quadratic area and repeated passes.)
 // - line search: the largest step t_max before any triangle of any shape reaches zero area
 //   (smallest positive root of a quadratic per triangle); start at min(1, max_step_fraction *
 //   t_max) and backtrack (Armijo). Every accepted iterate is strictly positive everywhere.
