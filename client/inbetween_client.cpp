@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 
 #include "absl/strings/match.h"
@@ -10,9 +11,46 @@
 
 namespace inbetween::client {
 
+namespace {
+
+// gRPC's text for a message over a size limit (message_size filter): "Received message larger
+// than max (A vs. B)" / "Sent message larger than max (A vs. B)". Empty when `message` is not it.
+std::string NameMessageSizeLimit(const std::string& message) {
+  long long size = 0, limit = 0;
+  char direction[16] = {};
+  if (std::sscanf(message.c_str(), "%15s message larger than max (%lld vs. %lld)", direction, &size,
+                  &limit) != 3) {
+    return "";
+  }
+  const std::string which = direction;
+  if (which != "Received" && which != "Sent") return "";
+  const bool request = which == "Received";  // received by the server
+  return absl::StrCat(
+      request ? "the request is " : "the reply is ", size, " bytes, over the server's limit of ",
+      limit, " bytes (inbetween-server --max-message-bytes ", limit, "): ",
+      request ? "send smaller drawings (fewer points) or raise the server's --max-message-bytes"
+              : "raise the server's --max-message-bytes or ask for less (a smaller mesh, fewer "
+                "vertices per frame)",
+      " [gRPC: ", message, "]");
+}
+
+}  // namespace
+
 absl::Status FromGrpcStatus(const grpc::Status& status) {
   if (status.ok()) return absl::OkStatus();
+  if (status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED) {
+    if (std::string named = NameMessageSizeLimit(status.error_message()); !named.empty()) {
+      return absl::ResourceExhaustedError(named);
+    }
+  }
   return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+}
+
+std::shared_ptr<grpc::Channel> CreateChannelForServer(
+    const std::string& target, const std::shared_ptr<grpc::ChannelCredentials>& credentials) {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(-1);
+  return grpc::CreateCustomChannel(target, credentials, args);
 }
 
 bool IsTransient(const grpc::Status& status) {

@@ -26,8 +26,21 @@
 
 namespace inbetween::client {
 
-// grpc::Status -> absl::Status (same code, same message).
+// grpc::Status -> absl::Status (same code, same message), except gRPC's own message-size
+// refusals: a request or reply over the server's --max-message-bytes is refused by gRPC before
+// any handler runs, as RESOURCE_EXHAUSTED "Received message larger than max (A vs. B)" (the
+// request) or "Sent message larger than max (A vs. B)" (the reply), naming no flag. Those become
+// "the request is A bytes, over the server's limit of B bytes (inbetween-server
+// --max-message-bytes B) ..." with gRPC's text kept at the end (docs/hardening.md). On a channel
+// from CreateChannelForServer (no receive limit of the client's own) every such refusal is the
+// server's.
 absl::Status FromGrpcStatus(const grpc::Status& status);
+
+// A channel to a remote inbetween-server without gRPC's default 4 MiB receive limit: the server's
+// --max-message-bytes bounds its replies (its default, 64 MiB, is what the embedded service's
+// in-process channel allows), and a size refusal is then always the server's limit.
+std::shared_ptr<grpc::Channel> CreateChannelForServer(
+    const std::string& target, const std::shared_ptr<grpc::ChannelCredentials>& credentials);
 
 // The frames of one Inbetween stream, as received.
 struct FramesResult {

@@ -312,7 +312,7 @@ int main(int argc, char** argv) {
     embedded = std::move(*started);
     channel = embedded->InProcessChannel();
   } else {
-    channel = grpc::CreateChannel(server, Credentials(tls_ca));
+    channel = inbetween::client::CreateChannelForServer(server, Credentials(tls_ca));
   }
 
   inbetween::client::ClientOptions client_options;

@@ -246,8 +246,7 @@ absl::StatusOr<SessionState> DirSessionStore::Get(absl::string_view id) const {
 absl::StatusOr<SessionState> DirSessionStore::Create(SessionState state) {
   std::lock_guard lock(mutex_);
   if (by_id_.size() >= options_.max_sessions) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("the server holds the maximum of ", options_.max_sessions, " sessions"));
+    return SessionLimitError(options_.max_sessions);
   }
   std::string id = state.session.id();
   if (id.empty()) {

@@ -319,8 +319,7 @@ absl::StatusOr<SessionState> RedisSessionStore::Create(SessionState state) {
       return stamped;
     }
     if (verdict == "full") {
-      return absl::ResourceExhaustedError(
-          absl::StrCat("the server holds the maximum of ", options_.max_sessions, " sessions"));
+      return SessionLimitError(options_.max_sessions);
     }
     if (verdict != "exists") return Malformed("create");
     if (chosen_id) return absl::AlreadyExistsError(absl::StrCat("session ", id, " already exists"));

@@ -25,6 +25,12 @@ absl::Status SessionNotFoundError(absl::string_view id) {
   return absl::NotFoundError(absl::StrCat("session ", id, " not found"));
 }
 
+absl::Status SessionLimitError(size_t max_sessions) {
+  return absl::ResourceExhaustedError(absl::StrCat("the server holds the maximum of ", max_sessions,
+                                                   " sessions (--max-sessions ", max_sessions,
+                                                   "); delete some first"));
+}
+
 absl::StatusOr<uint64_t> ParsePageToken(absl::string_view page_token) {
   uint64_t after = 0;
   if (page_token.empty()) return after;
@@ -116,8 +122,7 @@ absl::StatusOr<SessionState> MemorySessionStore::Get(absl::string_view id) const
 absl::StatusOr<SessionState> MemorySessionStore::Create(SessionState state) {
   std::lock_guard lock(mutex_);
   if (by_id_.size() >= max_sessions_) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("the server holds the maximum of ", max_sessions_, " sessions"));
+    return SessionLimitError(max_sessions_);
   }
   std::string id = state.session.id();
   if (id.empty()) {

@@ -81,6 +81,10 @@ absl::Status StaleVersionError(absl::string_view id, uint64_t current, uint64_t 
 
 absl::Status SessionNotFoundError(absl::string_view id);
 
+// The RESOURCE_EXHAUSTED of a full store, naming the flag that sets the limit, worded the same by
+// every store.
+absl::Status SessionLimitError(size_t max_sessions);
+
 // Parses a List page token (a sequence number); INVALID_ARGUMENT if it is not one.
 absl::StatusOr<uint64_t> ParsePageToken(absl::string_view page_token);
 

@@ -259,6 +259,8 @@ class Driver:
         self.expect_error(f"PutDrawing of drawing {a.max_drawings + 1}",
                           lambda: self.put(b1, polyline_drawing("one more", outline(0, 64))),
                           [grpc.StatusCode.RESOURCE_EXHAUSTED], ["--max-drawings"])
+        # gRPC refuses it before any handler, with its own text; the C++ client (and so the CLI)
+        # rewords it naming --max-message-bytes (client/inbetween_client.h, FromGrpcStatus).
         huge = pb.Drawing(name="huge.svg", svg="<svg>" + " " * (a.max_message_bytes + 1) + "</svg>")
         self.expect_error(f"PutDrawing of {a.max_message_bytes + 1}+ bytes",
                           lambda: self.put(fresh, huge),
@@ -267,7 +269,8 @@ class Driver:
         extra = [self.create(f"extra{i}") for i in range(a.max_sessions - 4)]
         self.expect_error(f"CreateSession number {a.max_sessions + 1}",
                           lambda: self.create("one too many"),
-                          [grpc.StatusCode.RESOURCE_EXHAUSTED], [f"maximum of {a.max_sessions}"])
+                          [grpc.StatusCode.RESOURCE_EXHAUSTED],
+                          [f"maximum of {a.max_sessions} sessions (--max-sessions {a.max_sessions})"])
         for s in extra + [fresh]:
             self.stub.DeleteSession(pb.DeleteSessionRequest(session_id=s.id), timeout=30,
                                     metadata=self.md(s.id))

@@ -493,5 +493,51 @@ TEST_F(InbetweenClientFailoverTest, OptimizationIsNotRetriedOnANonTransientError
   EXPECT_TRUE(retries_.empty());
 }
 
+// Refusals by a server limit name the flag: --max-sessions (the store's refusal) and
+// --max-message-bytes, which gRPC enforces before any handler with its own text; the client
+// translates that (FromGrpcStatus) for a request over the limit and for a reply over it.
+TEST(InbetweenClientLimitsTest, RefusalsNameTheServerFlag) {
+  server::ServerOptions options;
+  options.listen = "127.0.0.1:0";
+  options.max_sessions = 1;
+  options.max_message_bytes = 4096;
+  auto started = server::InbetweenServer::Start(options);
+  ASSERT_TRUE(started.ok()) << started.status();
+  InbetweenClient client(CreateChannelForServer("127.0.0.1:" + std::to_string((*started)->port()),
+                                                grpc::InsecureChannelCredentials()));
+  auto session = client.CreateSession("one");
+  ASSERT_TRUE(session.ok()) << session.status();
+
+  auto second = client.CreateSession("two");
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(second.status().message(), HasSubstr("maximum of 1 sessions (--max-sessions 1)"));
+
+  v1::PutDrawingRequest request;
+  request.set_session_id(session->id());
+  request.set_expected_version(session->version());
+  request.mutable_drawing()->set_name("big");
+  request.mutable_drawing()->set_svg(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\"><rect width=\"10\" height=\"10\"/>" +
+      std::string(5000, ' ') + "</svg>");
+  auto put = client.PutDrawing(request);
+  EXPECT_EQ(put.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(put.status().message(), HasSubstr("the request is"));
+  EXPECT_THAT(put.status().message(), HasSubstr("over the server's limit of 4096 bytes "
+                                                "(inbetween-server --max-message-bytes 4096)"));
+
+  // A small request whose reply (the circle flattened to a few thousand points) is over it.
+  request.mutable_drawing()->set_svg(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\"><circle r=\"100\"/></svg>");
+  request.set_flatten_tolerance(1e-4);
+  put = client.PutDrawing(request);
+  EXPECT_EQ(put.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(put.status().message(), HasSubstr("the reply is"));
+  EXPECT_THAT(put.status().message(), HasSubstr("(inbetween-server --max-message-bytes 4096)"));
+
+  // Other statuses pass unchanged.
+  const grpc::Status other(grpc::StatusCode::RESOURCE_EXHAUSTED, "frames = 9 exceeds 8");
+  EXPECT_EQ(FromGrpcStatus(other).message(), "frames = 9 exceeds 8");
+}
+
 }  // namespace
 }  // namespace inbetween::client
