@@ -112,6 +112,19 @@ cholmod_sparse View(const Eigen::SparseMatrix<double>& a) {
   return s;
 }
 
+// CHOLMOD's out-of-memory (malloc returned NULL) and too-large (size_t overflow) statuses are
+// RESOURCE_EXHAUSTED, so that callers can tell them from a matrix that is not SPD.
+absl::Status CholmodError(const cholmod_common& common, const char* step) {
+  const std::string what = absl::StrCat("SparseCholesky: ", step);
+  if (common.status == CHOLMOD_OUT_OF_MEMORY) {
+    return absl::ResourceExhaustedError(absl::StrCat(what, " ran out of memory"));
+  }
+  if (common.status == CHOLMOD_TOO_LARGE) {
+    return absl::ResourceExhaustedError(absl::StrCat(what, ": the problem is too large"));
+  }
+  return absl::InternalError(absl::StrCat(what, " failed (CHOLMOD status ", common.status, ")"));
+}
+
 absl::Status CheckShape(const Eigen::SparseMatrix<double>& a) {
   if (a.rows() != a.cols()) {
     return absl::InvalidArgumentError(
@@ -141,8 +154,7 @@ absl::Status SparseCholesky::Analyze(const Eigen::SparseMatrix<double>& a) {
   cholmod_sparse view = View(a);
   m.factor = cholmod_analyze(&view, &m.common);
   if (m.factor == nullptr || m.common.status < CHOLMOD_OK) {
-    return absl::InternalError(absl::StrCat(
-        "SparseCholesky: symbolic analysis failed (CHOLMOD status ", m.common.status, ")"));
+    return CholmodError(m.common, "symbolic analysis");
   }
   return absl::OkStatus();
 }
@@ -165,8 +177,7 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
   cholmod_sparse view = View(a);
   const int ok = cholmod_factorize(&view, m.factor, &m.common);
   if (!ok || m.common.status < CHOLMOD_OK) {
-    return absl::InternalError(absl::StrCat(
-        "SparseCholesky: numeric factorization failed (CHOLMOD status ", m.common.status, ")"));
+    return CholmodError(m.common, "numeric factorization");
   }
   if (m.common.status == CHOLMOD_NOT_POSDEF || m.factor->minor < m.factor->n) {
     return absl::FailedPreconditionError(

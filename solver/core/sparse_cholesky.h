@@ -29,7 +29,8 @@ class SparseCholesky {
   absl::Status Analyze(const Eigen::SparseMatrix<double>& a);
 
   // Numeric factorization of `a`, which must have exactly the analyzed pattern (same compressed
-  // structure). FailedPrecondition if `a` is not positive definite.
+  // structure). FailedPrecondition if `a` is not positive definite. Analyze and Factorize answer
+  // RESOURCE_EXHAUSTED when CHOLMOD runs out of memory (it reports, never throws).
   absl::Status Factorize(const Eigen::SparseMatrix<double>& a);
 
   // Analyze + Factorize.

@@ -452,8 +452,12 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       }
       std::stable_sort(mapped_before.begin(), mapped_before.end(),
                        [d](int a, int b) { return std::abs(a - d) < std::abs(b - d); });
+      // Out of memory is not a map that was not found: neither retried nor reworded as one.
+      auto final_error = [](const absl::Status& s) {
+        return absl::IsCancelled(s) || absl::IsResourceExhausted(s);
+      };
       for (size_t k = 0;
-           k < mapped_before.size() && k < 3 && !mapped.ok() && !absl::IsCancelled(mapped.status());
+           k < mapped_before.size() && k < 3 && !mapped.ok() && !final_error(mapped.status());
            ++k) {
         Points start;
         for (int v : global) start.push_back(mesh.shapes[mapped_before[k]][v]);
@@ -462,10 +466,15 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
         chained.start = &start;
         absl::StatusOr<Points> retry =
             injective(MapToBoundary(source, triangles, boundary, target_boundary, chained, cancel));
-        if (retry.ok() || absl::IsCancelled(retry.status())) mapped = std::move(retry);
+        if (retry.ok() || final_error(retry.status())) mapped = std::move(retry);
       }
       if (!mapped.ok()) {
         if (absl::IsCancelled(mapped.status())) return mapped.status();
+        if (absl::IsResourceExhausted(mapped.status())) {
+          return absl::ResourceExhaustedError(absl::StrCat("mapping drawing ", ref + 1,
+                                                           "'s mesh into drawing ", d + 1, ": ",
+                                                           mapped.status().message()));
+        }
         return absl::FailedPreconditionError(absl::StrCat("cannot map drawing ", ref + 1,
                                                           "'s mesh into drawing ", d + 1, ": ",
                                                           mapped.status().message()));

@@ -11,18 +11,26 @@
 // line-searches towards it, never beyond the first step at which some det(J) reaches zero
 // (smallest positive root of a quadratic per triangle). At the end the boundary is placed
 // exactly, checked to invert nothing, and the interior polished with the boundary fixed.
+//
+// The sparse systems are solved by SuiteSparse (CHOLMOD for the SPD proxy, KLU for the
+// non-symmetric Tutte system), not by Eigen's sparse solvers: those are not exception-safe when
+// an allocation fails (a double free, docs/hardening.md), while these report it, and the map
+// answers RESOURCE_EXHAUSTED naming the system.
 #include "solver/mesh/map_to_boundary.h"
 
 #include <Eigen/LU>
 #include <Eigen/SVD>
-#include <Eigen/Sparse>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <memory>
+#include <new>
 
 #include "absl/strings/str_cat.h"
+#include "solver/core/sparse_cholesky.h"
+#include "solver/core/sparse_lu.h"
 #include "solver/geometry/polygon.h"
 #include "solver/mesh/validate.h"
 
@@ -98,8 +106,10 @@ class Mapper {
     return e;
   }
 
-  // Minimiser of the SLIM proxy sum_t area |W_t (J_t - R_t)|^2 (+ boundary penalty).
-  bool ProxySolve(const Points& x, const Constraints& c, Points* out) const {
+  // Minimiser of the SLIM proxy sum_t area |W_t (J_t - R_t)|^2 (+ boundary penalty). OK, or
+  // FAILED_PRECONDITION when the system is numerically not positive definite (the penalty
+  // outgrew the factorization), RESOURCE_EXHAUSTED when memory ran out.
+  absl::Status ProxySolve(const Points& x, const Constraints& c, Points* out) const {
     const int nf = c.free_count;
     std::vector<Eigen::Triplet<double>> entries;
     entries.reserve(triangles_.size() * 36 + 2 * boundary_.size());
@@ -170,22 +180,23 @@ class Mapper {
     // numbers each iteration.
     Cached& cached = cache_[&c];
     if (cached.size != 2 * nf || cached.nonzeros != h.nonZeros()) {
-      cached.solver = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>();
-      cached.solver->analyzePattern(h);
+      cached.size = -1;  // until the analysis succeeds
+      cached.solver = std::make_unique<SparseCholesky>();
+      if (absl::Status s = cached.solver->Analyze(h); !s.ok()) return SolveError(s, h);
       cached.size = 2 * nf;
       cached.nonzeros = h.nonZeros();
     }
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& solver = *cached.solver;
-    solver.factorize(h);
-    if (solver.info() != Eigen::Success) return false;
-    const Eigen::VectorXd sol = solver.solve(rhs);
-    if (solver.info() != Eigen::Success || !sol.allFinite()) return false;
+    SparseCholesky& solver = *cached.solver;
+    if (absl::Status s = solver.Factorize(h); !s.ok()) return SolveError(s, h);
+    absl::StatusOr<Eigen::MatrixXd> sol = solver.Solve(rhs);
+    if (!sol.ok()) return SolveError(sol.status(), h);
+    if (!sol->allFinite()) return absl::FailedPreconditionError("map: the proxy solve diverged");
     *out = x;
     for (size_t v = 0; v < x.size(); ++v) {
       const int fi = c.free_index[v];
-      (*out)[v] = fi < 0 ? c.fixed_at[v] : Point(sol(fi), sol(nf + fi));
+      (*out)[v] = fi < 0 ? c.fixed_at[v] : Point((*sol)(fi, 0), (*sol)(nf + fi, 0));
     }
-    return true;
+    return absl::OkStatus();
   }
 
   // Largest alpha such that x + a * d keeps every triangle positive for all a in [0, alpha).
@@ -213,10 +224,14 @@ class Mapper {
   }
 
   // One iteration: proxy solve, flip-free backtracking line search on the true energy. Returns
-  // the relative energy decrease (0 when no progress), or -1 if the solve failed.
-  double Iterate(Points* x, const Constraints& c) const {
+  // the relative energy decrease (0 when no progress), or -1 if the solve failed numerically;
+  // RESOURCE_EXHAUSTED when memory ran out.
+  absl::StatusOr<double> Iterate(Points* x, const Constraints& c) const {
     Points proxy;
-    if (!ProxySolve(*x, c, &proxy)) return -1;
+    if (absl::Status s = ProxySolve(*x, c, &proxy); !s.ok()) {
+      if (absl::IsResourceExhausted(s)) return s;
+      return -1.0;
+    }
     Points d(x->size());
     for (size_t v = 0; v < x->size(); ++v) d[v] = proxy[v] - (*x)[v];
     double alpha = std::min(1.0, 0.9 * MaxStep(*x, d));
@@ -243,7 +258,7 @@ class Mapper {
 
  private:
   struct Cached {
-    std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> solver;
+    std::unique_ptr<SparseCholesky> solver;
     int size = -1;
     Eigen::Index nonzeros = -1;
   };
@@ -253,11 +268,23 @@ class Mapper {
   const Points& target_;
   std::vector<TriangleFrame> frames_;
   double total_area_ = 0.0;
+
+  // Out of memory names the system; anything else is a numerical failure of the solve.
+  static absl::Status SolveError(const absl::Status& s, const Eigen::SparseMatrix<double>& h) {
+    if (absl::IsResourceExhausted(s)) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat("map: out of memory factorizing the ", h.rows(), " x ", h.cols(),
+                       " SLIM proxy system (", h.nonZeros(), " nonzeros): ", s.message()));
+    }
+    return absl::FailedPreconditionError(absl::StrCat("map: linear solve failed: ", s.message()));
+  }
 };
 
-// Mean-value Tutte embedding with the boundary pinned to `target`.
-bool TutteEmbedding(const Points& source, const std::vector<Triangle>& triangles,
-                    const std::vector<int>& boundary, const Points& target, Points* out) {
+// Mean-value Tutte embedding with the boundary pinned to `target`. The weights are not symmetric
+// (w_ij != w_ji), so the system is solved by LU. OK, FAILED_PRECONDITION when the system is
+// singular or the solution not finite, RESOURCE_EXHAUSTED when memory ran out.
+absl::Status TutteEmbedding(const Points& source, const std::vector<Triangle>& triangles,
+                            const std::vector<int>& boundary, const Points& target, Points* out) {
   const int n = static_cast<int>(source.size());
   std::vector<int> interior(n, -1);
   std::vector<bool> pinned(n, false);
@@ -268,7 +295,7 @@ bool TutteEmbedding(const Points& source, const std::vector<Triangle>& triangles
   }
   *out = source;
   for (size_t k = 0; k < boundary.size(); ++k) (*out)[boundary[k]] = target[k];
-  if (ni == 0) return true;
+  if (ni == 0) return absl::OkStatus();
   std::vector<Eigen::Triplet<double>> entries;
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(ni, 2);
   for (const Triangle& t : triangles) {
@@ -290,15 +317,21 @@ bool TutteEmbedding(const Points& source, const std::vector<Triangle>& triangles
   }
   Eigen::SparseMatrix<double> m(ni, ni);
   m.setFromTriplets(entries.begin(), entries.end());
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-  lu.compute(m);
-  if (lu.info() != Eigen::Success) return false;
-  const Eigen::MatrixXd sol = lu.solve(rhs);
-  if (lu.info() != Eigen::Success || !sol.allFinite()) return false;
-  for (int v = 0; v < n; ++v) {
-    if (interior[v] >= 0) (*out)[v] = sol.row(interior[v]).transpose();
+  absl::StatusOr<Eigen::MatrixXd> sol = SparseLuSolve(m, rhs);
+  if (!sol.ok()) {
+    if (absl::IsResourceExhausted(sol.status())) {
+      return absl::ResourceExhaustedError(absl::StrCat("map: out of memory factorizing the ", ni,
+                                                       " x ", ni,
+                                                       " Tutte system: ", sol.status().message()));
+    }
+    return absl::FailedPreconditionError(
+        absl::StrCat("map: Tutte embedding failed: ", sol.status().message()));
   }
-  return true;
+  if (!sol->allFinite()) return absl::FailedPreconditionError("map: Tutte embedding not finite");
+  for (int v = 0; v < n; ++v) {
+    if (interior[v] >= 0) (*out)[v] = sol->row(interior[v]).transpose();
+  }
+  return absl::OkStatus();
 }
 
 // The least-squares affine map of the source boundary onto the target boundary, applied to every
@@ -325,13 +358,12 @@ bool AffineStart(const Points& source, const std::vector<Triangle>& triangles,
   return CountInverted(triangles, *out) == 0;
 }
 
-}  // namespace
-
-absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Triangle>& triangles,
-                                     const std::vector<int>& boundary,
-                                     const Points& target_boundary,
-                                     const MapToBoundaryOptions& options, const CancelToken* cancel,
-                                     MapToBoundaryReport* report) {
+absl::StatusOr<Points> MapToBoundaryImpl(const Points& source,
+                                         const std::vector<Triangle>& triangles,
+                                         const std::vector<int>& boundary,
+                                         const Points& target_boundary,
+                                         const MapToBoundaryOptions& options,
+                                         const CancelToken* cancel, MapToBoundaryReport* report) {
   const int n = static_cast<int>(source.size());
   if (boundary.size() != target_boundary.size() || boundary.size() < 3) {
     return absl::InvalidArgumentError(absl::StrCat("map: ", boundary.size(),
@@ -367,8 +399,12 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
   Points x;
   bool placed = false;
   const bool convex = IsConvexPositive(target_boundary);
-  if (((options.tutte_when_convex && convex) || options.tutte_first_always) &&
-      TutteEmbedding(source, triangles, boundary, target_boundary, &x)) {
+  absl::Status tutte = absl::FailedPreconditionError("not tried");
+  if ((options.tutte_when_convex && convex) || options.tutte_first_always) {
+    tutte = TutteEmbedding(source, triangles, boundary, target_boundary, &x);
+    if (absl::IsResourceExhausted(tutte)) return tutte;
+  }
+  if (tutte.ok()) {
     // Non-convex targets: keep it only if no triangle is folded or nearly flat (relative to
     // its source area), so the polish's barrier starts from a sound map.
     bool sound = CountInverted(triangles, x) == 0;
@@ -414,7 +450,9 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
            ++it) {
         if (cancelled()) return absl::CancelledError("map: cancelled");
         ++rep.iterations;
-        const double progress = mapper.Iterate(&x, pull);
+        const absl::StatusOr<double> iterated = mapper.Iterate(&x, pull);
+        if (!iterated.ok()) return iterated.status();
+        const double progress = *iterated;
         if (progress < 0) break;  // the penalty outgrew the factorization: the pull is stuck
         if (progress < 1e-7) break;
       }
@@ -438,9 +476,7 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
     }
     // Exact placement: the proxy step with the boundary pinned; it must not fold anything.
     Points proxy;
-    if (!mapper.ProxySolve(x, fixed, &proxy)) {
-      return absl::FailedPreconditionError("map: linear solve failed");
-    }
+    if (absl::Status s = mapper.ProxySolve(x, fixed, &proxy); !s.ok()) return s;
     Points d(n);
     for (int v = 0; v < n; ++v) d[v] = proxy[v] - x[v];
     if (!(mapper.MaxStep(x, d) > 1.0)) {
@@ -460,8 +496,9 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
   for (int it = 0; it < options.polish_iterations; ++it) {
     if (cancelled()) return absl::CancelledError("map: cancelled");
     ++rep.iterations;
-    const double progress = mapper.Iterate(&x, fixed);
-    if (progress < 1e-6) break;
+    const absl::StatusOr<double> progress = mapper.Iterate(&x, fixed);
+    if (!progress.ok()) return progress.status();
+    if (*progress < 1e-6) break;
   }
   for (size_t k = 0; k < boundary.size(); ++k) x[boundary[k]] = target_boundary[k];
   if (const int inverted = CountInverted(triangles, x); inverted > 0) {
@@ -469,6 +506,24 @@ absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Tri
   }
   rep.energy = mapper.Distortion(x) / mapper.total_area();
   return x;
+}
+
+}  // namespace
+
+absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Triangle>& triangles,
+                                     const std::vector<int>& boundary,
+                                     const Points& target_boundary,
+                                     const MapToBoundaryOptions& options, const CancelToken* cancel,
+                                     MapToBoundaryReport* report) {
+  // The sparse solvers report their own allocation failures; what is left to throw are the
+  // vectors and freshly constructed Eigen objects of the iterations (exception-safe: they are
+  // never half-resized), so a failed allocation ends the map here, not the process.
+  try {
+    return MapToBoundaryImpl(source, triangles, boundary, target_boundary, options, cancel, report);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "map: out of memory (", source.size(), " vertices, ", triangles.size(), " triangles)"));
+  }
 }
 
 }  // namespace inbetween::solver

@@ -43,7 +43,8 @@ struct MapToBoundaryReport {
 // `source` is a valid mesh (all `triangles` positive), `boundary` lists its boundary vertices in
 // order and `target_boundary[k]` is where boundary[k] must go. Returns positions for every
 // vertex: boundary exactly on target, no triangle inverted or degenerate.
-// Errors: INVALID_ARGUMENT (sizes), FAILED_PRECONDITION (no injective map found), CANCELLED.
+// Errors: INVALID_ARGUMENT (sizes), FAILED_PRECONDITION (no injective map found), CANCELLED,
+// RESOURCE_EXHAUSTED (out of memory, naming the system being factorized when it was a solve).
 absl::StatusOr<Points> MapToBoundary(const Points& source, const std::vector<Triangle>& triangles,
                                      const std::vector<int>& boundary,
                                      const Points& target_boundary,

@@ -4,10 +4,18 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <Eigen/LU>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <string>
 
+#include "absl/strings/match.h"
 #include "solver/geometry/correspondence.h"
 #include "solver/geometry/polygon.h"
 #include "solver/mesh/cgal_triangulate.h"
@@ -52,14 +60,16 @@ struct MapCase {
 };
 
 // Mesh of the first outline, boundary target from the second (no boundary Steiner points: the
-// size bound is generous relative to the boundary spacing).
-MapCase Make(const Points& from, const Points& to, int n) {
+// size bound, none or `max_edge`, is generous relative to the boundary spacing).
+MapCase Make(const Points& from, const Points& to, int n, double max_edge = 0.0) {
   CorrespondenceOptions c;
   c.vertices = n;
   absl::StatusOr<Correspondence> corr =
       ComputeCorrespondence({Drawing{{Outline{from}}}, Drawing{{Outline{to}}}}, c);
   EXPECT_TRUE(corr.ok()) << corr.status();
-  absl::StatusOr<PolygonTriangulation> tri = CgalTriangulate(corr->boundaries[0], {});
+  TriangulateOptions mesh_options;
+  mesh_options.max_edge = max_edge;
+  absl::StatusOr<PolygonTriangulation> tri = CgalTriangulate(corr->boundaries[0], mesh_options);
   EXPECT_TRUE(tri.ok()) << tri.status();
   EXPECT_TRUE(tri->boundary_steiner.empty());
   MapCase s;
@@ -174,6 +184,106 @@ TEST(MapToBoundaryTest, Cancelled) {
   absl::StatusOr<Points> x =
       MapToBoundary(s.source, s.triangles, s.boundary, s.target, {}, &cancel);
   EXPECT_EQ(x.status().code(), absl::StatusCode::kCancelled);
+}
+
+// Out of memory: MapToBoundary in a forked child whose address space is capped (RLIMIT_AS) a
+// little above what it maps already, for a range of caps, so that allocations fail at many
+// different points (the sparse factorizations among them). Eigen's SparseLU / SimplicialLDLT
+// died there (a double free after a failed allocation, docs/hardening.md); the map must answer
+// RESOURCE_EXHAUSTED "... out of memory ..." or succeed, never die.
+struct CappedRun {
+  int exit = -1;        // 0 mapped, 1 RESOURCE_EXHAUSTED naming "out of memory", 2 another status,
+                        // 5 an exception escaped; 128 + signal when the child died
+  std::string message;  // the status message (first 300 bytes)
+};
+
+size_t AddressSpaceBytes() {
+  std::ifstream in("/proc/self/status");
+  std::string key;
+  while (in >> key) {
+    if (key == "VmSize:") {
+      size_t kb = 0;
+      in >> kb;
+      return kb * 1024;
+    }
+    in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  }
+  return 0;
+}
+
+CappedRun MapUnderCap(const MapCase& s, const MapToBoundaryOptions& options, size_t headroom) {
+  int fds[2];
+  if (pipe(fds) != 0) return {};
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    const size_t now = AddressSpaceBytes();
+    rlimit cap;
+    cap.rlim_cur = cap.rlim_max = now + headroom;
+    if (now == 0 || setrlimit(RLIMIT_AS, &cap) != 0) _exit(3);
+    absl::StatusOr<Points> x = absl::UnknownError("not run");
+    try {
+      x = MapToBoundary(s.source, s.triangles, s.boundary, s.target, options);
+    } catch (...) {
+      _exit(5);  // not into gtest's handler: the child must not go on running tests
+    }
+    char text[300] = {};
+    int code = 0;
+    if (!x.ok()) {
+      const absl::Status& st = x.status();
+      code =
+          absl::IsResourceExhausted(st) && absl::StrContains(st.message(), "out of memory") ? 1 : 2;
+      std::snprintf(text, sizeof(text), "%s", st.ToString().c_str());
+    }
+    if (write(fds[1], text, sizeof(text)) < 0) _exit(4);
+    _exit(code);  // no destructors, no gtest in the child
+  }
+  close(fds[1]);
+  CappedRun run;
+  char text[300] = {};
+  if (read(fds[0], text, sizeof(text)) > 0) run.message.assign(text, strnlen(text, sizeof(text)));
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  run.exit = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return run;
+}
+
+// Caps from 1 MiB above the child's address space up, 1.15x apart, until two runs in a row map
+// (at most 512 MiB): every run maps or answers out of memory, the tightest run out, and some
+// run out in `factorizing` (the named sparse system), not only in the vectors around it.
+void ExpectOutOfMemoryIsAStatus(const MapCase& s, const MapToBoundaryOptions& options,
+                                const std::string& factorizing) {
+  int out_of_memory = 0, mapped = 0, named = 0, last = -1, mapped_in_a_row = 0;
+  for (double headroom = 1 << 20; headroom < (512 << 20) && mapped_in_a_row < 2; headroom *= 1.15) {
+    const CappedRun run = MapUnderCap(s, options, static_cast<size_t>(headroom));
+    EXPECT_TRUE(run.exit == 0 || run.exit == 1) << "cap +" << static_cast<long>(headroom / 1024)
+                                                << " KiB: exit " << run.exit << " " << run.message;
+    out_of_memory += run.exit == 1;
+    mapped += run.exit == 0;
+    named += run.exit == 1 && absl::StrContains(run.message, factorizing);
+    if (run.exit == 1) std::printf("cap +%.0f KiB: %s\n", headroom / 1024, run.message.c_str());
+    last = run.exit;
+    mapped_in_a_row = run.exit == 0 ? mapped_in_a_row + 1 : 0;
+  }
+  EXPECT_GT(out_of_memory, 0);
+  EXPECT_GT(mapped, 0);
+  EXPECT_EQ(last, 0);
+  EXPECT_GT(named, 0) << "no cap ran out in " << factorizing;
+}
+
+TEST(MapToBoundaryTest, OutOfMemoryInTheTutteSystemIsAStatus) {
+  const MapCase s = Make(Square(), Hexagon(), 400, 1.5);
+  std::printf("%zu vertices, %zu triangles\n", s.source.size(), s.triangles.size());
+  ExpectOutOfMemoryIsAStatus(s, {}, "Tutte system");
+}
+
+TEST(MapToBoundaryTest, OutOfMemoryInTheProxySystemIsAStatus) {
+  const MapCase s = Make(Bar(), Arch(), 400, 2.0);
+  std::printf("%zu vertices, %zu triangles\n", s.source.size(), s.triangles.size());
+  MapToBoundaryOptions options;
+  options.tutte_first_always = false;  // the progressive pull: SLIM proxy solves only
+  ExpectOutOfMemoryIsAStatus(s, options, "SLIM proxy system");
 }
 
 }  // namespace
