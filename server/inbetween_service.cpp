@@ -9,9 +9,11 @@
 #include <cmath>
 #include <exception>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <random>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -68,9 +70,9 @@ std::string RequestId(const grpc::ServerContext& context) {
 // anything thrown (a bug must not take the server down), maps the status once, logs one line and
 // counts it. `session_id` is read after `body` ran (CreateSession sets it).
 template <typename Body>
-grpc::Status RunRpc(const ServiceOptions& options, grpc::ServerContext* context,
-                    absl::string_view rpc, const std::string& session_id, Caller* caller,
-                    Body&& body) {
+grpc::Status RunRpcUnguarded(const ServiceOptions& options, grpc::ServerContext* context,
+                             absl::string_view rpc, const std::string& session_id, Caller* caller,
+                             Body&& body) {
   const Clock::time_point start = Clock::now();
   caller->request_id = RequestId(*context);
   context->AddInitialMetadata("x-request-id", caller->request_id);
@@ -86,6 +88,18 @@ grpc::Status RunRpc(const ServiceOptions& options, grpc::ServerContext* context,
   if (status.ok()) {
     try {
       status = body();
+    } catch (const std::bad_alloc&) {
+      // Out of memory (e.g. under an address-space cap) is not a bug: RESOURCE_EXHAUSTED, like
+      // the solver's own allocation failures ("mapping drawing k ...: out of memory ...").
+      status = absl::ResourceExhaustedError(
+          absl::StrCat(rpc, ": the server ran out of memory; try again later or a smaller job"));
+    } catch (const std::system_error& e) {
+      // EAGAIN from std::thread: no memory (or no thread) left for a worker's stack.
+      status =
+          e.code() == std::errc::resource_unavailable_try_again
+              ? absl::ResourceExhaustedError(absl::StrCat(
+                    rpc, ": the server could not start a thread (", e.what(), "); try again later"))
+              : absl::InternalError(absl::StrCat(rpc, " failed: ", e.what()));
     } catch (const std::exception& e) {
       status = absl::InternalError(absl::StrCat(rpc, " failed: ", e.what()));
     } catch (...) {
@@ -99,6 +113,23 @@ grpc::Status RunRpc(const ServiceOptions& options, grpc::ServerContext* context,
     options.metrics->ObserveRpc(rpc, absl::StatusCodeToString(status.code()), seconds);
   }
   return out;
+}
+
+// RunRpcUnguarded, and if even that throws (out of memory while wording an error, logging or
+// counting it: seen under an address-space cap), an answer that allocates nothing (a message
+// short enough for std::string's inline buffer). Escaping, the exception would reach gRPC's own
+// catch, whose message allocation fails again and terminates the process.
+template <typename Body>
+grpc::Status RunRpc(const ServiceOptions& options, grpc::ServerContext* context,
+                    absl::string_view rpc, const std::string& session_id, Caller* caller,
+                    Body&& body) {
+  try {
+    return RunRpcUnguarded(options, context, rpc, session_id, caller, std::forward<Body>(body));
+  } catch (const std::bad_alloc&) {
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, "out of memory");
+  } catch (...) {
+    return grpc::Status(grpc::StatusCode::INTERNAL, "internal error");
+  }
 }
 
 absl::Status RequireSessionId(const std::string& id) {
