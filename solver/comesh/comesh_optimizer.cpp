@@ -684,7 +684,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   // H0: the shape-block Hessian (Newton-type) or the Laplacian model (BCQN).
   std::optional<HessianPreconditioner> hessian;
   std::optional<InitialHessian> laplacian;
-  if (options.hessian_preconditioner) {
+  if (options.hessian_preconditioner && mesh->num_shapes() <= options.hessian_max_shapes) {
     absl::StatusOr<HessianPreconditioner> h =
         HessianPreconditioner::Create(mesh->triangles, layout, *objective, shapes);
     if (!h.ok()) return h.status();

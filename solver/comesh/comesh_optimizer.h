@@ -4,13 +4,14 @@
 // identically to every shape (comesh_topology.h).
 //
 // Inner loop: L-BFGS after Blended Cured Quasi-Newton (Zhu, Bridson & Kaufman 2018), with
-// - initial Hessian B0 (default, hessian_preconditioner): the objective's own Hessian, block
-//   diagonal by shape (the shape-shape MIPS blocks dropped), projected positive definite per
-//   triangle and shape (comesh_hessian.h), in the reduced unknowns (a slider's row projected on
-//   its direction); one sparse matrix and CHOLMOD factor per shape, built and factored once per
-//   inner run (every hessian_refresh iterations if set). A Newton-type model: inner iterations
-//   grow far more slowly with the mesh size than with BCQN's Laplacian (docs/benchmarks.md).
-//   With hessian_preconditioner = false, BCQN's model: H0_s = A_s J_s^T L^{-1} J_s / beta, L the
+// - initial Hessian B0 (default for two shapes, hessian_preconditioner): the objective's
+//   Hessian, block diagonal by shape (the shape-shape MIPS blocks dropped), projected positive
+//   definite per triangle and shape (comesh_hessian.h), in the reduced unknowns (a slider's row
+//   projected on its direction); one sparse matrix and CHOLMOD factor per shape, built and
+//   factored once per inner run (every hessian_refresh iterations if set). A Newton-type
+//   model: inner iterations grow far more slowly with the mesh size than with BCQN's Laplacian
+//   (docs/benchmarks.md).
+//   Otherwise (more shapes, or hessian_preconditioner = false) BCQN's model: H0_s = A_s J_s^T L^{-1} J_s / beta, L the
 //   uniform graph Laplacian of the shared topology restricted to the vertices movable in every
 //   shape, factored ONCE as a scalar matrix (CHOLMOD, solver/core/sparse_cholesky.h) and applied
 //   to x and y of all shapes in one multi-column solve; J_s lifts a sliding boundary unknown to
@@ -75,7 +76,7 @@ struct ComeshCheckpoint;
 
 struct ComeshOptions {
   double map_weight = 0.5;           // w of the objective (S-Table 1 default)
-  int max_iterations = 1000;         // per inner run
+  int max_iterations = 200;          // per inner run (the service default too)
   double gradient_tolerance = 1e-6;  // relative to the inner run's initial gradient
   // Stop when the objective fell by less than relative_decrease_tolerance * |f| over the last
   // decrease_window iterations (a window, not one iteration: single steps can be tiny while the
@@ -85,9 +86,14 @@ struct ComeshOptions {
   int decrease_window = 10;
   int history = 8;                       // L-BFGS curvature pairs kept
   bool laplacian_preconditioner = true;  // false: H0 = identity (plain L-BFGS)
-  // H0 = the shape-block Hessian (see "Hessian preconditioner" above) instead of the Laplacian
-  // model; refactored every hessian_refresh iterations of an inner run (0: once per run).
+  // H0 = the shape-block Hessian (see "Inner loop" above) instead of the Laplacian model, for
+  // multimeshes of at most hessian_max_shapes shapes; refactored every hessian_refresh
+  // iterations of an inner run (0: once per run). The block-diagonal model drops the MIPS
+  // coupling between neighbouring shapes of the cycle, which matters more the more shapes there
+  // are: measured on the walking character (S-Table 3), it beats the Laplacian for 2 shapes and
+  // loses from 3 on (more time, and from 4 shapes a worse mesh energy).
   bool hessian_preconditioner = true;
+  int hessian_max_shapes = 2;
   int hessian_refresh = 0;
   bool scaling_by_inverse = false;  // beta = y^T H0 y / s^T y (else s^T y / s^T B0 s)
   double blend = 1.0;               // blending strength (0 = plain L-BFGS pairs), see above
