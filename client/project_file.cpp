@@ -161,7 +161,8 @@ absl::Status ParseMeshing(const Node& node, v1::MeshingParameters* out) {
 
 absl::Status ParseComesh(const Node& node, v1::ComeshParameters* out) {
   if (absl::Status s = node.CheckKeys(
-          {"map_weight", "max_outer_iterations", "max_inner_iterations", "tolerance"});
+          {"map_weight", "max_outer_iterations", "max_inner_iterations", "tolerance",
+           "outer_tolerance"});
       !s.ok()) {
     return s;
   }
@@ -180,6 +181,10 @@ absl::Status ParseComesh(const Node& node, v1::ComeshParameters* out) {
   if (node.Has("tolerance")) {
     PROJECT_ASSIGN_OR_RETURN(v, node.Child("tolerance").Number(1e-15, 0.999));
     out->set_tolerance(v);
+  }
+  if (node.Has("outer_tolerance")) {
+    PROJECT_ASSIGN_OR_RETURN(v, node.Child("outer_tolerance").Number(0.0, 0.999));
+    out->set_outer_tolerance(v);
   }
   return absl::OkStatus();
 }
@@ -456,6 +461,7 @@ json ProjectToJson(const Project& project, const std::filesystem::path& base_dir
   if (c.max_outer_iterations()) comesh["max_outer_iterations"] = c.max_outer_iterations();
   if (c.max_inner_iterations()) comesh["max_inner_iterations"] = c.max_inner_iterations();
   if (c.tolerance() > 0) comesh["tolerance"] = c.tolerance();
+  if (c.has_outer_tolerance()) comesh["outer_tolerance"] = c.outer_tolerance();
   if (!comesh.empty()) doc["comesh"] = std::move(comesh);
   const v1::InbetweenParameters& p = project.parameters.inbetween();
   json inbetween = json::object();

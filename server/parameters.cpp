@@ -37,6 +37,13 @@ absl::Status ValidateComesh(const inbetween::v1::ComeshParameters& comesh,
         absl::StrCat(field, ".max_inner_iterations = ", comesh.max_inner_iterations(),
                      " is not in [1, 100000]"));
   }
+  if (comesh.has_outer_tolerance()) {
+    if (!(std::isfinite(comesh.outer_tolerance()) && comesh.outer_tolerance() >= 0 &&
+          comesh.outer_tolerance() < 1)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".outer_tolerance = ", comesh.outer_tolerance(), " is not in [0, 1)"));
+    }
+  }
   if (comesh.tolerance() != 0) {
     if (!(std::isfinite(comesh.tolerance()) && comesh.tolerance() > 0 && comesh.tolerance() < 1)) {
       return absl::InvalidArgumentError(
@@ -167,6 +174,7 @@ solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& com
                                : static_cast<int>(comesh.max_inner_iterations());
   options.relative_decrease_tolerance =
       comesh.tolerance() == 0 ? kDefaultComeshTolerance : comesh.tolerance();
+  if (comesh.has_outer_tolerance()) options.outer_tolerance = comesh.outer_tolerance();
   return options;
 }
 

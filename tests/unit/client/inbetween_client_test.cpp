@@ -398,10 +398,12 @@ TEST_F(InbetweenClientFailoverTest, GetSessionAndListSessionsAreRetried) {
   EXPECT_EQ(retries_.size(), 3u);
 }
 
-// Bounded so that the test stays short but makes several topology passes.
+// Bounded so that the test stays short but makes several topology passes (no outer tolerance:
+// passes until one changes nothing or 8 were made).
 v1::ComeshParameters ShortComesh() {
   v1::ComeshParameters comesh;
   comesh.set_max_outer_iterations(8);
+  comesh.set_outer_tolerance(0.0);
   comesh.set_max_inner_iterations(200);
   return comesh;
 }
@@ -415,7 +417,8 @@ TEST_F(InbetweenClientFailoverTest, ResumedOptimizationGivesTheMultimeshOfAnUnin
       reference_session, [&](const v1::ComeshIteration& it) { reference_iterations.push_back(it); },
       nullptr, &comesh);
   ASSERT_TRUE(reference.ok()) << reference.status();
-  ASSERT_GE(reference->outer_iterations(), 3u);
+  // Resumed from the checkpoint of pass 1, the run still has a pass (and the outer stops) ahead.
+  ASSERT_GE(reference->outer_iterations(), 2u);
   // Break the stream 3 iterations after the first topology pass (its checkpoint is stored by
   // then), and the resumed stream after its first iteration.
   int first_after_pass = -1;
