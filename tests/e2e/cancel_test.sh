@@ -3,8 +3,9 @@
 # OptimizeComesh (pentagon -> star, iteration limits at their maximum) holds the slot; a second
 # heavy call is RESOURCE_EXHAUSTED with retry-after-ms; the client cancels the optimization and
 # the server is idle again within a second (metrics: no heavy job running, queue empty), a new
-# heavy call is admitted, and the cancelled optimization stored nothing. A 1 s deadline on the
-# same optimization ends it with DEADLINE_EXCEEDED and the server is idle again within a second.
+# heavy call is admitted, and the cancelled optimization stored nothing. A 1 s deadline on an
+# optimization of a finely meshed copy ends it with DEADLINE_EXCEEDED and the server is idle again
+# within a second.
 source "$(dirname "$0")/lib/common.sh"
 PY=/usr/bin/python3
 "$INBETWEEN_SRC/client/python/generate_stubs.sh" "$WORK/stubs"
@@ -81,10 +82,14 @@ assert len(list(client.frames(other.id, frames=3))) == 4  # header + 3 frames
 after = client.get_session(session.id)
 assert after.version == session.version and after.stage == pb.STAGE_MULTIMESH, after
 
-# A deadline stops the work the same way: DEADLINE_EXCEEDED, then idle within a second.
+# A deadline stops the work the same way: DEADLINE_EXCEEDED, then idle within a second. The pair
+# is meshed finely (~20k vertices): at the default size the optimizer's Newton-type inner loop
+# converges within the second.
+long = client.build(client.upload_svgs(client.create_session("long"), drawings),
+                    boundary_vertices=800, max_edge_relative=0.008)
 with inbetween.Client(address, timeout=1.0) as hurried:
     try:
-        hurried.optimize(session, max_outer_iterations=1000, max_inner_iterations=100000,
+        hurried.optimize(long, max_outer_iterations=1000, max_inner_iterations=100000,
                          tolerance=1e-15)
         raise SystemExit("a minutes-long optimization finished within its 1 s deadline")
     except inbetween.InbetweenError as e:

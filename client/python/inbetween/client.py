@@ -170,9 +170,13 @@ class Client:
             raise InbetweenError("INTERNAL", f"{method} ended without a result")
         return result
 
-    def build(self, session, on_progress=None):
-        """BuildMultimesh; returns the session at STAGE_MULTIMESH."""
+    def build(self, session, on_progress=None, boundary_vertices=0, max_edge_relative=0.0):
+        """BuildMultimesh; returns the session at STAGE_MULTIMESH. boundary_vertices and
+        max_edge_relative (MeshingParameters): 0 = the session's parameters."""
         request = pb.BuildMultimeshRequest(session_id=session.id, expected_version=session.version)
+        if boundary_vertices or max_edge_relative:
+            request.meshing.CopyFrom(pb.MeshingParameters(boundary_vertices=boundary_vertices,
+                                                          max_edge_relative=max_edge_relative))
         return self._run_stage("BuildMultimesh", request, session.id, on_progress,
                                "result").session
 
