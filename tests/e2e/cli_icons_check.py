@@ -169,6 +169,19 @@ def parse_path(d):
         cur = [p]
         subpaths.append([cur, False])
 
+    # Both read the loop's current ox, oy, pen and last_ctrl when called.
+    def point(i):
+        x, i = number(i)
+        y, i = number(i)
+        return (ox + x, oy + y), i
+
+    def reflected(kind):
+        # S and T: the previous control point of the same kind mirrored about the pen, else the
+        # pen itself.
+        if last_ctrl and last_ctrl[0] == kind:
+            return (2 * pen[0] - last_ctrl[1][0], 2 * pen[1] - last_ctrl[1][1])
+        return pen
+
     while True:
         i = skip(i)
         if i >= n:
@@ -189,9 +202,8 @@ def parse_path(d):
         C = cmd.upper()
         ox, oy = pen if rel else (0.0, 0.0)
         if C == "M":
-            x, i = number(i)
-            y, i = number(i)
-            pen = start = (ox + x, oy + y)
+            pen, i = point(i)
+            start = pen
             begin(pen)
             cmd = "l" if rel else "L"
             last_ctrl = None
@@ -199,10 +211,9 @@ def parse_path(d):
         if cur is None:
             begin(pen)
             start = pen
+
         if C == "L":
-            x, i = number(i)
-            y, i = number(i)
-            pen = (ox + x, oy + y)
+            pen, i = point(i)
             cur.append(pen)
             last_ctrl = None
         elif C == "H":
@@ -217,30 +228,19 @@ def parse_path(d):
             last_ctrl = None
         elif C in "CS":
             if C == "C":
-                x1, i = number(i)
-                y1, i = number(i)
-                c1 = (ox + x1, oy + y1)
+                c1, i = point(i)
             else:
-                c1 = (2 * pen[0] - last_ctrl[1][0], 2 * pen[1] - last_ctrl[1][1]) \
-                    if last_ctrl and last_ctrl[0] == "C" else pen
-            x2, i = number(i)
-            y2, i = number(i)
-            x, i = number(i)
-            y, i = number(i)
-            c2, p = (ox + x2, oy + y2), (ox + x, oy + y)
+                c1 = reflected("C")
+            c2, i = point(i)
+            p, i = point(i)
             cubic(pen, c1, c2, p, cur)
             pen, last_ctrl = p, ("C", c2)
         elif C in "QT":
             if C == "Q":
-                x1, i = number(i)
-                y1, i = number(i)
-                q = (ox + x1, oy + y1)
+                q, i = point(i)
             else:
-                q = (2 * pen[0] - last_ctrl[1][0], 2 * pen[1] - last_ctrl[1][1]) \
-                    if last_ctrl and last_ctrl[0] == "Q" else pen
-            x, i = number(i)
-            y, i = number(i)
-            p = (ox + x, oy + y)
+                q = reflected("Q")
+            p, i = point(i)
             c1 = (pen[0] + 2 / 3 * (q[0] - pen[0]), pen[1] + 2 / 3 * (q[1] - pen[1]))
             c2 = (p[0] + 2 / 3 * (q[0] - p[0]), p[1] + 2 / 3 * (q[1] - p[1]))
             cubic(pen, c1, c2, p, cur)
@@ -251,9 +251,7 @@ def parse_path(d):
             rot, i = number(i)
             large, i = flag(i)
             sweep, i = flag(i)
-            x, i = number(i)
-            y, i = number(i)
-            p = (ox + x, oy + y)
+            p, i = point(i)
             arc(pen, rx, ry, rot, large, sweep, p, cur)
             pen, last_ctrl = p, None
         else:
