@@ -20,6 +20,7 @@
 #include "solver/comesh/comesh_hessian.h"
 #include "solver/comesh/comesh_objective.h"
 #include "solver/comesh/comesh_topology.h"
+#include "solver/comesh/mips_energy.h"
 #include "solver/core/parallel_chunks.h"
 #include "solver/core/sparse_cholesky.h"
 
@@ -520,13 +521,6 @@ class HessianPreconditioner {
     return absl::OkStatus();
   }
 
-  static Eigen::Matrix2d Edges(const Points& x, const Triangle& t) {
-    Eigen::Matrix2d e;
-    e.col(0) = x[t[1]] - x[t[0]];
-    e.col(1) = x[t[2]] - x[t[0]];
-    return e;
-  }
-
   // Adds `value` at (row, col) of a block (binary search in the column).
   static void Add(Eigen::SparseMatrix<double>* m, int row, int col, double value) {
     const int* begin = m->innerIndexPtr() + m->outerIndexPtr()[col];
@@ -561,12 +555,12 @@ class HessianPreconditioner {
         any |= vars[k] >= 0;
       }
       if (!any) continue;
-      const Eigen::Matrix2d e = Edges(shapes[s], t);
+      const Eigen::Matrix2d e = EdgeMatrix(shapes[s], t);
       Matrix4 h4 = ((1.0 - w) / obj.odt_normalizer(s)) * OdtEdgeHessian(e);
       if (num_shapes > 1 && w > 0.0) {
         Matrix4 hp, hq;
-        MipsEdgeHessians(e, Edges(shapes[next], t), &hp, nullptr);
-        MipsEdgeHessians(Edges(shapes[prev], t), e, nullptr, &hq);
+        MipsEdgeHessians(e, EdgeMatrix(shapes[next], t), &hp, nullptr);
+        MipsEdgeHessians(EdgeMatrix(shapes[prev], t), e, nullptr, &hq);
         h4 += (w / obj.rest_area(s)) * hp + (w / obj.rest_area(prev)) * hq;
       }
       const Matrix6 h6 = CornerHessian(ProjectPositiveDefinite(h4, 1e-8));
@@ -679,8 +673,6 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     stats->stop_reason = "no_free";
     return absl::OkStatus();
   }
-  std::vector<double> areas;
-  for (int s = 0; s < mesh->num_shapes(); ++s) areas.push_back(objective->rest_area(s));
   // H0: the shape-block Hessian (Newton-type) or the Laplacian model (BCQN).
   std::optional<HessianPreconditioner> hessian;
   std::optional<InitialHessian> laplacian;
@@ -690,6 +682,8 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     if (!h.ok()) return h.status();
     hessian.emplace(*std::move(h));
   } else {
+    std::vector<double> areas;
+    for (int s = 0; s < mesh->num_shapes(); ++s) areas.push_back(objective->rest_area(s));
     absl::StatusOr<InitialHessian> h = InitialHessian::Create(
         mesh->triangles, layout, std::move(areas), options.laplacian_preconditioner);
     if (!h.ok()) return h.status();

@@ -11,12 +11,13 @@
 //   factored once per inner run (every hessian_refresh iterations if set). A Newton-type
 //   model: inner iterations grow far more slowly with the mesh size than with BCQN's Laplacian
 //   (docs/benchmarks.md).
-//   Otherwise (more shapes, or hessian_preconditioner = false) BCQN's model: H0_s = A_s J_s^T L^{-1} J_s / beta, L the
-//   uniform graph Laplacian of the shared topology restricted to the vertices movable in every
-//   shape, factored ONCE as a scalar matrix (CHOLMOD, solver/core/sparse_cholesky.h) and applied
-//   to x and y of all shapes in one multi-column solve; J_s lifts a sliding boundary unknown to
-//   2D along its line. Vertices movable only in some shapes get the Jacobi value A_s / deg.
-//   Either way H0 = B0^{-1} / beta with beta = s^T y / s^T B0 s from the newest pair.
+//   Otherwise (more shapes, or hessian_preconditioner = false) BCQN's model: H0_s = A_s J_s^T
+//   L^{-1} J_s / beta, L the uniform graph Laplacian of the shared topology restricted to the
+//   vertices movable in every shape, factored ONCE as a scalar matrix (CHOLMOD,
+//   solver/core/sparse_cholesky.h) and applied to x and y of all shapes in one multi-column solve;
+//   J_s lifts a sliding boundary unknown to 2D along its line. Vertices movable only in some shapes
+//   get the Jacobi value A_s / deg. Either way H0 = B0^{-1} / beta with beta = s^T y / s^T B0 s
+//   from the newest pair.
 // - blending: y <- (1 - theta) y + theta beta B0 s with theta = min(1, blend ||g|| / ||g_0||):
 //   the model dominates far from the minimum, measured curvature near it.
 // - curing: per triangle and shape, corners whose unit step would shrink the linearised area

@@ -18,13 +18,6 @@ Eigen::Matrix2d Adjugate(const Eigen::Matrix2d& m) {
   return a;
 }
 
-Eigen::Matrix2d EdgeMatrix(const std::array<Point, 3>& x) {
-  Eigen::Matrix2d m;
-  m.col(0) = x[1] - x[0];
-  m.col(1) = x[2] - x[0];
-  return m;
-}
-
 void ToCorners(const Eigen::Matrix2d& d, std::array<Point, 3>* g) {
   (*g)[1] = d.col(0);
   (*g)[2] = d.col(1);
@@ -32,6 +25,17 @@ void ToCorners(const Eigen::Matrix2d& d, std::array<Point, 3>* g) {
 }
 
 }  // namespace
+
+Eigen::Matrix2d EdgeMatrix(const std::array<Point, 3>& x) {
+  Eigen::Matrix2d m;
+  m.col(0) = x[1] - x[0];
+  m.col(1) = x[2] - x[0];
+  return m;
+}
+
+Eigen::Matrix2d EdgeMatrix(const Points& x, const Triangle& t) {
+  return EdgeMatrix({x[t[0]], x[t[1]], x[t[2]]});
+}
 
 double MipsSigma(const Eigen::Matrix2d& p, const Eigen::Matrix2d& q) {
   const double det_p = Det(p);
@@ -87,8 +91,7 @@ std::vector<double> MipsSigmas(const std::vector<Triangle>& triangles, const Poi
   std::vector<double> sigmas;
   sigmas.reserve(triangles.size());
   for (const Triangle& t : triangles) {
-    sigmas.push_back(MipsSigma(EdgeMatrix({xi[t[0]], xi[t[1]], xi[t[2]]}),
-                               EdgeMatrix({xj[t[0]], xj[t[1]], xj[t[2]]})));
+    sigmas.push_back(MipsSigma(EdgeMatrix(xi, t), EdgeMatrix(xj, t)));
   }
   return sigmas;
 }

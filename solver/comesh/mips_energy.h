@@ -23,6 +23,10 @@
 
 namespace inbetween::solver {
 
+// The edge matrix [x1 - x0, x2 - x0] of a triangle with corners x (or triangle t of shape x).
+Eigen::Matrix2d EdgeMatrix(const std::array<Point, 3>& x);
+Eigen::Matrix2d EdgeMatrix(const Points& x, const Triangle& t);
+
 // sigma* for edge matrices P (source) and Q (target); +inf unless both determinants are positive.
 double MipsSigma(const Eigen::Matrix2d& p, const Eigen::Matrix2d& q);
 

@@ -27,13 +27,6 @@ Corners RandomTriangle(std::mt19937& rng) {
   }
 }
 
-Eigen::Matrix2d Edges(const Corners& c) {
-  Eigen::Matrix2d e;
-  e.col(0) = c[1] - c[0];
-  e.col(1) = c[2] - c[0];
-  return e;
-}
-
 // Column j of the corner Hessian by central differences of `gradient` (x, y interleaved).
 Matrix6 DifferenceHessian(const Corners& x, const GradientFn& gradient) {
   constexpr double h = 1e-6;
@@ -64,7 +57,7 @@ TEST(ComeshHessianTest, OdtMatchesDifferencedGradient) {
       OdtTriangleEnergy(c[0], c[1], c[2], &g);
       return g;
     };
-    ExpectNear(CornerHessian(OdtEdgeHessian(Edges(x))), DifferenceHessian(x, gradient));
+    ExpectNear(CornerHessian(OdtEdgeHessian(EdgeMatrix(x))), DifferenceHessian(x, gradient));
   }
 }
 
@@ -73,7 +66,7 @@ TEST(ComeshHessianTest, MipsBlocksMatchDifferencedGradients) {
   for (int i = 0; i < 50; ++i) {
     const Corners xi = RandomTriangle(rng), xj = RandomTriangle(rng);
     Matrix4 hp, hq;
-    MipsEdgeHessians(Edges(xi), Edges(xj), &hp, &hq);
+    MipsEdgeHessians(EdgeMatrix(xi), EdgeMatrix(xj), &hp, &hq);
     const GradientFn in_p = [&](const Corners& c) {
       Corners g;
       MipsTriangleEnergy(c, xj, &g, nullptr);
