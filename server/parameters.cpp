@@ -169,11 +169,11 @@ solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& com
   options.max_outer = comesh.max_outer_iterations() == 0
                           ? kDefaultMaxOuterIterations
                           : static_cast<int>(comesh.max_outer_iterations());
-  options.max_iterations = comesh.max_inner_iterations() == 0
-                               ? kDefaultMaxInnerIterations
-                               : static_cast<int>(comesh.max_inner_iterations());
-  options.relative_decrease_tolerance =
-      comesh.tolerance() == 0 ? kDefaultComeshTolerance : comesh.tolerance();
+  // Unset (0): the solver's defaults, which the proto documents (200 inner iterations, 1e-5).
+  if (comesh.max_inner_iterations() != 0) {
+    options.max_iterations = static_cast<int>(comesh.max_inner_iterations());
+  }
+  if (comesh.tolerance() != 0) options.relative_decrease_tolerance = comesh.tolerance();
   if (comesh.has_outer_tolerance()) options.outer_tolerance = comesh.outer_tolerance();
   return options;
 }
@@ -228,7 +228,7 @@ absl::StatusOr<InbetweenPlan> ToInbetweenPlan(const inbetween::v1::InbetweenPara
 }
 
 absl::StatusOr<solver::TimingOptions> ToTimingOptions(const inbetween::v1::InbetweenParameters& p,
-                                                     int num_drawings, absl::string_view field) {
+                                                      int num_drawings, absl::string_view field) {
   solver::TimingOptions timing;
   switch (p.timing()) {
     case inbetween::v1::TIMING_CURVE_CATMULL_ROM:

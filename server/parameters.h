@@ -15,11 +15,10 @@ namespace inbetween::server {
 
 inline constexpr int kDefaultFrames = 24;
 inline constexpr int kMaxFrames = 100000;
-// ComeshParameters defaults (inbetween.proto).
+// ComeshParameters defaults (inbetween.proto) where the service's differ from, or predate, the
+// solver's; max_inner_iterations and tolerance take ComeshOptions' own defaults.
 inline constexpr double kDefaultMapWeight = 0.5;
 inline constexpr int kDefaultMaxOuterIterations = 50;
-inline constexpr int kDefaultMaxInnerIterations = 200;
-inline constexpr double kDefaultComeshTolerance = 1e-5;
 
 // Range checks of every field (the ranges in inbetween.proto). Errors are INVALID_ARGUMENT
 // naming `field`.subfield, or RESOURCE_EXHAUSTED for frames above kMaxFrames.
