@@ -457,7 +457,7 @@ class HessianPreconditioner {
       block.matrix.resizeNonZeros(static_cast<Eigen::Index>(inner[s].size()));
       std::copy(outer[s].begin(), outer[s].end(), block.matrix.outerIndexPtr());
       std::copy(inner[s].begin(), inner[s].end(), block.matrix.innerIndexPtr());
-      block.solver = std::make_unique<SparseCholesky>();
+      block.solver = std::make_unique<SparseCholesky>(SparseCholesky::Method::kAuto);
     }
     h.threads_ = layout.size() >= kParallelUnknowns ? objective.threads() : 1;
     if (absl::Status st = h.Refactor(shapes, /*analyze=*/true); !st.ok()) return st;
@@ -487,6 +487,7 @@ class HessianPreconditioner {
   }
 
  private:
+  static constexpr double kDiagonalShift = 1e-10;  // relative to the largest diagonal entry
   // Below this many unknowns a thread start costs more than it saves.
   static constexpr int kParallelUnknowns = 20000;
 
@@ -593,7 +594,7 @@ class HessianPreconditioner {
     // (e.g. a vertex whose every triangle has all other corners fixed along one line).
     double top = 0.0;
     for (int c = 0; c < m->cols(); ++c) top = std::max(top, m->coeff(c, c));
-    for (int c = 0; c < m->cols(); ++c) Add(m, c, c, 1e-10 * top);
+    for (int c = 0; c < m->cols(); ++c) Add(m, c, c, kDiagonalShift * top);
   }
 
   const std::vector<Triangle>* triangles_ = nullptr;

@@ -1,12 +1,13 @@
-// CHOLMOD-backed sparse LDL^T (see sparse_cholesky.h). Simplicial factorization with an AMD
-// ordering: no BLAS and no threads, so results are bit-identical run to run; for the planar
-// meshes we solve (10^2..10^5 vertices) simplicial is as fast as supernodal. Solves are our own
-// substitutions reading CHOLMOD's factor arrays in place (no copy, no allocation per solve).
+// CHOLMOD-backed sparse LDL^T (see sparse_cholesky.h). By default a simplicial factorization with
+// an AMD ordering: no BLAS and no threads, so results are bit-identical run to run; solves are our
+// own substitutions reading CHOLMOD's factor arrays in place (no copy, no allocation per solve).
+// Method::kAuto lets CHOLMOD go supernodal on large matrices (solves then by cholmod_solve2).
 #include "solver/core/sparse_cholesky.h"
 
 #include <cholmod.h>
 
 #include <algorithm>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -32,21 +33,28 @@ struct SparseCholesky::Impl {
   const int* l_i = nullptr;
   const double* l_x = nullptr;
   mutable std::vector<double> work;  // interleaved right-hand sides, n x columns
+  // cholmod_solve2's solution and workspace for a supernodal factor, reused between solves.
+  mutable cholmod_dense* solve_x = nullptr;
+  mutable cholmod_dense* solve_y = nullptr;
+  mutable cholmod_dense* solve_e = nullptr;
 
   void Extract();
   template <int kColumns>
   void Substitute(double* y, int columns) const;
 
-  Impl() {
+  explicit Impl(Method method) {
     cholmod_start(&common);
     common.print = 0;  // errors come back as absl::Status, not on stderr
-    common.supernodal = CHOLMOD_SIMPLICIAL;
+    common.supernodal = method == Method::kAuto ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
     common.final_ll = false;
     common.nmethods = 1;
     common.method[0].ordering = CHOLMOD_AMD;
     common.postorder = true;
   }
   ~Impl() {
+    for (cholmod_dense** d : {&solve_x, &solve_y, &solve_e}) {
+      if (*d != nullptr) cholmod_free_dense(d, &common);
+    }
     if (factor != nullptr) cholmod_free_factor(&factor, &common);
     cholmod_finish(&common);
   }
@@ -91,6 +99,16 @@ void SparseCholesky::Impl::Substitute(double* y, int columns) const {
 }
 
 namespace {
+
+// Supernodal factorizations and solves call the system BLAS, and not every BLAS Debian offers is
+// reentrant: with libopenblas0-serial as the alternative, two concurrent factorizations of
+// positive definite matrices failed with "not positive definite" (measured; libblis4-serial and
+// the reference BLAS did not). One process-wide lock around the BLAS-using calls makes any of
+// them safe; simplicial factors use no BLAS and never take it.
+std::mutex& BlasMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
 
 // A non-owning CHOLMOD view of a compressed column-major Eigen matrix, read as symmetric upper.
 cholmod_sparse View(const Eigen::SparseMatrix<double>& a) {
@@ -138,7 +156,7 @@ absl::Status CheckShape(const Eigen::SparseMatrix<double>& a) {
 
 }  // namespace
 
-SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
+SparseCholesky::SparseCholesky(Method method) : impl_(std::make_unique<Impl>(method)) {}
 SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 SparseCholesky::~SparseCholesky() = default;
@@ -175,7 +193,10 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
   }
   m.factorized = false;
   cholmod_sparse view = View(a);
+  std::unique_lock<std::mutex> blas(BlasMutex(), std::defer_lock);
+  if (m.factor->is_super) blas.lock();
   const int ok = cholmod_factorize(&view, m.factor, &m.common);
+  if (blas.owns_lock()) blas.unlock();
   if (!ok || m.common.status < CHOLMOD_OK) {
     return CholmodError(m.common, "numeric factorization");
   }
@@ -197,7 +218,7 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
       }
     }
   }
-  m.Extract();
+  if (!m.factor->is_super) m.Extract();
   m.factorized = true;
   return absl::OkStatus();
 }
@@ -224,6 +245,24 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
   }
   const int c = static_cast<int>(b->cols());
   if (c == 0) return absl::OkStatus();
+  if (m.factor->is_super) {
+    cholmod_dense rhs{};
+    rhs.nrow = static_cast<size_t>(m.n);
+    rhs.ncol = static_cast<size_t>(c);
+    rhs.nzmax = rhs.nrow * rhs.ncol;
+    rhs.d = rhs.nrow;
+    rhs.x = b->data();
+    rhs.xtype = CHOLMOD_REAL;
+    rhs.dtype = CHOLMOD_DOUBLE;
+    cholmod_common& common = const_cast<cholmod_common&>(m.common);
+    const std::lock_guard<std::mutex> blas(BlasMutex());
+    if (!cholmod_solve2(CHOLMOD_A, m.factor, &rhs, nullptr, &m.solve_x, nullptr, &m.solve_y,
+                        &m.solve_e, &common)) {
+      return CholmodError(common, "solve");
+    }
+    std::copy_n(static_cast<const double*>(m.solve_x->x), rhs.nzmax, b->data());
+    return absl::OkStatus();
+  }
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int workers = std::min(threads, c);
   m.work.resize(static_cast<size_t>(m.n) * c);
@@ -265,5 +304,8 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
 
 int SparseCholesky::rows() const { return impl_->n; }
 bool SparseCholesky::factorized() const { return impl_->factorized; }
+bool SparseCholesky::supernodal() const {
+  return impl_->factor != nullptr && impl_->factor->is_super;
+}
 
 }  // namespace inbetween::solver

@@ -6,6 +6,13 @@
 // CHOLMOD's factor arrays, all right-hand sides in one sweep over L (interleaved), with no
 // allocation per solve in SolveInPlace: the inbetweener's global step is one such solve with 2
 // columns per iteration.
+//
+// Method::kAuto lets CHOLMOD choose a supernodal LL^T factor when the matrix is large enough for
+// dense kernels to pay (flops / nnz(L) >= 40, CHOLMOD's own switch; else the same simplicial
+// factor): a supernodal factorization runs on BLAS (scripts/setup installs Debian's serial
+// OpenBLAS), measured 2.6 s against 70 s simplicial for a 320k-unknown planar mesh matrix
+// (docs/benchmarks.md). Its solves are CHOLMOD's (cholmod_solve2, workspace kept between calls).
+// Serial BLAS and a fixed ordering keep the result bit-identical run to run on one machine.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,7 +26,8 @@ namespace inbetween::solver {
 
 class SparseCholesky {
  public:
-  SparseCholesky();
+  enum class Method { kSimplicial, kAuto };
+  explicit SparseCholesky(Method method = Method::kSimplicial);
   SparseCholesky(SparseCholesky&&) noexcept;
   SparseCholesky& operator=(SparseCholesky&&) noexcept;
   ~SparseCholesky();
@@ -44,12 +52,13 @@ class SparseCholesky {
   // one object must not solve on two threads at once. With threads > 1 (<= 0: all cores) and at
   // least kParallelRows rows, the columns are substituted separately on up to `threads` threads;
   // each column sees the same operations in the same order either way, so the result is
-  // bit-identical for every thread count.
+  // bit-identical for every thread count. A supernodal factor (Method::kAuto) ignores `threads`.
   absl::Status SolveInPlace(Eigen::MatrixXd* b, int threads = 1) const;
   static constexpr int kParallelRows = 8192;
 
   int rows() const;
   bool factorized() const;
+  bool supernodal() const;  // after Analyze: CHOLMOD chose a supernodal factor
 
  private:
   struct Impl;

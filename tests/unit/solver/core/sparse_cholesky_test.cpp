@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <thread>
 #include <vector>
 
 namespace inbetween::solver {
@@ -122,6 +123,69 @@ TEST(SparseCholeskyTest, ReportsMisuse) {
   EXPECT_FALSE(chol.factorized());
   Eigen::SparseMatrix<double> rect(3, 4);
   EXPECT_EQ(chol.Analyze(rect).code(), absl::StatusCode::kInvalidArgument);
+}
+
+// Method::kAuto: CHOLMOD goes supernodal on a large grid (and stays simplicial on a small one);
+// the supernodal solve agrees with the simplicial one, refactors on the analyzed pattern, and
+// still reports a matrix that is not positive definite.
+TEST(SparseCholeskyTest, AutoGoesSupernodalOnLargeMatricesWithTheSameSolution) {
+  SparseCholesky small(SparseCholesky::Method::kAuto);
+  ASSERT_TRUE(small.Compute(GridMatrix(6, 0.1)).ok());
+  EXPECT_FALSE(small.supernodal());
+
+  const Eigen::SparseMatrix<double> a = GridMatrix(160, 1e-3);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::MatrixXd b(a.rows(), 2);
+  for (Eigen::Index k = 0; k < b.size(); ++k) b.data()[k] = u(rng);
+  SparseCholesky super(SparseCholesky::Method::kAuto), simplicial;
+  ASSERT_TRUE(super.Compute(a).ok());
+  ASSERT_TRUE(super.supernodal());
+  ASSERT_TRUE(simplicial.Compute(a).ok());
+  EXPECT_FALSE(simplicial.supernodal());
+  Eigen::MatrixXd x = b, y = b;
+  ASSERT_TRUE(super.SolveInPlace(&x).ok());
+  ASSERT_TRUE(simplicial.SolveInPlace(&y).ok());
+  EXPECT_LT((a * x - b).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 1e-9 * y.cwiseAbs().maxCoeff());
+
+  const Eigen::SparseMatrix<double> scaled = 3.0 * a;
+  ASSERT_TRUE(super.Factorize(scaled).ok());
+  x = b;
+  ASSERT_TRUE(super.SolveInPlace(&x).ok());
+  EXPECT_LT((scaled * x - b).cwiseAbs().maxCoeff(), 1e-9);
+
+  SparseCholesky indefinite(SparseCholesky::Method::kAuto);
+  EXPECT_EQ(indefinite.Compute(GridMatrix(160, -0.5)).code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_FALSE(indefinite.factorized());
+}
+
+// Supernodal factorizations on several threads at once (the comesh preconditioner factors its
+// shapes in parallel) are all correct, whatever BLAS the system provides.
+TEST(SparseCholeskyTest, ConcurrentSupernodalFactorizationsAreCorrect) {
+  const Eigen::SparseMatrix<double> a = GridMatrix(150, 1e-2);
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Ones(a.rows(), 1);
+  std::vector<double> residual(4, 0.0);
+  std::vector<int> ok(4, 0);
+  std::vector<std::thread> threads;
+  for (int w = 0; w < 4; ++w) {
+    threads.emplace_back([&, w] {
+      const Eigen::SparseMatrix<double> m = (1.0 + w) * a;
+      SparseCholesky chol(SparseCholesky::Method::kAuto);
+      for (int round = 0; round < 6; ++round) {
+        if (!chol.Compute(m).ok() || !chol.supernodal()) return;
+        Eigen::MatrixXd x = b;
+        if (!chol.SolveInPlace(&x).ok()) return;
+        residual[w] = std::max(residual[w], (m * x - b).cwiseAbs().maxCoeff());
+      }
+      ok[w] = 1;
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (int w = 0; w < 4; ++w) {
+    EXPECT_EQ(ok[w], 1) << "thread " << w;
+    EXPECT_LT(residual[w], 1e-9) << "thread " << w;
+  }
 }
 
 }  // namespace
