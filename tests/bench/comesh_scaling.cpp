@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "tests/bench/comesh_bench_common.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
@@ -34,6 +36,20 @@ constexpr PaperRow kPaper[] = {{98, 98, 59, 5, 0.065},
                                {165107, 164638, 447, 33, 13650.724},
                                {311522, 311183, 495, 34, 51253.368}};
 
+// Least-squares slope k of log(seconds) against log(vertices): time ~ vertices^k.
+double GrowthExponent(const std::vector<std::pair<double, double>>& points) {
+  const double n = static_cast<double>(points.size());
+  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  for (const auto& [v, t] : points) {
+    const double x = std::log(v), y = std::log(t);
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -42,6 +58,7 @@ int main(int argc, char** argv) {
   const sv::ComeshOptions& options = args.options;
   const sv::ProgressFn progress = inbetween::bench::VerboseProgress(args.verbose);
   nlohmann::json rows = nlohmann::json::array();
+  std::vector<std::pair<double, double>> ours, papers;  // (vertices, seconds) per row run
   std::printf("%-22s %13s %13s %11s %11s %6s %9s %9s %7s %7s %7s\n", "case", "ver ours",
               "ver paper", "inner o/p", "outer o/p", "evals", "seconds", "paper_s", "ratio", "map",
               "mesh");
@@ -84,6 +101,13 @@ int main(int argc, char** argv) {
                 paper.seconds, paper.seconds / r.seconds, r.map_energy, r.mesh_energy);
     std::fflush(stdout);
     rows.push_back(inbetween::bench::ComeshRow(name, r, paper.seconds));
+    ours.emplace_back(r.vertices_before, r.seconds);
+    papers.emplace_back(paper.before, paper.seconds);
+  }
+  if (ours.size() >= 2) {
+    std::printf("growth, time ~ vertices^k over these %zu rows (least squares in log-log): "
+                "ours k = %.2f, paper k = %.2f\n",
+                ours.size(), GrowthExponent(ours), GrowthExponent(papers));
   }
   inbetween::bench::WriteRows(args.json_path, rows);
   return 0;
