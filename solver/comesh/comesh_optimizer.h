@@ -8,7 +8,8 @@
 //   Hessian, block diagonal by shape (the shape-shape MIPS blocks dropped), projected positive
 //   definite per triangle and shape (comesh_hessian.h), in the reduced unknowns (a slider's row
 //   projected on its direction); one sparse matrix and CHOLMOD factor per shape, built and
-//   factored once per inner run (every hessian_refresh iterations if set). A Newton-type
+//   factored once per inner run (every hessian_refresh iterations if set); CHOLMOD goes
+//   supernodal (BLAS) on large blocks (SparseCholesky::Method::kAuto). A Newton-type
 //   model: inner iterations grow far more slowly with the mesh size than with BCQN's Laplacian
 //   (docs/benchmarks.md).
 //   Otherwise (more shapes, or hessian_preconditioner = false) BCQN's model: H0_s = A_s J_s^T

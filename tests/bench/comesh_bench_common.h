@@ -25,17 +25,17 @@ struct ComeshBenchArgs {
 };
 
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
-// --scale-by-inverse, --history M, --tolerance R, --laplacian (BCQN's H0), --refresh K,
-// --outer-inner K,
-// --repeat N, --verbose and (when `with_max_vertices`) --max-vertices N and --min-vertices N; exits 2 with a usage line
-// otherwise.
+// --cure-keep C, --step-fraction F, --scale-by-inverse, --history M, --tolerance R, --laplacian
+// (BCQN's H0), --refresh K, --outer-inner K, --repeat N, --verbose and (when
+// `with_max_vertices`) --max-vertices N and --min-vertices N; exits 2 with a usage line otherwise.
 inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max_vertices) {
   ComeshBenchArgs args;
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
-                 "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
-                 "[--repeat N] [--verbose] [--json FILE]\n",
+                 "[--cure-keep C] [--step-fraction F] [--outer-inner K] [--scale-by-inverse] "
+                 "[--history M] [--tolerance R] [--laplacian] [--refresh K] [--repeat N] "
+                 "[--verbose] [--json FILE]\n",
                  argv[0], with_max_vertices ? "[--max-vertices N] [--min-vertices N] " : "");
     std::exit(2);
   };
@@ -68,6 +68,10 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.hessian_refresh = std::atoi(next());
     } else if (a == "--no-cure") {
       args.options.cure = false;
+    } else if (a == "--cure-keep") {
+      args.options.cure_keep = std::atof(next());
+    } else if (a == "--step-fraction") {
+      args.options.max_step_fraction = std::atof(next());
     } else if (a == "--tolerance") {
       args.options.relative_decrease_tolerance = std::atof(next());
     } else if (a == "--repeat") {
