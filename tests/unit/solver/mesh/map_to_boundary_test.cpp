@@ -191,6 +191,22 @@ TEST(MapToBoundaryTest, Cancelled) {
 // different points (the sparse factorizations among them). Eigen's SparseLU / SimplicialLDLT
 // died there (a double free after a failed allocation, docs/hardening.md); the map must answer
 // RESOURCE_EXHAUSTED "... out of memory ..." or succeed, never die.
+// Not in sanitizer builds: ASan reserves terabytes of shadow address space, and its allocator
+// answers an allocation that does not fit under the cap with its own out-of-memory report (then
+// a failed CHECK that hangs the child: seen in build/asan, 2026-12-02) instead of a null or
+// std::bad_alloc our code could turn into a status.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitizerBuild = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+constexpr bool kSanitizerBuild = true;
+#else
+constexpr bool kSanitizerBuild = false;
+#endif
+#else
+constexpr bool kSanitizerBuild = false;
+#endif
+
 struct CappedRun {
   int exit = -1;        // 0 mapped, 1 RESOURCE_EXHAUSTED naming "out of memory", 2 another status,
                         // 5 an exception escaped; 128 + signal when the child died
@@ -273,12 +289,14 @@ void ExpectOutOfMemoryIsAStatus(const MapCase& s, const MapToBoundaryOptions& op
 }
 
 TEST(MapToBoundaryTest, OutOfMemoryInTheTutteSystemIsAStatus) {
+  if (kSanitizerBuild) GTEST_SKIP() << "RLIMIT_AS caps do not apply under ASan/TSan";
   const MapCase s = Make(Square(), Hexagon(), 400, 1.5);
   std::printf("%zu vertices, %zu triangles\n", s.source.size(), s.triangles.size());
   ExpectOutOfMemoryIsAStatus(s, {}, "Tutte system");
 }
 
 TEST(MapToBoundaryTest, OutOfMemoryInTheProxySystemIsAStatus) {
+  if (kSanitizerBuild) GTEST_SKIP() << "RLIMIT_AS caps do not apply under ASan/TSan";
   const MapCase s = Make(Bar(), Arch(), 400, 2.0);
   std::printf("%zu vertices, %zu triangles\n", s.source.size(), s.triangles.size());
   MapToBoundaryOptions options;
