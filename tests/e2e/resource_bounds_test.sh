@@ -16,10 +16,16 @@ PY=/usr/bin/python3
 sanitizer=""
 if [[ -n "${INBETWEEN_SANITIZER:-}" ]]; then
   sanitizer=$INBETWEEN_SANITIZER
-elif ldd "$SERVER_BIN" 2>/dev/null | grep -qE 'lib(asan|tsan)\.so'; then
-  sanitizer=$(ldd "$SERVER_BIN" | grep -oE 'lib(asan|tsan)' | head -1)
-elif nm -D "$SERVER_BIN" 2>/dev/null | grep -qE ' __(asan|tsan)_init'; then
-  sanitizer=static
+else
+  # ldd's output captured first: `ldd | grep -q` under pipefail fails when grep exits before
+  # ldd has written everything (SIGPIPE); build/asan's server ran under the cap once, 2026-12-02.
+  libs=$(ldd "$SERVER_BIN" 2>/dev/null || true)
+  symbols=$(nm -D "$SERVER_BIN" 2>/dev/null || true)
+  if [[ $libs =~ lib(asan|tsan)\.so ]]; then
+    sanitizer=lib${BASH_REMATCH[1]}
+  elif [[ $symbols =~ \ __(asan|tsan)_init ]]; then
+    sanitizer=static
+  fi
 fi
 
 # The limits (flags of inbetween-server). The largest allowed session: 3 drawings of 20,000
