@@ -473,6 +473,11 @@ def check_runtime_packages(src, binaries):
     for binary in binaries:
         out = run(["ldd", binary])
         check(out.returncode == 0, f"ldd {binary} failed")
+        if re.search(r"lib(asan|tsan)\.so", out.stdout):
+            # scripts/sanitize's builds link the sanitizer runtimes (and more libraries directly);
+            # the image ships release binaries, whose libraries are what the list must cover.
+            print(f"runtime packages: {binary} is a sanitizer build, ldd check skipped")
+            return
         for line in out.stdout.splitlines():
             check("not found" not in line, f"{binary}: {line.strip()}")
             m = re.search(r"=>\s+(/\S+)", line) or re.match(r"\s*(/\S+)", line)
