@@ -469,6 +469,9 @@ def check_runtime_packages(src, binaries):
     known = set(re.findall(r"^Package: (\S+)$", out.stdout, re.M))
     for pkg in listed:
         check(pkg in known, f"runtime package {pkg} is not in Debian (apt-cache show)")
+    check(
+        "python3-grpcio" in listed, "docker/runtime-packages.txt lacks python3-grpcio (HEALTHCHECK)"
+    )
     libs = {}
     for binary in binaries:
         out = run(["ldd", binary])
@@ -493,9 +496,6 @@ def check_runtime_packages(src, binaries):
         check(
             pkg in listed, f"docker/runtime-packages.txt lacks {pkg} ({', '.join(sorted(names))})"
         )
-    check(
-        "python3-grpcio" in listed, "docker/runtime-packages.txt lacks python3-grpcio (HEALTHCHECK)"
-    )
     print(
         f"runtime packages: {len(listed)} listed, {len(needed)} needed by ldd ({len(libs)} "
         f"libraries), all present"
