@@ -398,11 +398,11 @@ class InitialHessian {
 // (comesh_hessian.h: the edge-space 4 x 4 sum of that shape's ODT term and its two MIPS terms,
 // projected), in the reduced unknowns (a slider's row is the 2D row projected on its direction).
 // Each shape's unknowns are contiguous in z, so every shape has its own sparse matrix and
-// CHOLMOD factor (supernodal when CHOLMOD finds it pays: large meshes); their sparsity patterns (unknowns adjacent in the mesh) are built once per
-// inner run, and Update() recomputes the values at new positions and refactors on the same
-// patterns. Shapes are assembled, factored and solved on separate threads (large meshes only):
-// each touches only its own block, in a fixed order, so results do not depend on the thread
-// count.
+// CHOLMOD factor (supernodal when CHOLMOD finds it pays: large meshes); their sparsity patterns
+// (unknowns adjacent in the mesh) are built once per inner run, and Update() recomputes the values
+// at new positions and refactors on the same patterns. Shapes are assembled, factored and solved on
+// separate threads (large meshes only): each touches only its own block, in a fixed order, so
+// results do not depend on the thread count.
 class HessianPreconditioner {
  public:
   static absl::StatusOr<HessianPreconditioner> Create(const std::vector<Triangle>& triangles,

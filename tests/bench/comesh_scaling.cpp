@@ -105,9 +105,10 @@ int main(int argc, char** argv) {
     papers.emplace_back(paper.before, paper.seconds);
   }
   if (ours.size() >= 2) {
-    std::printf("growth, time ~ vertices^k over these %zu rows (least squares in log-log): "
-                "ours k = %.2f, paper k = %.2f\n",
-                ours.size(), GrowthExponent(ours), GrowthExponent(papers));
+    std::printf(
+        "growth, time ~ vertices^k over these %zu rows (least squares in log-log): "
+        "ours k = %.2f, paper k = %.2f\n",
+        ours.size(), GrowthExponent(ours), GrowthExponent(papers));
   }
   inbetween::bench::WriteRows(args.json_path, rows);
   return 0;

@@ -156,7 +156,8 @@ TEST(SparseCholeskyTest, AutoGoesSupernodalOnLargeMatricesWithTheSameSolution) {
   EXPECT_LT((scaled * x - b).cwiseAbs().maxCoeff(), 1e-9);
 
   SparseCholesky indefinite(SparseCholesky::Method::kAuto);
-  EXPECT_EQ(indefinite.Compute(GridMatrix(160, -0.5)).code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(indefinite.Compute(GridMatrix(160, -0.5)).code(),
+            absl::StatusCode::kFailedPrecondition);
   EXPECT_FALSE(indefinite.factorized());
 }
 
