@@ -5,6 +5,7 @@
 #include "solver/core/sparse_cholesky.h"
 
 #include <cholmod.h>
+#include <dlfcn.h>
 
 #include <algorithm>
 #include <mutex>
@@ -47,6 +48,10 @@ struct SparseCholesky::Impl {
     common.print = 0;  // errors come back as absl::Status, not on stderr
     common.supernodal = method == Method::kAuto ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
     common.final_ll = false;
+    // Supernodal from flops / nnz(L) >= 200 (CHOLMOD's default switch is 40): on the comesh
+    // Hessians (2 unknowns per vertex) the simplicial factor with our substitutions was faster up
+    // to the 17k-vertex row of S-Table 2, the supernodal one from 35k (docs/benchmarks.md).
+    common.supernodal_switch = 200.0;
     common.nmethods = 1;
     common.method[0].ordering = CHOLMOD_AMD;
     common.postorder = true;
@@ -100,15 +105,48 @@ void SparseCholesky::Impl::Substitute(double* y, int columns) const {
 
 namespace {
 
-// Supernodal factorizations and solves call the system BLAS, and not every BLAS Debian offers is
-// reentrant: with libopenblas0-serial as the alternative, two concurrent factorizations of
-// positive definite matrices failed with "not positive definite" (measured; libblis4-serial and
-// the reference BLAS did not). One process-wide lock around the BLAS-using calls makes any of
-// them safe; simplicial factors use no BLAS and never take it.
-std::mutex& BlasMutex() {
-  static std::mutex mutex;
-  return mutex;
+// Supernodal factorizations and solves call the system BLAS (Debian's alternative for
+// libblas.so.3). Two properties matter, and both are settled once per process:
+// - Threads: OpenBLAS's pthread build (what scripts/setup installs) would split each call over
+//   every core, on top of our own threads, and its sums would then depend on the thread count.
+//   It is set to one thread (openblas_set_num_threads, looked up at run time because the binary
+//   links the generic libblas), so results are bit-identical for any thread count of ours.
+// - Reentrancy: OpenBLAS's serial build (libopenblas0-serial, openblas_get_parallel() == 0) is
+//   not reentrant: two concurrent factorizations of positive definite matrices failed with "not
+//   positive definite" (measured). Only then do the BLAS-using calls take one process-wide lock;
+//   the pthread and OpenMP builds, BLIS and the reference BLAS run concurrently (measured: the
+//   pthread build passed SparseCholeskyTest.ConcurrentSupernodalFactorizationsAreCorrect 8 of 8
+//   times unlocked, the serial one failed 6 of 6). Simplicial factors use no BLAS.
+struct BlasSetup {
+  bool serialize = false;
+};
+
+const BlasSetup& Blas() {
+  static const BlasSetup setup = [] {
+    using GetParallel = int (*)();
+    using SetThreads = void (*)(int);
+    auto* get = reinterpret_cast<GetParallel>(dlsym(RTLD_DEFAULT, "openblas_get_parallel"));
+    auto* set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+    if (set != nullptr) set(1);
+    return BlasSetup{.serialize = get != nullptr && get() == 0};
+  }();
+  return setup;
 }
+
+// Held around a BLAS-using call when the BLAS is not reentrant (see above).
+class BlasLock {
+ public:
+  BlasLock() : lock_(Mutex(), std::defer_lock) {
+    if (Blas().serialize) lock_.lock();
+  }
+
+ private:
+  static std::mutex& Mutex() {
+    static std::mutex mutex;
+    return mutex;
+  }
+  std::unique_lock<std::mutex> lock_;
+};
 
 // A non-owning CHOLMOD view of a compressed column-major Eigen matrix, read as symmetric upper.
 cholmod_sparse View(const Eigen::SparseMatrix<double>& a) {
@@ -193,10 +231,13 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
   }
   m.factorized = false;
   cholmod_sparse view = View(a);
-  std::unique_lock<std::mutex> blas(BlasMutex(), std::defer_lock);
-  if (m.factor->is_super) blas.lock();
-  const int ok = cholmod_factorize(&view, m.factor, &m.common);
-  if (blas.owns_lock()) blas.unlock();
+  int ok = 0;
+  if (m.factor->is_super) {
+    const BlasLock blas;
+    ok = cholmod_factorize(&view, m.factor, &m.common);
+  } else {
+    ok = cholmod_factorize(&view, m.factor, &m.common);
+  }
   if (!ok || m.common.status < CHOLMOD_OK) {
     return CholmodError(m.common, "numeric factorization");
   }
@@ -255,7 +296,7 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
     rhs.xtype = CHOLMOD_REAL;
     rhs.dtype = CHOLMOD_DOUBLE;
     cholmod_common& common = const_cast<cholmod_common&>(m.common);
-    const std::lock_guard<std::mutex> blas(BlasMutex());
+    const BlasLock blas;
     if (!cholmod_solve2(CHOLMOD_A, m.factor, &rhs, nullptr, &m.solve_x, nullptr, &m.solve_y,
                         &m.solve_e, &common)) {
       return CholmodError(common, "solve");

@@ -9,10 +9,12 @@
 //
 // Method::kAuto lets CHOLMOD choose a supernodal LL^T factor when the matrix is large enough for
 // dense kernels to pay (flops / nnz(L) >= 40, CHOLMOD's own switch; else the same simplicial
-// factor): a supernodal factorization runs on BLAS (scripts/setup installs Debian's serial
-// OpenBLAS), measured 2.6 s against 70 s simplicial for a 320k-unknown planar mesh matrix
-// (docs/benchmarks.md). Its solves are CHOLMOD's (cholmod_solve2, workspace kept between calls).
-// Serial BLAS and a fixed ordering keep the result bit-identical run to run on one machine.
+// factor): a supernodal factorization runs on BLAS (scripts/setup installs Debian's OpenBLAS,
+// pthread build, which SparseCholesky sets to one thread), measured 2.6 s against 70 s simplicial
+// for a 320k-unknown planar mesh matrix (docs/benchmarks.md). Its solves are CHOLMOD's
+// (cholmod_solve2, workspace kept between calls). Single-threaded BLAS and a fixed ordering keep
+// the result bit-identical run to run on one machine. Objects on different threads factor and
+// solve concurrently (with a non-reentrant BLAS, the serial OpenBLAS, those calls are serialized).
 #pragma once
 
 #include <Eigen/Core>
