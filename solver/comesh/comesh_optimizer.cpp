@@ -645,10 +645,25 @@ int CureDirection(const std::vector<Triangle>& triangles, const std::vector<Poin
   return cured;
 }
 
+// Seconds since construction or the previous Lap().
+class Stopwatch {
+ public:
+  double Lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    return seconds;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
 // Accumulated over inner runs (one per outer iteration).
 struct InnerStats {
   int iterations = 0;
   int evaluations = 0;
+  ComeshPhaseSeconds phases;
   std::string stop_reason;
   ComeshEnergies energies;
   double objective = 0.0;
@@ -659,6 +674,7 @@ struct InnerStats {
 absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int threads,
                        const CancelToken* cancel, const ProgressFn& progress, int iteration_base,
                        InnerStats* stats) {
+  Stopwatch clock;
   absl::StatusOr<ComeshObjective> objective =
       ComeshObjective::Create(mesh->triangles, mesh->shapes, options.map_weight, threads);
   if (!objective.ok()) return objective.status();
@@ -694,6 +710,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     return hessian ? hessian->ApplyInverse(v) : laplacian->ApplyInverse(v);
   };
   auto apply = [&](const VectorXd& v) { return hessian ? hessian->Apply(v) : laplacian->Apply(v); };
+  stats->phases.hessian += clock.Lap();
 
   VectorXd z = layout.Gather(shapes);
   VectorXd g = layout.GatherGradient(grad_shapes);
@@ -725,6 +742,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
 
     if (hessian && options.hessian_refresh > 0 && iter > 0 && iter % options.hessian_refresh == 0) {
       if (absl::Status st = hessian->Update(shapes); !st.ok()) return st;
+      stats->phases.hessian += clock.Lap();
     }
     // L-BFGS two-loop recursion with H0 = B0^{-1} / beta.
     auto direction = [&]() {
@@ -752,6 +770,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
         slope = -g.squaredNorm();
       }
     }
+    stats->phases.direction += clock.Lap();
     if (options.cure) {
       VectorXd cured = d;
       if (CureDirection(mesh->triangles, shapes, layout, options.cure_keep, &cured) > 0) {
@@ -767,6 +786,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     const double max_step =
         MaxNonInvertingStep(mesh->triangles, shapes, layout, d, objective->threads());
     double step = std::min(1.0, options.max_step_fraction * max_step);
+    stats->phases.step_bound += clock.Lap();
     bool accepted = false;
     double f_new = f;
     VectorXd z_new;
@@ -789,6 +809,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       }
       step = next;
     }
+    stats->phases.line_search += clock.Lap();
     if (!accepted) {
       stats->stop_reason = "line_search";
       return absl::OkStatus();
@@ -815,6 +836,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       pairs.push_back(std::move(p));
       if (static_cast<int>(pairs.size()) > options.history) pairs.pop_front();
     }
+    stats->phases.direction += clock.Lap();
     history.push_back(f_new);
     const int window = std::max(1, options.decrease_window);
     // A step capped by the inversion bound is "blocked": slow progress there may be one blocking
@@ -924,8 +946,10 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       return absl::CancelledError(absl::StrCat("comesh optimization cancelled at outer ", outer));
     }
     TopologyReport topo;
+    Stopwatch topology_clock;
     absl::StatusOr<Multimesh> improved =
         ImproveTopology(current, options.map_weight, options.topology, &topo);
+    stats.phases.topology += topology_clock.Lap();
     if (!improved.ok()) return improved.status();
     if (topo.flips + topo.collapses + topo.splits == 0) break;
     rep.flips += topo.flips;
@@ -961,6 +985,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   if (absl::Status st = inner(options.max_iterations); !st.ok()) return st;
   rep.inner = stats.iterations;
   rep.energy_evaluations = stats.evaluations + 1;
+  rep.phase_seconds = stats.phases;
   rep.stop_reason = stats.stop_reason;
   rep.objective_after = stats.objective;
   rep.map_energy = stats.energies.map;

@@ -134,6 +134,15 @@ struct ComeshCheckpoint {
   std::vector<double> objective_trace;  // ComeshReport::objective_trace so far
 };
 
+// Where a run's time went (seconds, summed over inner runs and passes; for benchmarks).
+struct ComeshPhaseSeconds {
+  double hessian = 0.0;      // H0: objective set-up, pattern, ordering, factorization (per run)
+  double direction = 0.0;    // L-BFGS two-loop recursion with H0 solves, curvature pairs
+  double step_bound = 0.0;   // curing and the largest non-inverting step
+  double line_search = 0.0;  // objective + gradient evaluations of the line search
+  double topology = 0.0;     // topology passes
+};
+
 struct ComeshReport {
   int vertices_before = 0;
   int vertices_after = 0;
@@ -152,6 +161,7 @@ struct ComeshReport {
   int collapses = 0;
   int splits = 0;
   int energy_evaluations = 0;
+  ComeshPhaseSeconds phase_seconds;
   std::string stop_reason;  // last inner run: "gradient", "decrease", "max_iterations",
                             // "line_search", "no_free"
 };

@@ -93,16 +93,26 @@ inline solver::ProgressFn VerboseProgress(bool verbose) {
   };
 }
 
+// With --verbose: where the (first) run's time went.
+inline void PrintPhases(const solver::ComeshReport& r) {
+  const solver::ComeshPhaseSeconds& p = r.phase_seconds;
+  std::printf("  phases (s): hessian %.3f, direction %.3f, step bound %.3f, line search %.3f, "
+              "topology %.3f\n",
+              p.hessian, p.direction, p.step_bound, p.line_search, p.topology);
+}
+
 // OptimizeComesh, timed: a run shorter than a second is repeated until `repeat` runs were made
 // (the optimizer is deterministic, so every run reports the same numbers) and report->seconds is
 // the median, because a few milliseconds on a shared machine are mostly noise. Progress is only
-// shown for the first run.
+// shown for the first run (and, with it, where
+// that run's time went).
 inline absl::StatusOr<solver::Multimesh> TimedOptimize(const solver::Multimesh& mesh,
                                                        const solver::ComeshOptions& options,
                                                        const solver::ProgressFn& progress,
                                                        int repeat, solver::ComeshReport* report) {
   absl::StatusOr<solver::Multimesh> out =
       solver::OptimizeComesh(mesh, options, nullptr, progress, report);
+  if (out.ok() && progress) PrintPhases(*report);
   if (!out.ok() || report->seconds >= 1.0 || repeat <= 1) return out;
   std::vector<double> seconds = {report->seconds};
   for (int i = 1; i < repeat; ++i) {
@@ -127,8 +137,15 @@ inline nlohmann::json ComeshRow(const std::string& name, const solver::ComeshRep
           {"seconds", r.seconds},
           {"map_energy", r.map_energy},
           {"mesh_energy", r.mesh_energy},
-          {"paper_seconds", paper_seconds}};
+          {"paper_seconds", paper_seconds},
+          {"phase_seconds",
+           {{"hessian", r.phase_seconds.hessian},
+            {"direction", r.phase_seconds.direction},
+            {"step_bound", r.phase_seconds.step_bound},
+            {"line_search", r.phase_seconds.line_search},
+            {"topology", r.phase_seconds.topology}}}};
 }
+
 
 inline void WriteRows(const std::string& path, const nlohmann::json& rows) {
   if (!path.empty()) std::ofstream(path) << rows.dump(2) << "\n";
