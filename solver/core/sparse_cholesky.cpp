@@ -1,7 +1,8 @@
 // CHOLMOD-backed sparse LDL^T (see sparse_cholesky.h). By default a simplicial factorization with
 // an AMD ordering: no BLAS and no threads, so results are bit-identical run to run; solves are our
 // own substitutions reading CHOLMOD's factor arrays in place (no copy, no allocation per solve).
-// Method::kAuto lets CHOLMOD go supernodal on large matrices (solves then by cholmod_solve2).
+// Method::kAuto lets CHOLMOD go supernodal on large matrices (its factorization runs on BLAS; the
+// solves are our own substitutions over the supernodes, no BLAS).
 #include "solver/core/sparse_cholesky.h"
 
 #include <cholmod.h>
@@ -33,15 +34,30 @@ struct SparseCholesky::Impl {
   const int* l_nz = nullptr;
   const int* l_i = nullptr;
   const double* l_x = nullptr;
+  // P A P^T = L L^T from CHOLMOD's supernodal factor (in place): supernode s holds columns
+  // [super[s], super[s + 1]) as a dense column-major block of nsrow = pi[s + 1] - pi[s] rows at
+  // x[px[s]], its rows listed at s_i[pi[s] ..] (the first ones are the block's own columns).
+  int nsuper = 0;
+  const int* super = nullptr;
+  const int* s_pi = nullptr;
+  const int* s_px = nullptr;
+  const int* s_i = nullptr;
   mutable std::vector<double> work;  // interleaved right-hand sides, n x columns
-  // cholmod_solve2's solution and workspace for a supernodal factor, reused between solves.
-  mutable cholmod_dense* solve_x = nullptr;
-  mutable cholmod_dense* solve_y = nullptr;
-  mutable cholmod_dense* solve_e = nullptr;
 
   void Extract();
   template <int kColumns>
   void Substitute(double* y, int columns) const;
+  template <int kColumns>
+  void SubstituteSupernodal(double* y, int columns) const;
+  // Solves in place for `columns` interleaved right-hand sides in the permuted order.
+  template <int kColumns>
+  void SolvePermuted(double* y, int columns) const {
+    if (super != nullptr) {
+      SubstituteSupernodal<kColumns>(y, columns);
+    } else {
+      Substitute<kColumns>(y, columns);
+    }
+  }
 
   explicit Impl(Method method) {
     cholmod_start(&common);
@@ -57,9 +73,6 @@ struct SparseCholesky::Impl {
     common.postorder = true;
   }
   ~Impl() {
-    for (cholmod_dense** d : {&solve_x, &solve_y, &solve_e}) {
-      if (*d != nullptr) cholmod_free_dense(d, &common);
-    }
     if (factor != nullptr) cholmod_free_factor(&factor, &common);
     cholmod_finish(&common);
   }
@@ -69,10 +82,61 @@ struct SparseCholesky::Impl {
 
 void SparseCholesky::Impl::Extract() {
   perm = static_cast<const int*>(factor->Perm);
-  l_p = static_cast<const int*>(factor->p);
-  l_nz = static_cast<const int*>(factor->nz);
-  l_i = static_cast<const int*>(factor->i);
   l_x = static_cast<const double*>(factor->x);
+  if (factor->is_super) {
+    nsuper = static_cast<int>(factor->nsuper);
+    super = static_cast<const int*>(factor->super);
+    s_pi = static_cast<const int*>(factor->pi);
+    s_px = static_cast<const int*>(factor->px);
+    s_i = static_cast<const int*>(factor->s);
+    l_p = l_nz = l_i = nullptr;
+  } else {
+    l_p = static_cast<const int*>(factor->p);
+    l_nz = static_cast<const int*>(factor->nz);
+    l_i = static_cast<const int*>(factor->i);
+    super = s_pi = s_px = s_i = nullptr;
+  }
+}
+
+// The supernodal twin of Substitute (L L^T, no D): per supernode, the dense diagonal block and
+// the rows below it, column by column; no BLAS, so solves on several threads never contend.
+template <int kColumns>
+void SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns) const {
+  const int c = kColumns > 0 ? kColumns : columns;
+  for (int s = 0; s < nsuper; ++s) {  // L z = y
+    const int k1 = super[s], nscol = super[s + 1] - k1;
+    const int nsrow = s_pi[s + 1] - s_pi[s];
+    const int* rows = s_i + s_pi[s];
+    const double* block = l_x + s_px[s];
+    for (int j = 0; j < nscol; ++j) {
+      const double* col = block + static_cast<size_t>(j) * nsrow;
+      double* yj = y + static_cast<size_t>(k1 + j) * c;
+      const double inv = 1.0 / col[j];
+      for (int q = 0; q < c; ++q) yj[q] *= inv;
+      for (int i = j + 1; i < nsrow; ++i) {
+        double* yi = y + static_cast<size_t>(rows[i]) * c;
+        const double l = col[i];
+        for (int q = 0; q < c; ++q) yi[q] -= l * yj[q];
+      }
+    }
+  }
+  for (int s = nsuper - 1; s >= 0; --s) {  // L^T x = z
+    const int k1 = super[s], nscol = super[s + 1] - k1;
+    const int nsrow = s_pi[s + 1] - s_pi[s];
+    const int* rows = s_i + s_pi[s];
+    const double* block = l_x + s_px[s];
+    for (int j = nscol - 1; j >= 0; --j) {
+      const double* col = block + static_cast<size_t>(j) * nsrow;
+      double* yj = y + static_cast<size_t>(k1 + j) * c;
+      for (int i = j + 1; i < nsrow; ++i) {
+        const double* yi = y + static_cast<size_t>(rows[i]) * c;
+        const double l = col[i];
+        for (int q = 0; q < c; ++q) yj[q] -= l * yi[q];
+      }
+      const double inv = 1.0 / col[j];
+      for (int q = 0; q < c; ++q) yj[q] *= inv;
+    }
+  }
 }
 
 // y: n rows of `columns` interleaved values (kColumns == columns, or 0 for any count).
@@ -259,7 +323,7 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
       }
     }
   }
-  if (!m.factor->is_super) m.Extract();
+  m.Extract();
   m.factorized = true;
   return absl::OkStatus();
 }
@@ -286,24 +350,6 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
   }
   const int c = static_cast<int>(b->cols());
   if (c == 0) return absl::OkStatus();
-  if (m.factor->is_super) {
-    cholmod_dense rhs{};
-    rhs.nrow = static_cast<size_t>(m.n);
-    rhs.ncol = static_cast<size_t>(c);
-    rhs.nzmax = rhs.nrow * rhs.ncol;
-    rhs.d = rhs.nrow;
-    rhs.x = b->data();
-    rhs.xtype = CHOLMOD_REAL;
-    rhs.dtype = CHOLMOD_DOUBLE;
-    cholmod_common& common = const_cast<cholmod_common&>(m.common);
-    const BlasLock blas;
-    if (!cholmod_solve2(CHOLMOD_A, m.factor, &rhs, nullptr, &m.solve_x, nullptr, &m.solve_y,
-                        &m.solve_e, &common)) {
-      return CholmodError(common, "solve");
-    }
-    std::copy_n(static_cast<const double*>(m.solve_x->x), rhs.nzmax, b->data());
-    return absl::OkStatus();
-  }
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int workers = std::min(threads, c);
   m.work.resize(static_cast<size_t>(m.n) * c);
@@ -314,7 +360,7 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
       for (int q = worker; q < c; q += workers) {
         double* yq = y + static_cast<size_t>(q) * m.n;
         for (int k = 0; k < m.n; ++k) yq[k] = (*b)(m.perm[k], q);
-        m.Substitute<1>(yq, 1);
+        m.SolvePermuted<1>(yq, 1);
         for (int k = 0; k < m.n; ++k) (*b)(m.perm[k], q) = yq[k];
       }
     };
@@ -329,13 +375,13 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
   }
   switch (c) {
     case 1:
-      m.Substitute<1>(y, c);
+      m.SolvePermuted<1>(y, c);
       break;
     case 2:
-      m.Substitute<2>(y, c);
+      m.SolvePermuted<2>(y, c);
       break;
     default:
-      m.Substitute<0>(y, c);
+      m.SolvePermuted<0>(y, c);
   }
   for (int k = 0; k < m.n; ++k) {
     for (int q = 0; q < c; ++q) (*b)(m.perm[k], q) = y[static_cast<size_t>(k) * c + q];

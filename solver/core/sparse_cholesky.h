@@ -11,8 +11,9 @@
 // dense kernels to pay (flops / nnz(L) >= 40, CHOLMOD's own switch; else the same simplicial
 // factor): a supernodal factorization runs on BLAS (scripts/setup installs Debian's OpenBLAS,
 // pthread build, which SparseCholesky sets to one thread), measured 2.6 s against 70 s simplicial
-// for a 320k-unknown planar mesh matrix (docs/benchmarks.md). Its solves are CHOLMOD's
-// (cholmod_solve2, workspace kept between calls). Single-threaded BLAS and a fixed ordering keep
+// for a 320k-unknown planar mesh matrix (docs/benchmarks.md). Its solves are our own
+// substitutions over the supernodes' dense blocks (no BLAS: solves on several threads never
+// contend for OpenBLAS's buffer lock). Single-threaded BLAS and a fixed ordering keep
 // the result bit-identical run to run on one machine. Objects on different threads factor and
 // solve concurrently (with a non-reentrant BLAS, the serial OpenBLAS, those calls are serialized).
 #pragma once
@@ -54,7 +55,7 @@ class SparseCholesky {
   // one object must not solve on two threads at once. With threads > 1 (<= 0: all cores) and at
   // least kParallelRows rows, the columns are substituted separately on up to `threads` threads;
   // each column sees the same operations in the same order either way, so the result is
-  // bit-identical for every thread count. A supernodal factor (Method::kAuto) ignores `threads`.
+  // bit-identical for every thread count (supernodal factors too).
   absl::Status SolveInPlace(Eigen::MatrixXd* b, int threads = 1) const;
   static constexpr int kParallelRows = 8192;
 
