@@ -174,12 +174,14 @@ class Layout {
                                              : Point(z.segment<2>(var.offset));
     }
   }
-  // Displacement of vertex v of shape s for the step z -> z + d.
-  Point Displacement(const VectorXd& d, int s, int v) const {
-    const int i = index_[s][v];
-    if (i < 0) return Point::Zero();
-    const Var& var = vars_[i];
-    return var.slider ? Point(d[var.offset] * var.direction) : Point(d.segment<2>(var.offset));
+  // Every vertex's displacement in every shape for the step z -> z + d (zero where fixed).
+  void Displacements(const VectorXd& d, std::vector<Points>* out) const {
+    out->resize(num_shapes_);
+    for (Points& shape : *out) shape.assign(num_vertices_, Point::Zero());
+    for (const Var& var : vars_) {
+      (*out)[var.shape][var.vertex] = var.slider ? Point(d[var.offset] * var.direction)
+                                                 : Point(d.segment<2>(var.offset));
+    }
   }
 
  private:
@@ -190,11 +192,13 @@ class Layout {
   std::vector<std::vector<int>> index_;  // [shape][vertex] -> var or -1
 };
 
-// Largest step t such that every triangle of every shape keeps positive area on (0, t). A min
-// over triangles, so the chunked parallel evaluation gives the same value for any thread count.
+// Largest step t such that every triangle of every shape keeps positive area on (0, t), for the
+// displacements `disp` (Layout::Displacements). A min over triangles, so the chunked parallel
+// evaluation gives the same value for any thread count. A triangle that does not move adds
+// nothing (its area polynomial is constant).
 double MaxNonInvertingStep(const std::vector<Triangle>& triangles,
-                           const std::vector<Points>& shapes, const Layout& layout,
-                           const VectorXd& d, int threads) {
+                           const std::vector<Points>& shapes, const std::vector<Points>& disp,
+                           int threads) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   constexpr int kChunk = 4096;
   auto cross = [](const Point& u, const Point& v) { return u.x() * v.y() - u.y() * v.x(); };
@@ -202,19 +206,13 @@ double MaxNonInvertingStep(const std::vector<Triangle>& triangles,
   std::vector<double> part(NumChunks(num_triangles, kChunk), kInf);
   ParallelChunks(num_triangles, kChunk, threads, [&](int chunk, int begin, int end) {
     double best = kInf;
-    for (int s = 0; s < static_cast<int>(shapes.size()); ++s) {
+    for (size_t s = 0; s < shapes.size(); ++s) {
+      const Points& x = shapes[s];
+      const Points& dx = disp[s];
       for (int ti = begin; ti < end; ++ti) {
         const Triangle& t = triangles[ti];
-        Point p[3], q[3];
-        bool moves = false;
-        for (int k = 0; k < 3; ++k) {
-          p[k] = shapes[s][t[k]];
-          moves |= layout.index(s, t[k]) >= 0;
-          q[k] = layout.Displacement(d, s, t[k]);
-        }
-        if (!moves) continue;
-        const Point e1 = p[1] - p[0], e2 = p[2] - p[0];
-        const Point f1 = q[1] - q[0], f2 = q[2] - q[0];
+        const Point e1 = x[t[1]] - x[t[0]], e2 = x[t[2]] - x[t[0]];
+        const Point f1 = dx[t[1]] - dx[t[0]], f2 = dx[t[2]] - dx[t[0]];
         // 2 area(t) = c0 + c1 t + c2 t^2, c0 > 0.
         const double c0 = cross(e1, e2);
         const double c1 = cross(e1, f2) + cross(f1, e2);
@@ -610,26 +608,41 @@ class HessianPreconditioner {
 // displacements of its moving corners are scaled by (1 - cure_keep) c0 / (-c1) (the factor that
 // keeps the linearised area at cure_keep * c0 if all corners are scaled alike; a vertex takes the
 // smallest factor of its triangles). A few blocking triangles then no longer shrink the step of
-// the whole mesh. Returns the number of scaled unknowns.
+// the whole mesh. Returns the number of scaled unknowns; `disp` is scratch (the displacements of
+// the uncured d).
 int CureDirection(const std::vector<Triangle>& triangles, const std::vector<Points>& shapes,
-                  const Layout& layout, double cure_keep, VectorXd* d) {
+                  const Layout& layout, double cure_keep, int threads, std::vector<Points>* disp,
+                  VectorXd* d) {
+  constexpr int kChunk = 4096;
   auto cross = [](const Point& u, const Point& v) { return u.x() * v.y() - u.y() * v.x(); };
-  std::vector<double> factor(layout.vars().size(), 1.0);
-  for (int s = 0; s < layout.num_shapes(); ++s) {
-    for (const Triangle& t : triangles) {
-      Point p[3], q[3];
-      for (int k = 0; k < 3; ++k) {
-        p[k] = shapes[s][t[k]];
-        q[k] = layout.Displacement(*d, s, t[k]);
+  layout.Displacements(*d, disp);
+  // Per triangle and shape, the factor its moving corners need (1: none), in parallel; then each
+  // vertex takes the smallest of its triangles' factors (serial, in triangle order).
+  const int num_triangles = static_cast<int>(triangles.size());
+  const int num_shapes = layout.num_shapes();
+  std::vector<double> need(static_cast<size_t>(num_triangles) * num_shapes, 1.0);
+  ParallelChunks(num_triangles, kChunk, threads, [&](int, int begin, int end) {
+    for (int s = 0; s < num_shapes; ++s) {
+      const Points& x = shapes[s];
+      const Points& dx = (*disp)[s];
+      for (int ti = begin; ti < end; ++ti) {
+        const Triangle& t = triangles[ti];
+        const Point e1 = x[t[1]] - x[t[0]], e2 = x[t[2]] - x[t[0]];
+        const Point f1 = dx[t[1]] - dx[t[0]], f2 = dx[t[2]] - dx[t[0]];
+        const double c0 = cross(e1, e2);
+        const double c1 = cross(e1, f2) + cross(f1, e2);
+        if (!(c0 + c1 < cure_keep * c0)) continue;
+        need[static_cast<size_t>(s) * num_triangles + ti] = (1.0 - cure_keep) * c0 / (-c1);
       }
-      const Point e1 = p[1] - p[0], e2 = p[2] - p[0];
-      const Point f1 = q[1] - q[0], f2 = q[2] - q[0];
-      const double c0 = cross(e1, e2);
-      const double c1 = cross(e1, f2) + cross(f1, e2);
-      if (!(c0 + c1 < cure_keep * c0)) continue;
-      const double c = (1.0 - cure_keep) * c0 / (-c1);
+    }
+  });
+  std::vector<double> factor(layout.vars().size(), 1.0);
+  for (int s = 0; s < num_shapes; ++s) {
+    for (int ti = 0; ti < num_triangles; ++ti) {
+      const double c = need[static_cast<size_t>(s) * num_triangles + ti];
+      if (c >= 1.0) continue;
       for (int k = 0; k < 3; ++k) {
-        const int i = layout.index(s, t[k]);
+        const int i = layout.index(s, triangles[ti][k]);
         if (i >= 0) factor[i] = std::min(factor[i], c);
       }
     }
@@ -724,6 +737,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   std::vector<double> history = {f};  // objective per iteration, for the stopping window
   std::vector<Points> trial = shapes;
   std::vector<Points> trial_grad;
+  std::vector<Points> disp;  // the direction as per-vertex displacements (step bound, curing)
   ComeshEnergies trial_energies;
 
   for (int iter = 0;; ++iter) {
@@ -773,7 +787,8 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     stats->phases.direction += clock.Lap();
     if (options.cure) {
       VectorXd cured = d;
-      if (CureDirection(mesh->triangles, shapes, layout, options.cure_keep, &cured) > 0) {
+      if (CureDirection(mesh->triangles, shapes, layout, options.cure_keep, objective->threads(),
+                        &disp, &cured) > 0) {
         const double cured_slope = g.dot(cured);
         if (cured_slope < 0.0) {
           d = std::move(cured);
@@ -783,8 +798,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     }
 
     // Inversion-free backtracking line search.
+    layout.Displacements(d, &disp);
     const double max_step =
-        MaxNonInvertingStep(mesh->triangles, shapes, layout, d, objective->threads());
+        MaxNonInvertingStep(mesh->triangles, shapes, disp, objective->threads());
     double step = std::min(1.0, options.max_step_fraction * max_step);
     stats->phases.step_bound += clock.Lap();
     bool accepted = false;
