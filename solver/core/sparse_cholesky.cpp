@@ -42,18 +42,21 @@ struct SparseCholesky::Impl {
   const int* s_pi = nullptr;
   const int* s_px = nullptr;
   const int* s_i = nullptr;
+  int max_below = 0;  // most rows below a supernode's diagonal block
   mutable std::vector<double> work;  // interleaved right-hand sides, n x columns
+  mutable std::vector<double> supernode_work;  // SubstituteSupernodal's scratch
 
   void Extract();
   template <int kColumns>
   void Substitute(double* y, int columns) const;
   template <int kColumns>
-  void SubstituteSupernodal(double* y, int columns) const;
-  // Solves in place for `columns` interleaved right-hand sides in the permuted order.
+  void SubstituteSupernodal(double* y, int columns, double* below) const;
+  // Solves in place for `columns` interleaved right-hand sides in the permuted order. `below`:
+  // max_below x columns values of scratch (supernodal factors only).
   template <int kColumns>
-  void SolvePermuted(double* y, int columns) const {
+  void SolvePermuted(double* y, int columns, double* below) const {
     if (super != nullptr) {
-      SubstituteSupernodal<kColumns>(y, columns);
+      SubstituteSupernodal<kColumns>(y, columns, below);
     } else {
       Substitute<kColumns>(y, columns);
     }
@@ -90,6 +93,10 @@ void SparseCholesky::Impl::Extract() {
     s_px = static_cast<const int*>(factor->px);
     s_i = static_cast<const int*>(factor->s);
     l_p = l_nz = l_i = nullptr;
+    max_below = 0;
+    for (int k = 0; k < nsuper; ++k) {
+      max_below = std::max(max_below, (s_pi[k + 1] - s_pi[k]) - (super[k + 1] - super[k]));
+    }
   } else {
     l_p = static_cast<const int*>(factor->p);
     l_nz = static_cast<const int*>(factor->nz);
@@ -98,43 +105,58 @@ void SparseCholesky::Impl::Extract() {
   }
 }
 
-// The supernodal twin of Substitute (L L^T, no D): per supernode, the dense diagonal block and
-// the rows below it, column by column; no BLAS, so solves on several threads never contend.
+// The supernodal twin of Substitute (L L^T, no D): per supernode, the dense diagonal block in
+// place, and the rows below it through a dense scratch (gathered or scattered once per supernode,
+// so the inner loops run over contiguous memory); no BLAS, so solves on several threads never
+// contend. `below`: scratch of max_below x columns values.
 template <int kColumns>
-void SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns) const {
+void SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* below) const {
   const int c = kColumns > 0 ? kColumns : columns;
   for (int s = 0; s < nsuper; ++s) {  // L z = y
     const int k1 = super[s], nscol = super[s + 1] - k1;
-    const int nsrow = s_pi[s + 1] - s_pi[s];
-    const int* rows = s_i + s_pi[s];
+    const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
+    const int* rows = s_i + s_pi[s] + nscol;
     const double* block = l_x + s_px[s];
+    double* ys = y + static_cast<size_t>(k1) * c;
+    std::fill(below, below + static_cast<size_t>(nbelow) * c, 0.0);
     for (int j = 0; j < nscol; ++j) {
       const double* col = block + static_cast<size_t>(j) * nsrow;
-      double* yj = y + static_cast<size_t>(k1 + j) * c;
+      double* yj = ys + static_cast<size_t>(j) * c;
       const double inv = 1.0 / col[j];
       for (int q = 0; q < c; ++q) yj[q] *= inv;
-      for (int i = j + 1; i < nsrow; ++i) {
-        double* yi = y + static_cast<size_t>(rows[i]) * c;
-        const double l = col[i];
-        for (int q = 0; q < c; ++q) yi[q] -= l * yj[q];
+      for (int i = j + 1; i < nscol; ++i) {
+        for (int q = 0; q < c; ++q) ys[static_cast<size_t>(i) * c + q] -= col[i] * yj[q];
       }
+      const double* lower = col + nscol;
+      for (int r = 0; r < nbelow; ++r) {
+        for (int q = 0; q < c; ++q) below[static_cast<size_t>(r) * c + q] += lower[r] * yj[q];
+      }
+    }
+    for (int r = 0; r < nbelow; ++r) {
+      double* yr = y + static_cast<size_t>(rows[r]) * c;
+      for (int q = 0; q < c; ++q) yr[q] -= below[static_cast<size_t>(r) * c + q];
     }
   }
   for (int s = nsuper - 1; s >= 0; --s) {  // L^T x = z
     const int k1 = super[s], nscol = super[s + 1] - k1;
-    const int nsrow = s_pi[s + 1] - s_pi[s];
-    const int* rows = s_i + s_pi[s];
+    const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
+    const int* rows = s_i + s_pi[s] + nscol;
     const double* block = l_x + s_px[s];
+    double* ys = y + static_cast<size_t>(k1) * c;
+    for (int r = 0; r < nbelow; ++r) {
+      const double* yr = y + static_cast<size_t>(rows[r]) * c;
+      for (int q = 0; q < c; ++q) below[static_cast<size_t>(r) * c + q] = yr[q];
+    }
     for (int j = nscol - 1; j >= 0; --j) {
       const double* col = block + static_cast<size_t>(j) * nsrow;
-      double* yj = y + static_cast<size_t>(k1 + j) * c;
-      for (int i = j + 1; i < nsrow; ++i) {
-        const double* yi = y + static_cast<size_t>(rows[i]) * c;
-        const double l = col[i];
-        for (int q = 0; q < c; ++q) yj[q] -= l * yi[q];
+      double* yj = ys + static_cast<size_t>(j) * c;
+      const double* lower = col + nscol;
+      for (int q = 0; q < c; ++q) {
+        double sum = 0.0;
+        for (int r = 0; r < nbelow; ++r) sum += lower[r] * below[static_cast<size_t>(r) * c + q];
+        for (int i = j + 1; i < nscol; ++i) sum += col[i] * ys[static_cast<size_t>(i) * c + q];
+        yj[q] = (yj[q] - sum) / col[j];
       }
-      const double inv = 1.0 / col[j];
-      for (int q = 0; q < c; ++q) yj[q] *= inv;
     }
   }
 }
@@ -354,13 +376,15 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
   const int workers = std::min(threads, c);
   m.work.resize(static_cast<size_t>(m.n) * c);
   double* y = m.work.data();
+  // Scratch for the supernodal substitution: one column's worth per worker, or c columns.
+  m.supernode_work.resize(static_cast<size_t>(m.max_below) * std::max(workers, c));
   if (workers > 1 && m.n >= kParallelRows) {
     // Column q in its own contiguous block of `work`, columns dealt round-robin to the workers.
     auto run = [&](int worker) {
       for (int q = worker; q < c; q += workers) {
         double* yq = y + static_cast<size_t>(q) * m.n;
         for (int k = 0; k < m.n; ++k) yq[k] = (*b)(m.perm[k], q);
-        m.SolvePermuted<1>(yq, 1);
+        m.SolvePermuted<1>(yq, 1, m.supernode_work.data() + static_cast<size_t>(worker) * m.max_below);
         for (int k = 0; k < m.n; ++k) (*b)(m.perm[k], q) = yq[k];
       }
     };
@@ -375,13 +399,13 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
   }
   switch (c) {
     case 1:
-      m.SolvePermuted<1>(y, c);
+      m.SolvePermuted<1>(y, c, m.supernode_work.data());
       break;
     case 2:
-      m.SolvePermuted<2>(y, c);
+      m.SolvePermuted<2>(y, c, m.supernode_work.data());
       break;
     default:
-      m.SolvePermuted<0>(y, c);
+      m.SolvePermuted<0>(y, c, m.supernode_work.data());
   }
   for (int k = 0; k < m.n; ++k) {
     for (int q = 0; q < c; ++q) (*b)(m.perm[k], q) = y[static_cast<size_t>(k) * c + q];

@@ -160,6 +160,16 @@ TEST(SparseCholeskyTest, AutoGoesSupernodalOnLargeMatricesWithTheSameSolution) {
   ASSERT_TRUE(simplicial.SolveInPlace(&y).ok());
   EXPECT_LT((a * x - b).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 1e-9 * y.cwiseAbs().maxCoeff());
+  // Any column count, and columns on several threads: the same numbers, bit for bit.
+  Eigen::MatrixXd wide(a.rows(), 3);
+  wide << b, b.col(0) - b.col(1);
+  Eigen::MatrixXd serial = wide, parallel = wide, one = wide.col(2);
+  ASSERT_TRUE(super.SolveInPlace(&serial).ok());
+  ASSERT_TRUE(super.SolveInPlace(&parallel, 2).ok());
+  ASSERT_TRUE(super.SolveInPlace(&one).ok());
+  EXPECT_EQ(serial, parallel);
+  EXPECT_EQ(serial.leftCols(2), x);
+  EXPECT_EQ(serial.col(2), one);
 
   const Eigen::SparseMatrix<double> scaled = 3.0 * a;
   ASSERT_TRUE(super.Factorize(scaled).ok());
