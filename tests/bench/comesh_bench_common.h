@@ -18,6 +18,7 @@ namespace inbetween::bench {
 struct ComeshBenchArgs {
   int max_vertices = 40000;
   int min_vertices = 0;  // rows below it are skipped (e.g. to run the 311k row alone)
+  std::string cache_dir;  // comesh-scaling: built multimeshes kept here and reused (--cache DIR)
   std::string json_path;
   bool verbose = false;
   int repeat = 5;  // runs shorter than a second are repeated; the median time is reported
@@ -36,7 +37,7 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
                  "[--cure-keep C] [--step-fraction F] [--outer-inner K] [--scale-by-inverse] "
                  "[--history M] [--tolerance R] [--laplacian] [--refresh K] [--repeat N] "
                  "[--verbose] [--json FILE]\n",
-                 argv[0], with_max_vertices ? "[--max-vertices N] [--min-vertices N] " : "");
+                 argv[0], with_max_vertices ? "[--max-vertices N] [--min-vertices N] [--cache DIR] " : "");
     std::exit(2);
   };
   for (int i = 1; i < argc; ++i) {
@@ -46,6 +47,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.max_vertices = std::atoi(next());
     } else if (a == "--min-vertices" && with_max_vertices) {
       args.min_vertices = std::atoi(next());
+    } else if (a == "--cache" && with_max_vertices) {
+      args.cache_dir = next();
     } else if (a == "--json") {
       args.json_path = next();
     } else if (a == "--threads") {
