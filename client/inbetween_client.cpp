@@ -61,6 +61,13 @@ bool IsTransient(const grpc::Status& status) {
          absl::StartsWith(status.error_message(), "Received RST_STREAM");
 }
 
+// The server's per-token heavy-job limit (server/heavy_jobs.cpp). After a transient failure it is
+// most likely our own broken attempt, whose job the server is still winding down: worth a retry.
+bool IsOwnHeavyJobLimit(const grpc::Status& status) {
+  return status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED &&
+         absl::StrContains(status.error_message(), "--max-heavy-jobs-per-token");
+}
+
 // gRPC aborts the process on a metadata value outside printable ASCII (API misuse), so such a
 // value (a session id or token typed with a control character) is not sent as metadata: the
 // server then judges the id in the request itself (NOT_FOUND) or sees no token (UNAUTHENTICATED).
@@ -106,10 +113,13 @@ grpc::Status InbetweenClient::PrepareRetry(const std::string& method, int failed
                                            const grpc::Status& status, uint32_t resume_frame,
                                            uint32_t last_iteration) {
   const RetryOptions& retry = options_.retry;
-  if (!IsTransient(status) || failed_attempt >= retry.max_attempts) return status;
-  const double ms =
+  const bool orphan = failed_attempt > 1 && IsOwnHeavyJobLimit(status);
+  if ((!IsTransient(status) && !orphan) || failed_attempt >= retry.max_attempts) return status;
+  double ms =
       std::min(static_cast<double>(retry.max_backoff.count()),
                retry.initial_backoff.count() * std::pow(retry.multiplier, failed_attempt - 1));
+  // The earlier attempt's job needs the server to notice the cancellation (its next check).
+  if (orphan) ms = std::max(ms, static_cast<double>(kOrphanJobBackoff.count()));
   const std::chrono::milliseconds backoff(static_cast<int64_t>(ms));
   if (options_.on_retry) {
     options_.on_retry(RetryEvent{.method = method,

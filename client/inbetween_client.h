@@ -81,6 +81,11 @@ bool IsTransient(const grpc::Status& status);
 
 class InbetweenClient {
  public:
+  // The least wait before retrying a refusal by the server's --max-heavy-jobs-per-token that
+  // follows a transient failure: the token's earlier, broken attempt is usually still winding
+  // down on the server until its job notices the cancellation.
+  static constexpr std::chrono::milliseconds kOrphanJobBackoff{500};
+
   explicit InbetweenClient(std::shared_ptr<grpc::Channel> channel, ClientOptions options = {});
 
   absl::StatusOr<v1::Session> CreateSession(const std::string& display_name,
@@ -123,7 +128,8 @@ class InbetweenClient {
                              const std::function<grpc::Status(grpc::ClientContext*)>& rpc);
   // Reports the retry and waits the backoff before attempt `failed_attempt + 1`: OK to go on;
   // else what the call returns: `status` itself when it is not transient or the attempts are
-  // used up, CANCELLED when CancelInFlight() came during the wait.
+  // used up, CANCELLED when CancelInFlight() came during the wait. A refusal by the server's
+  // --max-heavy-jobs-per-token on a retry counts as transient (kOrphanJobBackoff).
   grpc::Status PrepareRetry(const std::string& method, int failed_attempt,
                             const grpc::Status& status, uint32_t resume_frame = 0,
                             uint32_t last_iteration = 0);
