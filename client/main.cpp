@@ -1,7 +1,6 @@
 // `inbetween`: the animator's command-line tool. Without --server the service runs embedded
 // in this process and is reached over an in-process gRPC channel (the same code path as remote).
 #include <grpcpp/grpcpp.h>
-#include <signal.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -16,6 +15,7 @@
 #include "client/commands.h"
 #include "client/inbetween_client.h"
 #include "server/inbetween_server.h"
+#include "server/stop_signals.h"
 
 namespace {
 
@@ -27,17 +27,12 @@ constexpr const char* kExitCodes =
     "130 interrupted.";
 
 // Ctrl-C / SIGTERM cancel the RPC in flight; the command then exits with code 130.
+// (main installed the handler: server/stop_signals.h).
 void StartSignalThread(inbetween::client::InbetweenClient* client) {
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  std::thread([set, client]() {
-    int sig = 0;
-    if (sigwait(&set, &sig) == 0) {
-      std::fprintf(stderr, "\ninterrupted: cancelling...\n");
-      client->CancelInFlight();
-    }
+  std::thread([client]() {
+    inbetween::server::WaitForStopSignal();
+    std::fprintf(stderr, "\ninterrupted: cancelling...\n");
+    client->CancelInFlight();
   }).detach();
 }
 
@@ -107,12 +102,12 @@ void ApplyInbetweenFlags(const CLI::App& cmd, const InbetweenFlags& f,
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Block the signals before any thread starts so only the signal thread receives them.
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  // SIGINT / SIGTERM reach the signal thread through a handler and a pipe, whichever thread the
+  // kernel picks (libraries start threads before main).
+  if (!inbetween::server::InstallStopSignals()) {
+    std::fprintf(stderr, "inbetween: cannot install the SIGINT/SIGTERM handler\n");
+    return 1;
+  }
 
   CLI::App app{"inbetween: 2D inbetween animation from a few key drawings"};
   app.require_subcommand(1);

@@ -4,18 +4,18 @@
 // On start it prints exactly one plain line to stdout, then flushes:
 //   inbetween-server listening on HOST:PORT
 // with the real bound port (useful with --listen 127.0.0.1:0); e2e tests parse this line.
-#include <pthread.h>
-#include <signal.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <string>
 
 #include "server/inbetween_server.h"
 #include "server/logging.h"
+#include "server/stop_signals.h"
 
 namespace {
 
@@ -118,13 +118,11 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  // Block the shutdown signals before gRPC starts its threads (they inherit the mask); the main
-  // thread then waits for them synchronously with sigwait.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // SIGTERM / SIGINT: a handler writes to a pipe the main thread reads (server/stop_signals.h).
+  if (!inbetween::server::InstallStopSignals()) {
+    std::cerr << "inbetween-server: cannot install the SIGTERM/SIGINT handler\n";
+    return 1;
+  }
 
   options.listen = listen;
   options.service.log_ok_rpcs_at_info = true;
@@ -147,9 +145,7 @@ int main(int argc, char** argv) {
   }
   std::cout << "inbetween-server listening on " << address << std::endl;  // endl flushes
 
-  int signal_number = 0;
-  while (sigwait(&signals, &signal_number) != 0) {
-  }
+  const int signal_number = inbetween::server::WaitForStopSignal();
   spdlog::info("received {}, shutting down", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
   (*server)->Shutdown();
   (*server)->Wait();
