@@ -3,10 +3,11 @@
 //
 // Blocking works only if EVERY thread blocks them, and libraries may start threads before main:
 // OpenBLAS's pthread build (the system BLAS, scripts/setup) starts its worker threads when it is
-// loaded. The kernel hands a process-directed signal to a thread that does not block it, so with
-// sigwait a SIGTERM killed the server at once (default action, no graceful shutdown) and a SIGINT
-// that the shell had set to "ignore" (a background job) was dropped by the BLAS thread. A handler
-// runs on whichever thread receives the signal, and only writes the signal number to a pipe.
+// loaded. The kernel hands a process-directed signal to a thread that does not block it, so the
+// CLI's SIGINT (sigwait on a helper thread) went to the BLAS thread instead: dropped when the
+// shell had set it to "ignore" (a background job), or killing the process without the cancel
+// path (default action). A handler runs on whichever thread receives the signal, and only writes
+// the signal number to a pipe that the waiting thread reads.
 #pragma once
 
 namespace inbetween::server {
