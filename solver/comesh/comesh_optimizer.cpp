@@ -192,6 +192,17 @@ class Layout {
   std::vector<std::vector<int>> index_;  // [shape][vertex] -> var or -1
 };
 
+// Twice the area of triangle t at x + s dx, as c0 + c1 s + c2 s^2.
+struct AreaPolynomial {
+  double c0, c1, c2;
+};
+AreaPolynomial AreaAlong(const Points& x, const Points& dx, const Triangle& t) {
+  auto cross = [](const Point& u, const Point& v) { return u.x() * v.y() - u.y() * v.x(); };
+  const Point e1 = x[t[1]] - x[t[0]], e2 = x[t[2]] - x[t[0]];
+  const Point f1 = dx[t[1]] - dx[t[0]], f2 = dx[t[2]] - dx[t[0]];
+  return {cross(e1, e2), cross(e1, f2) + cross(f1, e2), cross(f1, f2)};
+}
+
 // Largest step t such that every triangle of every shape keeps positive area on (0, t), for the
 // displacements `disp` (Layout::Displacements). A min over triangles, so the chunked parallel
 // evaluation gives the same value for any thread count. A triangle that does not move adds
@@ -201,7 +212,6 @@ double MaxNonInvertingStep(const std::vector<Triangle>& triangles,
                            int threads) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   constexpr int kChunk = 4096;
-  auto cross = [](const Point& u, const Point& v) { return u.x() * v.y() - u.y() * v.x(); };
   const int num_triangles = static_cast<int>(triangles.size());
   std::vector<double> part(NumChunks(num_triangles, kChunk), kInf);
   ParallelChunks(num_triangles, kChunk, threads, [&](int chunk, int begin, int end) {
@@ -210,13 +220,7 @@ double MaxNonInvertingStep(const std::vector<Triangle>& triangles,
       const Points& x = shapes[s];
       const Points& dx = disp[s];
       for (int ti = begin; ti < end; ++ti) {
-        const Triangle& t = triangles[ti];
-        const Point e1 = x[t[1]] - x[t[0]], e2 = x[t[2]] - x[t[0]];
-        const Point f1 = dx[t[1]] - dx[t[0]], f2 = dx[t[2]] - dx[t[0]];
-        // 2 area(t) = c0 + c1 t + c2 t^2, c0 > 0.
-        const double c0 = cross(e1, e2);
-        const double c1 = cross(e1, f2) + cross(f1, e2);
-        const double c2 = cross(f1, f2);
+        const auto [c0, c1, c2] = AreaAlong(x, dx, triangles[ti]);  // c0 > 0
         double root = kInf;
         if (std::abs(c2) <= 1e-14 * (std::abs(c1) + std::abs(c0))) {
           if (c1 < 0.0) root = -c0 / c1;
@@ -614,7 +618,6 @@ int CureDirection(const std::vector<Triangle>& triangles, const std::vector<Poin
                   const Layout& layout, double cure_keep, int threads, std::vector<Points>* disp,
                   VectorXd* d) {
   constexpr int kChunk = 4096;
-  auto cross = [](const Point& u, const Point& v) { return u.x() * v.y() - u.y() * v.x(); };
   layout.Displacements(*d, disp);
   // Per triangle and shape, the factor its moving corners need (1: none), in parallel; then each
   // vertex takes the smallest of its triangles' factors (serial, in triangle order).
@@ -626,11 +629,7 @@ int CureDirection(const std::vector<Triangle>& triangles, const std::vector<Poin
       const Points& x = shapes[s];
       const Points& dx = (*disp)[s];
       for (int ti = begin; ti < end; ++ti) {
-        const Triangle& t = triangles[ti];
-        const Point e1 = x[t[1]] - x[t[0]], e2 = x[t[2]] - x[t[0]];
-        const Point f1 = dx[t[1]] - dx[t[0]], f2 = dx[t[2]] - dx[t[0]];
-        const double c0 = cross(e1, e2);
-        const double c1 = cross(e1, f2) + cross(f1, e2);
+        const auto [c0, c1, c2] = AreaAlong(x, dx, triangles[ti]);
         if (!(c0 + c1 < cure_keep * c0)) continue;
         need[static_cast<size_t>(s) * num_triangles + ti] = (1.0 - cure_keep) * c0 / (-c1);
       }
