@@ -179,8 +179,8 @@ class Layout {
     out->resize(num_shapes_);
     for (Points& shape : *out) shape.assign(num_vertices_, Point::Zero());
     for (const Var& var : vars_) {
-      (*out)[var.shape][var.vertex] = var.slider ? Point(d[var.offset] * var.direction)
-                                                 : Point(d.segment<2>(var.offset));
+      (*out)[var.shape][var.vertex] =
+          var.slider ? Point(d[var.offset] * var.direction) : Point(d.segment<2>(var.offset));
     }
   }
 

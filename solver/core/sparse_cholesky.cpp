@@ -42,7 +42,7 @@ struct SparseCholesky::Impl {
   const int* s_pi = nullptr;
   const int* s_px = nullptr;
   const int* s_i = nullptr;
-  int max_below = 0;  // most rows below a supernode's diagonal block
+  int max_below = 0;                 // most rows below a supernode's diagonal block
   mutable std::vector<double> work;  // interleaved right-hand sides, n x columns
   mutable std::vector<double> supernode_work;  // SubstituteSupernodal's scratch
 
@@ -384,7 +384,8 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
       for (int q = worker; q < c; q += workers) {
         double* yq = y + static_cast<size_t>(q) * m.n;
         for (int k = 0; k < m.n; ++k) yq[k] = (*b)(m.perm[k], q);
-        m.SolvePermuted<1>(yq, 1, m.supernode_work.data() + static_cast<size_t>(worker) * m.max_below);
+        m.SolvePermuted<1>(yq, 1,
+                           m.supernode_work.data() + static_cast<size_t>(worker) * m.max_below);
         for (int k = 0; k < m.n; ++k) (*b)(m.perm[k], q) = yq[k];
       }
     };

@@ -37,7 +37,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
                  "[--cure-keep C] [--step-fraction F] [--outer-inner K] [--scale-by-inverse] "
                  "[--history M] [--tolerance R] [--laplacian] [--refresh K] [--repeat N] "
                  "[--verbose] [--json FILE]\n",
-                 argv[0], with_max_vertices ? "[--max-vertices N] [--min-vertices N] [--cache DIR] " : "");
+                 argv[0],
+                 with_max_vertices ? "[--max-vertices N] [--min-vertices N] [--cache DIR] " : "");
     std::exit(2);
   };
   for (int i = 1; i < argc; ++i) {
@@ -99,9 +100,10 @@ inline solver::ProgressFn VerboseProgress(bool verbose) {
 // With --verbose: where the (first) run's time went.
 inline void PrintPhases(const solver::ComeshReport& r) {
   const solver::ComeshPhaseSeconds& p = r.phase_seconds;
-  std::printf("  phases (s): hessian %.3f, direction %.3f, step bound %.3f, line search %.3f, "
-              "topology %.3f\n",
-              p.hessian, p.direction, p.step_bound, p.line_search, p.topology);
+  std::printf(
+      "  phases (s): hessian %.3f, direction %.3f, step bound %.3f, line search %.3f, "
+      "topology %.3f\n",
+      p.hessian, p.direction, p.step_bound, p.line_search, p.topology);
 }
 
 // OptimizeComesh, timed: a run shorter than a second is repeated until `repeat` runs were made
@@ -148,7 +150,6 @@ inline nlohmann::json ComeshRow(const std::string& name, const solver::ComeshRep
             {"line_search", r.phase_seconds.line_search},
             {"topology", r.phase_seconds.topology}}}};
 }
-
 
 inline void WriteRows(const std::string& path, const nlohmann::json& rows) {
   if (!path.empty()) std::ofstream(path) << rows.dump(2) << "\n";

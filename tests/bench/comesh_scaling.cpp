@@ -70,7 +70,8 @@ void SaveMultimesh(const std::string& path, const sv::Multimesh& m) {
   }
   const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(j);
   std::ofstream(path, std::ios::binary)
-      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
 }
 
 absl::StatusOr<sv::Multimesh> LoadMultimesh(const std::string& path) {
@@ -112,10 +113,9 @@ int main(int argc, char** argv) {
     // SizeFor's estimate, then up to three corrections of the requested vertex count by the
     // count it gave (vertices ~ 1 / h^2) until the mesh is within 3% of the paper's row.
     absl::StatusOr<sv::Multimesh> mesh = absl::NotFoundError("not built");
-    const std::string cached =
-        args.cache_dir.empty()
-            ? std::string()
-            : args.cache_dir + "/square-hexagon-" + std::to_string(paper.before) + ".cbor";
+    const std::string cached = args.cache_dir.empty() ? std::string()
+                                                      : args.cache_dir + "/square-hexagon-" +
+                                                            std::to_string(paper.before) + ".cbor";
     if (!cached.empty() && std::filesystem::exists(cached)) mesh = LoadMultimesh(cached);
     double request = paper.before;
     for (int attempt = 0; attempt < 4 && !mesh.ok(); ++attempt) {
