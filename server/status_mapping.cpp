@@ -42,6 +42,8 @@ grpc::StatusCode ToGrpcCode(absl::StatusCode code) {
       return grpc::StatusCode::DATA_LOSS;
     case absl::StatusCode::kUnauthenticated:
       return grpc::StatusCode::UNAUTHENTICATED;
+    default:  // absl's reserved placeholder enumerator asks for a default
+      break;
   }
   // absl reserves the right to add codes; an unknown one is a bug on our side, not the client's.
   return grpc::StatusCode::UNKNOWN;

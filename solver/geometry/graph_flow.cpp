@@ -144,7 +144,7 @@ absl::StatusOr<BoundaryGraph> BuildBoundaries(const Drawing& drawing, int drawin
     const Points& p = outlines[o].points;
     for (size_t i = 0; i < p.size(); ++i) {
       segments.push_back(
-          {p[i], p[(i + 1) % p.size()], 0, static_cast<int>(o), static_cast<int>(i)});
+          {p[i], p[(i + 1) % p.size()], 0, static_cast<int>(o), static_cast<int>(i), {}});
     }
   }
   const int num_outline_segments = static_cast<int>(segments.size());
@@ -179,7 +179,7 @@ absl::StatusOr<BoundaryGraph> BuildBoundaries(const Drawing& drawing, int drawin
       p.front() = snap_end(p.front());
       p.back() = snap_end(p.back());
       for (size_t i = 0; i + 1 < p.size(); ++i) {
-        segments.push_back({p[i], p[i + 1], kind, static_cast<int>(c), static_cast<int>(i)});
+        segments.push_back({p[i], p[i + 1], kind, static_cast<int>(c), static_cast<int>(i), {}});
       }
     }
   }
