@@ -75,6 +75,36 @@ class Editor {
     return edges;
   }
 
+  // The vertices marked since the last call (ascending), and clears the marks.
+  std::vector<int> TakeDirty() {
+    std::vector<int> out;
+    out.swap(dirty_list_);
+    for (int v : out) dirty_[v] = 0;
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  // The interior edges (a, b), a < b, with an endpoint in `vertices`, ascending (each once).
+  std::vector<std::pair<int, int>> InteriorEdgesAt(const std::vector<int>& vertices) const {
+    std::vector<std::pair<int, int>> edges;
+    for (int v : vertices) {
+      if (v >= static_cast<int>(incident_.size())) continue;
+      for (int t : incident_[v]) {
+        for (int u : triangles_[t]) {
+          if (u != v) edges.push_back({std::min(u, v), std::max(u, v)});
+        }
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::vector<std::pair<int, int>> interior;
+    int t1 = -1, t2 = -1;
+    for (const auto& [a, b] : edges) {
+      if (EdgeTriangles(a, b, &t1, &t2)) interior.push_back({a, b});
+    }
+    return interior;
+  }
+
   // Length of edge (a, b) relative to the mean edge length, max (or min) over shapes.
   double RelativeLength(int a, int b, bool max) const {
     double r = max ? 0.0 : std::numeric_limits<double>::infinity();
@@ -193,6 +223,9 @@ class Editor {
         if (tri[k] == b) tri[k] = a;
       }
       Replace(t, tri);
+    }
+    for (int t : incident_[a]) {  // a may have moved: every triangle around it changed
+      for (int v : triangles_[t]) MarkDirty(v);
     }
     removed_[b] = 1;
     t_ -= 2;
@@ -329,14 +362,25 @@ class Editor {
     return out;
   }
 
+  void MarkDirty(int v) {
+    if (v >= static_cast<int>(dirty_.size())) dirty_.resize(v + 1, 0);
+    if (!dirty_[v]) {
+      dirty_[v] = 1;
+      dirty_list_.push_back(v);
+    }
+  }
   void Detach(int t) {
     for (int v : triangles_[t]) {
+      MarkDirty(v);
       auto& list = incident_[v];
       list.erase(std::find(list.begin(), list.end(), t));
     }
   }
   void Attach(int t) {
-    for (int v : triangles_[t]) incident_[v].push_back(t);
+    for (int v : triangles_[t]) {
+      MarkDirty(v);
+      incident_[v].push_back(t);
+    }
   }
   void Replace(int t, const Triangle& tri) {
     Detach(t);
@@ -364,6 +408,9 @@ class Editor {
   double t0_;
   int t_;
   double odt_sum_ = 0.0, mips_sum_ = 0.0;
+  // Vertices whose triangles changed (or moved) since the last TakeDirty().
+  std::vector<char> dirty_;
+  std::vector<int> dirty_list_;
 };
 
 }  // namespace
@@ -405,15 +452,23 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
   if (!std::isfinite(rep.objective_before)) {
     return absl::InvalidArgumentError("ImproveTopology: a triangle is not positive in some shape");
   }
-  auto flip_sweeps = [&] {
+  // Flip sweeps: the first over every interior edge (all_edges) or over the edges at vertices
+  // changed since the last sweep, each later one over the edges at the vertices the previous
+  // sweep changed (an edge whose two triangles and corners did not change would be refused
+  // again), until a sweep flips nothing or flip_sweeps were made.
+  auto flip_sweeps = [&](bool all_edges) {
     for (int sweep = 0; options.flips && sweep < options.flip_sweeps; ++sweep) {
+      const bool everything = all_edges && sweep == 0;
+      const std::vector<std::pair<int, int>> edges =
+          everything ? editor.InteriorEdges() : editor.InteriorEdgesAt(editor.TakeDirty());
+      if (everything) editor.TakeDirty();
       int flips = 0;
-      for (const auto& [a, b] : editor.InteriorEdges()) flips += editor.TryFlip(a, b);
+      for (const auto& [a, b] : edges) flips += editor.TryFlip(a, b);
       rep.flips += flips;
       if (flips == 0) break;
     }
   };
-  flip_sweeps();
+  flip_sweeps(/*all_edges=*/true);
   if (options.collapses) {
     std::vector<std::pair<double, std::pair<int, int>>> candidates;
     for (const auto& [a, b] : editor.InteriorEdges()) {
@@ -435,7 +490,7 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
     std::sort(candidates.begin(), candidates.end());
     for (const auto& [r, edge] : candidates) rep.splits += editor.TrySplit(edge.first, edge.second);
   }
-  if (rep.collapses + rep.splits > 0) flip_sweeps();
+  if (rep.collapses + rep.splits > 0) flip_sweeps(/*all_edges=*/false);
   rep.objective_after = editor.Objective();
   if (report != nullptr) *report = rep;
   return editor.Compact(mesh);

@@ -35,7 +35,10 @@ struct TopologyOptions {
   double collapse_ratio = 0.8;
   double split_ratio = 2.0;
   double min_area_ratio = 1e-2;  // new triangles: area >= this * mean triangle area, every shape
-  int flip_sweeps = 3;           // flip sweeps over all edges per pass (until none is accepted)
+  // Flip sweeps per pass (until one accepts none): the first over every interior edge, each
+  // later one (and the one after the collapses and splits) over the edges at the vertices that
+  // changed since the sweep before.
+  int flip_sweeps = 3;
 };
 
 struct TopologyReport {
