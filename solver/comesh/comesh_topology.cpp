@@ -455,7 +455,9 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
   // Flip sweeps: the first over every interior edge (all_edges) or over the edges at vertices
   // changed since the last sweep, each later one over the edges at the vertices the previous
   // sweep changed (an edge whose two triangles and corners did not change would be refused
-  // again), until a sweep flips nothing or flip_sweeps were made.
+  // again, up to the acceptance threshold's dependence on the whole objective and an edge between
+  // its opposite corners removed elsewhere; the next pass sees those), until a sweep flips
+  // nothing or flip_sweeps were made.
   auto flip_sweeps = [&](bool all_edges) {
     for (int sweep = 0; options.flips && sweep < options.flip_sweeps; ++sweep) {
       const bool everything = all_edges && sweep == 0;
