@@ -30,6 +30,43 @@ absl::StatusOr<std::string> ReadFile(const std::filesystem::path& path) {
   return text.str();
 }
 
+// The offset of the first byte that does not belong to a well-formed UTF-8 sequence, or -1.
+std::ptrdiff_t FirstInvalidUtf8(const std::string& text) {
+  const auto* p = reinterpret_cast<const unsigned char*>(text.data());
+  const size_t n = text.size();
+  for (size_t i = 0; i < n;) {
+    const unsigned char c = p[i];
+    size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    if (len == 0 || (len == 2 && c < 0xC2) || i + len > n) return static_cast<std::ptrdiff_t>(i);
+    for (size_t k = 1; k < len; ++k) {
+      if ((p[i + k] >> 6) != 0x2) return static_cast<std::ptrdiff_t>(i);
+    }
+    if (len == 3) {
+      const unsigned cp = ((c & 0xFu) << 12) | ((p[i + 1] & 0x3Fu) << 6) | (p[i + 2] & 0x3Fu);
+      if (cp < 0x800 || (cp >= 0xD800 && cp <= 0xDFFF)) return static_cast<std::ptrdiff_t>(i);
+    } else if (len == 4) {
+      const unsigned cp = ((c & 0x7u) << 18) | ((p[i + 1] & 0x3Fu) << 12) |
+                          ((p[i + 2] & 0x3Fu) << 6) | (p[i + 3] & 0x3Fu);
+      if (cp < 0x10000 || cp > 0x10FFFF) return static_cast<std::ptrdiff_t>(i);
+    }
+    i += len;
+  }
+  return -1;
+}
+
+// A drawing's SVG text: the request carries it as a protobuf string, which must be UTF-8.
+absl::StatusOr<std::string> ReadSvg(const std::filesystem::path& path) {
+  absl::StatusOr<std::string> text = ReadFile(path);
+  if (!text.ok()) return text;
+  if (const std::ptrdiff_t bad = FirstInvalidUtf8(*text); bad >= 0) {
+    const auto line = 1 + std::count(text->begin(), text->begin() + bad, '\n');
+    return absl::InvalidArgumentError(absl::StrCat(
+        "not UTF-8 text: byte ", bad, " (line ", line, ") is not part of a UTF-8 character; ",
+        "save the SVG as UTF-8"));
+  }
+  return text;
+}
+
 absl::Status WriteText(const std::filesystem::path& path, const std::string& text) {
   const std::filesystem::path tmp = path.string() + ".tmp";
   {
@@ -129,7 +166,7 @@ absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::str
   for (size_t i = 0; i < project.drawings.size(); ++i) {
     const ProjectDrawing& d = project.drawings[i];
     const std::string where = absl::StrCat("drawing ", i + 1, " (", d.file.string(), ")");
-    auto svg = ReadFile(d.file);
+    auto svg = ReadSvg(d.file);
     if (!svg.ok()) return Annotate(svg.status(), where);
     svgs.push_back(*svg);
     auto put = ctx.client->PutDrawing(DrawingRequest(d, *session, *std::move(svg)));
@@ -569,7 +606,7 @@ absl::Status RunValidate(const Inputs& inputs, const RunContext& ctx) {
     for (size_t i = 0; i < project->drawings.size(); ++i) {
       const ProjectDrawing& d = project->drawings[i];
       const std::string where = absl::StrCat("drawing ", i + 1, " (", d.file.string(), ")");
-      auto svg = ReadFile(d.file);
+      auto svg = ReadSvg(d.file);
       if (!svg.ok()) {
         problems.push_back(absl::StrCat(where, ": ", svg.status().message()));
         continue;

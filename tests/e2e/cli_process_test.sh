@@ -61,6 +61,17 @@ set +e
 set -e
 [[ $code -eq 5 ]] || { echo "UNIMPLEMENTED: exit $code, want 5"; cat unimplemented.out; exit 1; }
 
+# 3: a drawing that is not UTF-8 text is bad input, named with the drawing, byte and line (the
+# request carries SVG text as a protobuf string, which must be UTF-8).
+printf '<svg xmlns="http://www.w3.org/2000/svg">\n<path id="\xff" d="M0 0 L1 0 L1 1 Z"/></svg>\n' \
+  >latin1.svg
+set +e
+"$CLI_BIN" -q mesh latin1.svg "$ex/hexagon.svg" --out latin1_out >latin1.out 2>&1; code=$?
+set -e
+[[ $code -eq 3 ]] || { echo "non-UTF-8 drawing: exit $code, want 3"; cat latin1.out; exit 1; }
+grep -q "drawing 1 (latin1.svg): not UTF-8 text: byte 51 (line 2)" latin1.out ||
+  { echo "non-UTF-8 drawing: unexpected message"; cat latin1.out; exit 1; }
+
 # 130: SIGINT during a long animate (100000 frames) ends it promptly; no output is left behind.
 "$CLI_BIN" -q animate "$ex/square.svg" "$ex/hexagon.svg" --frames 100000 --format json \
   --out interrupted >interrupted.out 2>&1 &
