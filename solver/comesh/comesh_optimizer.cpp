@@ -785,20 +785,24 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       }
     }
     stats->phases.direction += clock.Lap();
+    // disp: d as per-vertex displacements; CureDirection leaves those of the uncured d there.
+    bool disp_is_d = false;
     if (options.cure) {
       VectorXd cured = d;
+      disp_is_d = true;
       if (CureDirection(mesh->triangles, shapes, layout, options.cure_keep, objective->threads(),
                         &disp, &cured) > 0) {
         const double cured_slope = g.dot(cured);
         if (cured_slope < 0.0) {
           d = std::move(cured);
           slope = cured_slope;
+          disp_is_d = false;
         }
       }
     }
 
     // Inversion-free backtracking line search.
-    layout.Displacements(d, &disp);
+    if (!disp_is_d) layout.Displacements(d, &disp);
     const double max_step =
         MaxNonInvertingStep(mesh->triangles, shapes, disp, objective->threads());
     double step = std::min(1.0, options.max_step_fraction * max_step);

@@ -102,6 +102,7 @@ void SparseCholesky::Impl::Extract() {
     l_nz = static_cast<const int*>(factor->nz);
     l_i = static_cast<const int*>(factor->i);
     super = s_pi = s_px = s_i = nullptr;
+    nsuper = max_below = 0;
   }
 }
 
@@ -191,8 +192,8 @@ void SparseCholesky::Impl::Substitute(double* y, int columns) const {
 
 namespace {
 
-// Supernodal factorizations and solves call the system BLAS (Debian's alternative for
-// libblas.so.3). Two properties matter, and both are settled once per process:
+// Supernodal factorizations call the system BLAS (Debian's alternative for libblas.so.3; the
+// solves are our own substitutions). Two properties matter, and both are settled once per process:
 // - Threads: OpenBLAS's pthread build (what scripts/setup installs) would split each call over
 //   every core, on top of our own threads, and its sums would then depend on the thread count.
 //   It is set to one thread (openblas_set_num_threads, looked up at run time because the binary
@@ -219,11 +220,11 @@ const BlasSetup& Blas() {
   return setup;
 }
 
-// Held around a BLAS-using call when the BLAS is not reentrant (see above).
+// Held around a call that uses BLAS (`uses_blas`) when the BLAS is not reentrant (see above).
 class BlasLock {
  public:
-  BlasLock() : lock_(Mutex(), std::defer_lock) {
-    if (Blas().serialize) lock_.lock();
+  explicit BlasLock(bool uses_blas) : lock_(Mutex(), std::defer_lock) {
+    if (uses_blas && Blas().serialize) lock_.lock();
   }
 
  private:
@@ -318,10 +319,8 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
   m.factorized = false;
   cholmod_sparse view = View(a);
   int ok = 0;
-  if (m.factor->is_super) {
-    const BlasLock blas;
-    ok = cholmod_factorize(&view, m.factor, &m.common);
-  } else {
+  {
+    const BlasLock blas(/*uses_blas=*/m.factor->is_super != 0);
     ok = cholmod_factorize(&view, m.factor, &m.common);
   }
   if (!ok || m.common.status < CHOLMOD_OK) {
