@@ -16,6 +16,7 @@
 #include "client/inbetween_client.h"
 #include "server/inbetween_server.h"
 #include "server/stop_signals.h"
+#include "solver/core/retain_memory.h"
 
 namespace {
 
@@ -102,6 +103,8 @@ void ApplyInbetweenFlags(const CLI::App& cmd, const InbetweenFlags& f,
 }  // namespace
 
 int main(int argc, char** argv) {
+  // One job per process: freed memory stays for reuse (solver/core/retain_memory.h).
+  inbetween::solver::RetainFreedMemory();
   // SIGINT / SIGTERM reach the signal thread through a handler and a pipe, whichever thread the
   // kernel picks (libraries start threads before main).
   if (!inbetween::server::InstallStopSignals()) {
