@@ -16,6 +16,7 @@
 #include "server/inbetween_server.h"
 #include "server/logging.h"
 #include "server/stop_signals.h"
+#include "solver/core/retain_memory.h"
 
 namespace {
 
@@ -103,11 +104,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--log-format", log_format, "text|json")->capture_default_str();
   app.add_flag("--no-reflection", no_reflection, "disable gRPC server reflection");
+  bool retain_freed_memory = false;
+  app.add_flag("--retain-freed-memory", retain_freed_memory,
+               "keep freed memory for reuse (faster comesh optimization and inbetweening; the "
+               "resident size stays near its peak): solver/core/retain_memory.h");
   app.add_option("--shutdown-grace-ms", grace_ms,
                  "on SIGTERM/SIGINT, how long running streams may finish before they are cancelled")
       ->capture_default_str()
       ->check(CLI::Range(int64_t{0}, int64_t{3'600'000}));
   CLI11_PARSE(app, argc, argv);
+  if (retain_freed_memory) inbetween::solver::RetainFreedMemory();
 
   if (absl::Status s = inbetween::server::ConfigureLogging(log_level, log_format); !s.ok()) {
     std::cerr << "inbetween-server: " << s.message() << "\n";

@@ -544,6 +544,27 @@ using Traversal =
                            sv::basic_shapes_policy<sv::policy::basic_shapes::all_to_path>,
                            sv::error_policy<ErrorPolicy>>;
 
+// libxml2 reports some errors without the parser's context (an input encoding conversion that
+// fails, the I/O layer's "encoder error"), to the thread's generic error handler, which prints
+// them on stderr whatever XML_PARSE_NOERROR says: in the server, user input would write to the
+// log. While one is alive, this thread's handler (libxml2 keeps one per thread) ignores them;
+// the failure still comes back through the parser (xmlCtxtGetLastError). Restores the previous
+// handler.
+void IgnoreXmlError(void* /*context*/, const char* /*format*/, ...) {}
+class QuietXmlErrors {
+ public:
+  QuietXmlErrors() : handler_(xmlGenericError), context_(xmlGenericErrorContext) {
+    xmlSetGenericErrorFunc(nullptr, IgnoreXmlError);
+  }
+  ~QuietXmlErrors() { xmlSetGenericErrorFunc(context_, handler_); }
+  QuietXmlErrors(const QuietXmlErrors&) = delete;
+  QuietXmlErrors& operator=(const QuietXmlErrors&) = delete;
+
+ private:
+  xmlGenericErrorFunc handler_;
+  void* context_;
+};
+
 struct DocDeleter {
   void operator()(xmlDoc* doc) const { xmlFreeDoc(doc); }
 };
@@ -735,6 +756,7 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   if (options.max_points < 1) {
     return absl::InvalidArgumentError("SVG import: max_points must be positive");
   }
+  const QuietXmlErrors quiet;
   std::unique_ptr<xmlParserCtxt, ParserDeleter> ctxt(xmlNewParserCtxt());
   if (ctxt == nullptr) return absl::ResourceExhaustedError("SVG import: out of memory");
   // No network, no entity substitution, no DTD loading or validation; keep errors quiet.

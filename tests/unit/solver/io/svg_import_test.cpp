@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <string>
 
+#include <libxml/parser.h>
+
 #include "solver/geometry/polygon.h"
 #include "tests/unit/solver/io/read_example.h"
 
@@ -164,6 +166,28 @@ TEST(SvgImportTest, MalformedXmlNamesTheLine) {
   ASSERT_FALSE(d.ok());
   EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(d.status().message(), HasSubstr("line 3"));
+}
+
+// libxml2 prints a failed input encoding conversion on stderr through its generic handler, past
+// XML_PARSE_NOERROR; in the server that was user input writing to the log (found by fuzzing).
+TEST(SvgImportTest, UndecodableBytesAreAnErrorAndNothingIsPrinted) {
+  const std::string svg =
+      "<?xml version=\"1.0\" encoding=\"ISO-2022-JP\"?>\n<svg>\x1b$B\xff\xff</svg>";
+  ::testing::internal::CaptureStderr();
+  absl::StatusOr<Drawing> d = ImportSvg(svg);
+  const std::string printed = ::testing::internal::GetCapturedStderr();
+  ASSERT_FALSE(d.ok());
+  EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(d.status().message(), HasSubstr("not well-formed XML"));
+  EXPECT_EQ(printed, "");
+  // The thread's own handler is back afterwards: libxml2 prints again outside ImportSvg.
+  ::testing::internal::CaptureStderr();
+  xmlParserCtxt* ctxt = xmlNewParserCtxt();
+  xmlDoc* doc = xmlCtxtReadMemory(ctxt, svg.data(), static_cast<int>(svg.size()), "t.svg", nullptr,
+                                  XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING);
+  if (doc != nullptr) xmlFreeDoc(doc);
+  xmlFreeParserCtxt(ctxt);
+  EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("encoding error"));
 }
 
 TEST(SvgImportTest, BadPathDataNamesTheElement) {
