@@ -106,8 +106,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-reflection", no_reflection, "disable gRPC server reflection");
   bool retain_freed_memory = false;
   app.add_flag("--retain-freed-memory", retain_freed_memory,
-               "keep freed memory for reuse (faster comesh optimization and inbetweening; the "
-               "resident size stays near its peak): solver/core/retain_memory.h");
+               "keep freed memory for reuse (faster comesh optimization; the resident size "
+               "stays near its peak): solver/core/retain_memory.h");
   app.add_option("--shutdown-grace-ms", grace_ms,
                  "on SIGTERM/SIGINT, how long running streams may finish before they are cancelled")
       ->capture_default_str()

@@ -3,12 +3,11 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <libxml/parser.h>
 
 #include <cmath>
 #include <filesystem>
 #include <string>
-
-#include <libxml/parser.h>
 
 #include "solver/geometry/polygon.h"
 #include "tests/unit/solver/io/read_example.h"
