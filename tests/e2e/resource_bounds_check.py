@@ -379,7 +379,12 @@ class Driver:
         calls, channels = [], []
 
         def own_stub():  # a connection per call, as separate clients would have
-            channels.append(grpc.insecure_channel(a.server, options=self.options))
+            # Without BDP probing the connection's flow-control window stays at its initial size,
+            # so a stream the client does not read blocks the server's writes: with the small
+            # meshes of a sanitizer run, a grown window took all max-frames frames, the handler
+            # finished and freed its slot, and the sixth call was admitted.
+            channels.append(grpc.insecure_channel(
+                a.server, options=list(self.options) + [("grpc.http2.bdp_probe", 0)]))
             return pb_grpc.InbetweenStub(channels[-1])
 
         try:
