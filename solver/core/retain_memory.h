@@ -1,11 +1,11 @@
 // Keeping freed memory in the process (glibc malloc), for programs that run the solver.
 //
 // The comesh optimizer frees and reallocates the same large blocks over and over: vectors of all
-// unknowns every iteration, a CHOLMOD factor every inner run. glibc's
-// defaults hand such blocks back to the kernel as soon as they are freed (blocks above a
-// threshold that starts at 128 KiB are mmap'd and unmapped; the heap top is trimmed above
-// 128 KiB), so every reuse is a fresh run of page faults, and on virtual machines each unmap or
-// trim also costs a TLB shootdown across cores. Measured on the S-Table 2 rows of
+// unknowns every iteration, a CHOLMOD factor every inner run. glibc's defaults hand such blocks
+// back to the kernel as soon as they are freed (blocks above a threshold that starts at 128 KiB
+// are mmap'd and unmapped; the heap top is trimmed above 128 KiB), so every reuse is a fresh run
+// of page faults, and on virtual machines each unmap or trim also costs a TLB shootdown across
+// cores. Measured on the S-Table 2 rows of
 // `comesh-scaling` (2-core VM, docs/benchmarks.md): the rows from 278 to 35k vertices took 1.2 to
 // 1.8 times as long with the defaults.
 //
