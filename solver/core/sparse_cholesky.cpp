@@ -9,12 +9,20 @@
 #include <dlfcn.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+
+// LAPACK's Cholesky factorization of a dense block, as CHOLMOD calls it (32-bit BLAS integers; the
+// trailing length of the character argument that gfortran-built LAPACKs take is passed through).
+// The kCancelPoint below explains why this file defines it.
+extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info,
+                        size_t uplo_length);
 
 namespace inbetween::solver {
 
@@ -47,6 +55,9 @@ struct SparseCholesky::Impl {
   mutable std::vector<double> supernode_work;  // SubstituteSupernodal's scratch
 
   void Extract();
+  // The simplicial numeric factorization in row blocks of kCancelRows, polling `cancel` between
+  // blocks: 1 on success (check common.status), 0 on a CHOLMOD error, -1 if cancelled.
+  int FactorizeSimplicialInBlocks(cholmod_sparse* a, const CancelToken& cancel);
   template <int kColumns>
   void Substitute(double* y, int columns) const;
   template <int kColumns>
@@ -220,6 +231,31 @@ const BlasSetup& Blas() {
   return setup;
 }
 
+// kCancelPoint: a supernodal factorization (CHOLMOD's cholmod_super_numeric) has no callback, but
+// it calls LAPACK's dpotrf_ once per supernode, on the supernode's dense diagonal block, and stops
+// as soon as one reports that block not positive definite at its first column (info == 1: the
+// rest of the factor is zeroed and the status becomes CHOLMOD_NOT_POSDEF). This file defines
+// dpotrf_, which the dynamic linker binds CHOLMOD's calls to (a definition in the executable comes
+// before the LAPACK library's), and forwards every call to the next definition (LAPACK's) unless
+// the calling thread is inside a cancellable Factorize whose token is set: then it answers
+// info = 1 and records that the stop was a cancellation, not a failed pivot. So a cancelled
+// supernodal factorization ends within one supernode's work (at most a few ms on meshes of 35k
+// vertices); any other caller of dpotrf_ gets LAPACK's result untouched.
+thread_local const CancelToken* tls_factor_cancel = nullptr;
+thread_local bool tls_factor_cancelled = false;
+
+// Sets the calling thread's cancellation token for the scope of one supernodal factorization.
+class CancelPointScope {
+ public:
+  explicit CancelPointScope(const CancelToken* cancel) {
+    tls_factor_cancel = cancel;
+    tls_factor_cancelled = false;
+  }
+  ~CancelPointScope() { tls_factor_cancel = nullptr; }
+  CancelPointScope(const CancelPointScope&) = delete;
+  CancelPointScope& operator=(const CancelPointScope&) = delete;
+};
+
 // Held around a call that uses BLAS (`uses_blas`) when the BLAS is not reentrant (see above).
 class BlasLock {
  public:
@@ -302,7 +338,8 @@ absl::Status SparseCholesky::Analyze(const Eigen::SparseMatrix<double>& a) {
   return absl::OkStatus();
 }
 
-absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
+absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a,
+                                       const CancelToken* cancel) {
   if (absl::Status s = CheckShape(a); !s.ok()) return s;
   Impl& m = *impl_;
   if (m.factor == nullptr) {
@@ -317,11 +354,24 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
         "SparseCholesky: Factorize needs the pattern that was analyzed");
   }
   m.factorized = false;
+  auto cancelled = [] {
+    return absl::CancelledError("SparseCholesky: numeric factorization cancelled");
+  };
+  // (No early return for a token already set: the first poll, at the first row block or the
+  // first supernode, answers then; the tests rely on that to reach both polls.)
   cholmod_sparse view = View(a);
   int ok = 0;
-  {
+  if (cancel != nullptr && m.factor->is_super == 0) {
+    // What cholmod_factorize does for a simplicial factor of a symmetric-upper matrix (with
+    // final_asis, our setting: no conversion afterwards), with cholmod_rowfac called on blocks of
+    // rows instead of all rows at once: row k only reads rows < k, so the factor is the same.
+    ok = m.FactorizeSimplicialInBlocks(&view, *cancel);
+    if (ok < 0) return cancelled();
+  } else {
     const BlasLock blas(/*uses_blas=*/m.factor->is_super != 0);
+    const CancelPointScope scope(m.factor->is_super != 0 ? cancel : nullptr);
     ok = cholmod_factorize(&view, m.factor, &m.common);
+    if (tls_factor_cancelled) return cancelled();
   }
   if (!ok || m.common.status < CHOLMOD_OK) {
     return CholmodError(m.common, "numeric factorization");
@@ -347,6 +397,49 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a) {
   m.Extract();
   m.factorized = true;
   return absl::OkStatus();
+}
+
+int SparseCholesky::Impl::FactorizeSimplicialInBlocks(cholmod_sparse* a,
+                                                      const CancelToken& cancel) {
+  common.status = CHOLMOD_OK;
+  const int rows = static_cast<int>(factor->n);
+  // S = triu(P A P^T): two permuted transposes, as cholmod_factorize_p does for stype > 0.
+  cholmod_sparse* s = a;
+  if (factor->ordering != CHOLMOD_NATURAL) {
+    cholmod_sparse* lower = cholmod_ptranspose(a, 2, static_cast<int*>(factor->Perm), nullptr, 0,
+                                               &common);
+    if (lower == nullptr) return 0;
+    s = cholmod_ptranspose(lower, 2, nullptr, nullptr, 0, &common);
+    cholmod_free_sparse(&lower, &common);
+    if (s == nullptr) return 0;
+  }
+  factor->is_ll = common.final_ll ? 1 : 0;
+  if (factor->xtype != CHOLMOD_PATTERN) {
+    // A refactorization: cholmod_rowfac restarts the factor (every column back to its diagonal
+    // entry, no failed pivot yet) only when one call covers all rows, so do that here.
+    factor->minor = factor->n;
+    int* column_counts = static_cast<int*>(factor->nz);
+    std::fill(column_counts, column_counts + rows, 1);
+  }
+  const double grow2 = common.grow2;
+  if (factor->xtype == CHOLMOD_PATTERN && common.final_pack) common.grow2 = 0;
+  double beta[2] = {0.0, 0.0};
+  int result = 1;
+  for (int k = 0; k < rows; k += kCancelRows) {
+    if (cancel.IsCancelled()) {
+      result = -1;
+      break;
+    }
+    const int end = std::min(rows, k + kCancelRows);
+    if (!cholmod_rowfac(s, nullptr, beta, k, end, factor, &common) ||
+        common.status < CHOLMOD_OK) {
+      result = 0;
+      break;
+    }
+  }
+  common.grow2 = grow2;
+  if (s != a) cholmod_free_sparse(&s, &common);
+  return result;
 }
 
 absl::Status SparseCholesky::Compute(const Eigen::SparseMatrix<double>& a) {
@@ -420,3 +513,23 @@ bool SparseCholesky::supernodal() const {
 }
 
 }  // namespace inbetween::solver
+
+extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info,
+                        size_t uplo_length) {
+  using Dpotrf = void (*)(const char*, const int*, double*, const int*, int*, size_t);
+  static const Dpotrf lapack = [] {
+    auto* next = reinterpret_cast<Dpotrf>(dlsym(RTLD_NEXT, "dpotrf_"));
+    if (next == nullptr) {
+      std::fprintf(stderr, "inbetween: LAPACK's dpotrf_ not found (%s)\n", dlerror());
+      std::abort();
+    }
+    return next;
+  }();
+  const inbetween::solver::CancelToken* cancel = inbetween::solver::tls_factor_cancel;
+  if (cancel != nullptr && cancel->IsCancelled()) {
+    inbetween::solver::tls_factor_cancelled = true;
+    *info = 1;  // "not positive definite at the block's first column": CHOLMOD stops here
+    return;
+  }
+  lapack(uplo, n, a, lda, info, uplo_length);
+}

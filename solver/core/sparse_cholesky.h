@@ -24,6 +24,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "solver/core/cancel.h"
 
 namespace inbetween::solver {
 
@@ -42,7 +43,13 @@ class SparseCholesky {
   // Numeric factorization of `a`, which must have exactly the analyzed pattern (same compressed
   // structure). FailedPrecondition if `a` is not positive definite. Analyze and Factorize answer
   // RESOURCE_EXHAUSTED when CHOLMOD runs out of memory (it reports, never throws).
-  absl::Status Factorize(const Eigen::SparseMatrix<double>& a);
+  // With a `cancel` token the factorization polls it as it goes and answers CANCELLED soon after
+  // it is set (then the object is not factorized; Factorize again to use it): a simplicial factor
+  // is computed in row blocks of kCancelRows rows (CHOLMOD's incremental row factorization, the
+  // same operations in the same order, so the factor is bit-identical to an uncancellable one),
+  // a supernodal one stops at the next supernode (see kCancelPoint in the .cpp).
+  absl::Status Factorize(const Eigen::SparseMatrix<double>& a, const CancelToken* cancel = nullptr);
+  static constexpr int kCancelRows = 2048;
 
   // Analyze + Factorize.
   absl::Status Compute(const Eigen::SparseMatrix<double>& a);

@@ -183,6 +183,66 @@ TEST(SparseCholeskyTest, AutoGoesSupernodalOnLargeMatricesWithTheSameSolution) {
   EXPECT_FALSE(indefinite.factorized());
 }
 
+// With a cancellation token the simplicial factor is computed in row blocks (several here): the
+// same factor, bit for bit, on a first factorization and on a refactorization with new values.
+TEST(SparseCholeskyTest, CancellableSimplicialFactorizationIsBitIdentical) {
+  const Eigen::SparseMatrix<double> a = GridMatrix(100, 0.1);
+  const Eigen::SparseMatrix<double> a2 = GridMatrix(100, 0.3, 2.0);  // same pattern
+  ASSERT_GT(a.rows(), 3 * SparseCholesky::kCancelRows);
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Random(a.rows(), 1);
+  CancelToken token;
+  SparseCholesky plain, blocks;
+  ASSERT_TRUE(plain.Analyze(a).ok());
+  ASSERT_TRUE(blocks.Analyze(a).ok());
+  for (const auto* m : {&a, &a2}) {
+    ASSERT_TRUE(plain.Factorize(*m).ok());
+    const absl::Status st = blocks.Factorize(*m, &token);
+    ASSERT_TRUE(st.ok()) << st << (m == &a ? " first" : " refactor");
+    ASSERT_FALSE(blocks.supernodal());
+    Eigen::MatrixXd x = b, y = b;
+    ASSERT_TRUE(plain.SolveInPlace(&x).ok());
+    ASSERT_TRUE(blocks.SolveInPlace(&y).ok());
+    EXPECT_EQ(x, y);
+    EXPECT_LT((*m * y - b).cwiseAbs().maxCoeff(), 1e-9);
+  }
+}
+
+// A set token stops a factorization at its first poll, simplicial (between row blocks) and
+// supernodal (at a supernode: LAPACK's dpotrf_ as CHOLMOD calls it is ours, see the .cpp): the
+// answer is CANCELLED, not "not positive definite", the object is not factorized, and a
+// factorization without the token afterwards is correct. Other objects are unaffected.
+TEST(SparseCholeskyTest, CancelledFactorizationAnswersCancelledAndCanBeRedone) {
+  const Eigen::SparseMatrix<double> small = GridMatrix(60, 0.1);
+  const Eigen::SparseMatrix<double> large = GridMatrix(100, 1e-3, 1.0, 3);
+  CancelToken cancelled;
+  cancelled.Cancel();
+  for (const auto* m : {&small, &large}) {
+    SparseCholesky chol(SparseCholesky::Method::kAuto);
+    ASSERT_TRUE(chol.Analyze(*m).ok());
+    EXPECT_EQ(chol.supernodal(), m == &large);
+    const absl::Status status = chol.Factorize(*m, &cancelled);
+    EXPECT_EQ(status.code(), absl::StatusCode::kCancelled) << status;
+    EXPECT_FALSE(chol.factorized());
+    EXPECT_EQ(chol.Solve(Eigen::MatrixXd::Ones(m->rows(), 1)).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    // The same object, and another one, factor correctly without the token.
+    SparseCholesky other(SparseCholesky::Method::kAuto);
+    for (SparseCholesky* c : {&chol, &other}) {
+      ASSERT_TRUE(c == &chol ? c->Factorize(*m).ok() : c->Compute(*m).ok());
+      const Eigen::MatrixXd b = Eigen::MatrixXd::Ones(m->rows(), 1);
+      absl::StatusOr<Eigen::MatrixXd> x = c->Solve(b);
+      ASSERT_TRUE(x.ok());
+      EXPECT_LT((*m * *x - b).cwiseAbs().maxCoeff(), 1e-8);
+    }
+  }
+  // An indefinite matrix without a cancelled token is still "not positive definite".
+  SparseCholesky indefinite(SparseCholesky::Method::kAuto);
+  ASSERT_TRUE(indefinite.Analyze(GridMatrix(100, -0.5, 1.0, 3)).ok());
+  CancelToken live;
+  EXPECT_EQ(indefinite.Factorize(GridMatrix(100, -0.5, 1.0, 3), &live).code(),
+            absl::StatusCode::kFailedPrecondition);
+}
+
 // Supernodal factorizations on several threads at once (the comesh preconditioner factors its
 // shapes in parallel) are all correct, whatever BLAS the system provides.
 TEST(SparseCholeskyTest, ConcurrentSupernodalFactorizationsAreCorrect) {
