@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -259,7 +260,7 @@ class InitialHessian {
  public:
   static absl::StatusOr<InitialHessian> Create(const std::vector<Triangle>& triangles,
                                                const Layout& layout, std::vector<double> areas,
-                                               bool use_laplacian) {
+                                               bool use_laplacian, const CancelToken* cancel) {
     InitialHessian h;
     h.areas_ = std::move(areas);
     h.use_laplacian_ = use_laplacian;
@@ -297,7 +298,10 @@ class InitialHessian {
     for (int k = 0; k < h.size_; ++k) h.matrix_.coeffRef(k, k) *= 1.0 + 1e-8;
     h.matrix_.makeCompressed();
     h.solver_ = std::make_unique<SparseCholesky>();
-    if (absl::Status st = h.solver_->Compute(h.matrix_); !st.ok()) {
+    absl::Status st = h.solver_->Analyze(h.matrix_);
+    if (st.ok()) st = h.solver_->Factorize(h.matrix_, cancel);
+    if (absl::IsCancelled(st)) return st;
+    if (!st.ok()) {
       return absl::InternalError(
           absl::StrCat("factorizing the comesh Laplacian preconditioner: ", st.message()));
     }
@@ -410,22 +414,39 @@ class HessianPreconditioner {
   static absl::StatusOr<HessianPreconditioner> Create(const std::vector<Triangle>& triangles,
                                                       const Layout& layout,
                                                       const ComeshObjective& objective,
-                                                      const std::vector<Points>& shapes) {
+                                                      const std::vector<Points>& shapes,
+                                                      const CancelToken* cancel) {
     HessianPreconditioner h;
     h.triangles_ = &triangles;
     h.layout_ = &layout;
     h.objective_ = &objective;
     const int n = layout.num_vertices();
     const int num_shapes = layout.num_shapes();
-    std::vector<std::vector<int>> nbrs(n);
+    // Each vertex's neighbours and itself, ascending: nbrs(v) (compressed rows, one allocation).
+    std::vector<int> start(n + 1, 0), list(9 * triangles.size());
     for (const Triangle& t : triangles) {
-      for (int a = 0; a < 3; ++a) {
-        for (int b = 0; b < 3; ++b) nbrs[t[a]].push_back(t[b]);
+      for (int a = 0; a < 3; ++a) start[t[a] + 1] += 3;
+    }
+    for (int v = 0; v < n; ++v) start[v + 1] += start[v];
+    {
+      std::vector<int> fill(start.begin(), start.end() - 1);
+      for (const Triangle& t : triangles) {
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) list[fill[t[a]]++] = t[b];
+        }
       }
     }
-    for (auto& list : nbrs) {
-      std::sort(list.begin(), list.end());
-      list.erase(std::unique(list.begin(), list.end()), list.end());
+    std::vector<int> count(n);
+    for (int v = 0; v < n; ++v) {
+      auto begin = list.begin() + start[v], end = list.begin() + start[v + 1];
+      std::sort(begin, end);
+      count[v] = static_cast<int>(std::unique(begin, end) - begin);
+    }
+    auto nbrs = [&](int v) {
+      return std::span<const int>(list.data() + start[v], static_cast<size_t>(count[v]));
+    };
+    if (cancel != nullptr && cancel->IsCancelled()) {
+      return absl::CancelledError("comesh Hessian set-up cancelled");
     }
     // Shape s's unknowns are z[begin_[s], begin_[s + 1]) (Layout numbers them shape by shape).
     h.begin_.assign(num_shapes + 1, layout.size());
@@ -442,7 +463,7 @@ class HessianPreconditioner {
       const int s = var.shape;
       for (int c = 0; c < (var.slider ? 1 : 2); ++c) {
         outer[s][var.offset + c - h.begin_[s]] = static_cast<int>(inner[s].size());
-        for (int w : nbrs[var.vertex]) {
+        for (int w : nbrs(var.vertex)) {
           const int i = layout.index(s, w);
           if (i < 0) continue;
           const Layout::Var& other = layout.vars()[i];
@@ -451,6 +472,21 @@ class HessianPreconditioner {
         }
       }
     }
+    // The vertex graph of each shape (one node per free or sliding vertex, in unknown order), for
+    // the fill-reducing ordering: AMD on it, each node expanded to its 1 or 2 unknowns, costs a
+    // quarter of AMD on the unknowns' graph and orders a vertex's two unknowns together anyway.
+    std::vector<int> node(layout.vars().size(), -1);
+    for (size_t i = 0; i < layout.vars().size(); ++i) {
+      Block& block = h.blocks_[layout.vars()[i].shape];
+      node[i] = static_cast<int>(block.node_unknowns.size());
+      block.node_unknowns.push_back(layout.vars()[i].offset - h.begin_[layout.vars()[i].shape]);
+      block.node_outer.push_back(static_cast<int>(block.node_inner.size()));
+      for (int w : nbrs(layout.vars()[i].vertex)) {
+        const int j = layout.index(layout.vars()[i].shape, w);
+        if (j >= 0 && node[j] >= 0) block.node_inner.push_back(node[j]);  // rows <= column
+      }
+    }
+    for (Block& block : h.blocks_) block.node_outer.push_back(static_cast<int>(block.node_inner.size()));
     for (int s = 0; s < num_shapes; ++s) {
       Block& block = h.blocks_[s];
       const int size = h.begin_[s + 1] - h.begin_[s];
@@ -462,11 +498,13 @@ class HessianPreconditioner {
       block.solver = std::make_unique<SparseCholesky>(SparseCholesky::Method::kAuto);
     }
     h.threads_ = layout.size() >= kParallelUnknowns ? objective.threads() : 1;
-    if (absl::Status st = h.Refactor(shapes, /*analyze=*/true); !st.ok()) return st;
+    if (absl::Status st = h.Refactor(shapes, /*analyze=*/true, cancel); !st.ok()) return st;
     return h;
   }
 
-  absl::Status Update(const std::vector<Points>& shapes) { return Refactor(shapes, false); }
+  absl::Status Update(const std::vector<Points>& shapes, const CancelToken* cancel) {
+    return Refactor(shapes, false, cancel);
+  }
 
   VectorXd ApplyInverse(const VectorXd& g) const {
     VectorXd x = g;
@@ -495,6 +533,8 @@ class HessianPreconditioner {
   static constexpr int kParallelUnknowns = 4000;
 
   struct Block {
+    // The vertex graph (see Create): node k's first unknown, and its upper-triangle pattern.
+    std::vector<int> node_unknowns, node_outer, node_inner;
     Eigen::SparseMatrix<double> matrix;
     std::unique_ptr<SparseCholesky> solver;  // by pointer: keeps the class movable
     absl::Status status;
@@ -507,14 +547,33 @@ class HessianPreconditioner {
         /*min_parallel=*/2);
   }
 
-  absl::Status Refactor(const std::vector<Points>& shapes, bool analyze) {
+  // Polls `cancel` before each step and inside the factorizations (SparseCholesky::Factorize), so a
+  // cancelled set-up ends within one step: assembly or analysis of one shape (tens of ms at 35k
+  // vertices) or one supernode.
+  absl::Status Refactor(const std::vector<Points>& shapes, bool analyze,
+                        const CancelToken* cancel) {
+    auto cancelled = [&] { return cancel != nullptr && cancel->IsCancelled(); };
     ForEachShape([&](int s) {
       Block& block = blocks_[s];
-      AssembleShape(s, shapes);
+      block.status = absl::OkStatus();
+      if (cancelled()) {
+        block.status = absl::CancelledError("comesh Hessian set-up cancelled");
+        return;
+      }
+      if (!AssembleShape(s, shapes, cancel)) {
+        block.status = absl::CancelledError("comesh Hessian set-up cancelled");
+        return;
+      }
       if (block.matrix.rows() == 0) return;
-      block.status = analyze ? block.solver->Analyze(block.matrix) : absl::OkStatus();
-      if (block.status.ok()) block.status = block.solver->Factorize(block.matrix);
+      if (analyze) block.status = Analyze(&block, cancel);
+      if (block.status.ok() && cancelled()) {
+        block.status = absl::CancelledError("comesh Hessian set-up cancelled");
+      }
+      if (block.status.ok()) block.status = block.solver->Factorize(block.matrix, cancel);
     });
+    for (size_t s = 0; s < blocks_.size(); ++s) {
+      if (absl::IsCancelled(blocks_[s].status)) return blocks_[s].status;
+    }
     for (size_t s = 0; s < blocks_.size(); ++s) {
       if (!blocks_[s].status.ok()) {
         return absl::Status(
@@ -523,6 +582,27 @@ class HessianPreconditioner {
       }
     }
     return absl::OkStatus();
+  }
+
+  // Symbolic analysis with the vertex graph's AMD ordering expanded to the unknowns.
+  static absl::Status Analyze(Block* block, const CancelToken* cancel) {
+    const absl::Status cancelled = absl::CancelledError("comesh Hessian set-up cancelled");
+    if (cancel != nullptr && cancel->IsCancelled()) return cancelled;
+    absl::StatusOr<std::vector<int>> nodes =
+        SparseCholesky::AmdOrdering(block->node_outer, block->node_inner);
+    if (!nodes.ok()) return nodes.status();
+    if (cancel != nullptr && cancel->IsCancelled()) return cancelled;
+    const int size = static_cast<int>(block->matrix.rows());
+    std::vector<int> ordering;
+    ordering.reserve(size);
+    for (int k : *nodes) {
+      const int first = block->node_unknowns[k];
+      const int end = k + 1 < static_cast<int>(block->node_unknowns.size())
+                          ? block->node_unknowns[k + 1]
+                          : size;
+      for (int u = first; u < end; ++u) ordering.push_back(u);
+    }
+    return block->solver->Analyze(block->matrix, &ordering);
   }
 
   // Adds `value` at (row, col) of a block (binary search in the column).
@@ -542,7 +622,8 @@ class HessianPreconditioner {
     v[1] += b;
   }
 
-  void AssembleShape(int s, const std::vector<Points>& shapes) {
+  // Returns false (block partly assembled) if `cancel` was set: polled every 4096 triangles.
+  bool AssembleShape(int s, const std::vector<Points>& shapes, const CancelToken* cancel) {
     const Layout& layout = *layout_;
     const ComeshObjective& obj = *objective_;
     Eigen::SparseMatrix<double>* m = &blocks_[s].matrix;
@@ -551,7 +632,9 @@ class HessianPreconditioner {
     const double w = obj.map_weight();
     const int next = (s + 1) % num_shapes, prev = (s + num_shapes - 1) % num_shapes;
     const int base = begin_[s];
+    int count = 0;
     for (const Triangle& t : *triangles_) {
+      if ((++count & 4095) == 0 && cancel != nullptr && cancel->IsCancelled()) return false;
       int vars[3];
       bool any = false;
       for (int k = 0; k < 3; ++k) {
@@ -598,6 +681,7 @@ class HessianPreconditioner {
     double top = 0.0;
     for (int c = 0; c < m->cols(); ++c) top = std::max(top, m->coeff(c, c));
     for (int c = 0; c < m->cols(); ++c) Add(m, c, c, kDiagonalShift * top);
+    return true;
   }
 
   const std::vector<Triangle>* triangles_ = nullptr;
@@ -703,19 +787,25 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     stats->stop_reason = "no_free";
     return absl::OkStatus();
   }
+  auto cancelled_at = [&](int iter) {
+    return absl::CancelledError(
+        absl::StrCat("comesh optimization cancelled at iteration ", iteration_base + iter));
+  };
   // H0: the shape-block Hessian (Newton-type) or the Laplacian model (BCQN).
   std::optional<HessianPreconditioner> hessian;
   std::optional<InitialHessian> laplacian;
   if (options.hessian_preconditioner && mesh->num_shapes() <= options.hessian_max_shapes) {
     absl::StatusOr<HessianPreconditioner> h =
-        HessianPreconditioner::Create(mesh->triangles, layout, *objective, shapes);
+        HessianPreconditioner::Create(mesh->triangles, layout, *objective, shapes, cancel);
+    if (absl::IsCancelled(h.status())) return cancelled_at(0);
     if (!h.ok()) return h.status();
     hessian.emplace(*std::move(h));
   } else {
     std::vector<double> areas;
     for (int s = 0; s < mesh->num_shapes(); ++s) areas.push_back(objective->rest_area(s));
     absl::StatusOr<InitialHessian> h = InitialHessian::Create(
-        mesh->triangles, layout, std::move(areas), options.laplacian_preconditioner);
+        mesh->triangles, layout, std::move(areas), options.laplacian_preconditioner, cancel);
+    if (absl::IsCancelled(h.status())) return cancelled_at(0);
     if (!h.ok()) return h.status();
     laplacian.emplace(*std::move(h));
   }
@@ -741,10 +831,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   ComeshEnergies trial_energies;
 
   for (int iter = 0;; ++iter) {
-    if (cancel != nullptr && cancel->IsCancelled()) {
-      return absl::CancelledError(
-          absl::StrCat("comesh optimization cancelled at iteration ", iteration_base + iter));
-    }
+    if (cancel != nullptr && cancel->IsCancelled()) return cancelled_at(iter);
     if (g.norm() <= options.gradient_tolerance * g0) {
       stats->stop_reason = "gradient";
       return absl::OkStatus();
@@ -755,7 +842,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     }
 
     if (hessian && options.hessian_refresh > 0 && iter > 0 && iter % options.hessian_refresh == 0) {
-      if (absl::Status st = hessian->Update(shapes); !st.ok()) return st;
+      if (absl::Status st = hessian->Update(shapes, cancel); !st.ok()) {
+        return absl::IsCancelled(st) ? cancelled_at(iter) : st;
+      }
       stats->phases.hessian += clock.Lap();
     }
     // L-BFGS two-loop recursion with H0 = B0^{-1} / beta.
@@ -968,8 +1057,11 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     TopologyReport topo;
     Stopwatch topology_clock;
     absl::StatusOr<Multimesh> improved =
-        ImproveTopology(current, options.map_weight, options.topology, &topo);
+        ImproveTopology(current, options.map_weight, options.topology, &topo, cancel);
     stats.phases.topology += topology_clock.Lap();
+    if (absl::IsCancelled(improved.status())) {
+      return absl::CancelledError(absl::StrCat("comesh optimization cancelled at outer ", outer));
+    }
     if (!improved.ok()) return improved.status();
     if (topo.flips + topo.collapses + topo.splits == 0) break;
     rep.flips += topo.flips;

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "solver/core/cancel.h"
 #include "solver/mesh/multimesh.h"
 
 namespace inbetween::solver {
@@ -56,9 +57,11 @@ std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Tria
                                                           const std::vector<char>& alive);
 
 // One topology pass. `mesh` must be valid (positive triangles in every shape). The returned
-// multimesh is valid too and has objective_after <= objective_before.
+// multimesh is valid too and has objective_after <= objective_before. CANCELLED (and no mesh) if
+// `cancel` is set during the pass (polled before every candidate operation).
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
                                           const TopologyOptions& options,
-                                          TopologyReport* report = nullptr);
+                                          TopologyReport* report = nullptr,
+                                          const CancelToken* cancel = nullptr);
 
 }  // namespace inbetween::solver

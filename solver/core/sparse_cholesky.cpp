@@ -322,8 +322,22 @@ SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 SparseCholesky::~SparseCholesky() = default;
 
-absl::Status SparseCholesky::Analyze(const Eigen::SparseMatrix<double>& a) {
+absl::Status SparseCholesky::Analyze(const Eigen::SparseMatrix<double>& a,
+                                     const std::vector<int>* ordering) {
   if (absl::Status s = CheckShape(a); !s.ok()) return s;
+  if (ordering != nullptr) {
+    std::vector<char> seen(a.rows(), 0);
+    bool valid = static_cast<Eigen::Index>(ordering->size()) == a.rows();
+    for (size_t k = 0; valid && k < ordering->size(); ++k) {
+      const int row = (*ordering)[k];
+      valid = row >= 0 && row < a.rows() && !seen[row];
+      if (valid) seen[row] = 1;
+    }
+    if (!valid) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("SparseCholesky: the ordering is not a permutation of 0..", a.rows() - 1));
+    }
+  }
   Impl& m = *impl_;
   if (m.factor != nullptr) cholmod_free_factor(&m.factor, &m.common);
   m.factorized = false;
@@ -331,7 +345,14 @@ absl::Status SparseCholesky::Analyze(const Eigen::SparseMatrix<double>& a) {
   m.outer.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1);
   m.inner.assign(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros());
   cholmod_sparse view = View(a);
-  m.factor = cholmod_analyze(&view, &m.common);
+  if (ordering != nullptr) {
+    const int amd = m.common.method[0].ordering;
+    m.common.method[0].ordering = CHOLMOD_GIVEN;
+    m.factor = cholmod_analyze_p(&view, const_cast<int*>(ordering->data()), nullptr, 0, &m.common);
+    m.common.method[0].ordering = amd;
+  } else {
+    m.factor = cholmod_analyze(&view, &m.common);
+  }
   if (m.factor == nullptr || m.common.status < CHOLMOD_OK) {
     return CholmodError(m.common, "symbolic analysis");
   }
@@ -440,6 +461,41 @@ int SparseCholesky::Impl::FactorizeSimplicialInBlocks(cholmod_sparse* a,
   common.grow2 = grow2;
   if (s != a) cholmod_free_sparse(&s, &common);
   return result;
+}
+
+absl::StatusOr<std::vector<int>> SparseCholesky::AmdOrdering(const std::vector<int>& outer,
+                                                             const std::vector<int>& inner) {
+  if (outer.empty() || outer.front() != 0 || outer.back() != static_cast<int>(inner.size()) ||
+      !std::is_sorted(outer.begin(), outer.end())) {
+    return absl::InvalidArgumentError("SparseCholesky::AmdOrdering: bad column starts");
+  }
+  const int n = static_cast<int>(outer.size()) - 1;
+  for (int row : inner) {
+    if (row < 0 || row >= n) {
+      return absl::InvalidArgumentError("SparseCholesky::AmdOrdering: row index out of range");
+    }
+  }
+  std::vector<int> ordering(n);
+  if (n == 0) return ordering;
+  cholmod_common common;
+  cholmod_start(&common);
+  common.print = 0;
+  cholmod_sparse pattern{};
+  pattern.nrow = pattern.ncol = static_cast<size_t>(n);
+  pattern.nzmax = inner.size();
+  pattern.p = const_cast<int*>(outer.data());
+  pattern.i = const_cast<int*>(inner.data());
+  pattern.stype = 1;  // symmetric, upper triangle read (entries below are ignored)
+  pattern.itype = CHOLMOD_INT;
+  pattern.xtype = CHOLMOD_PATTERN;
+  pattern.dtype = CHOLMOD_DOUBLE;
+  pattern.sorted = 0;
+  pattern.packed = 1;
+  const int ok = cholmod_amd(&pattern, nullptr, 0, ordering.data(), &common);
+  const cholmod_common copy = common;
+  cholmod_finish(&common);
+  if (!ok || copy.status < CHOLMOD_OK) return CholmodError(copy, "AMD ordering");
+  return ordering;
 }
 
 absl::Status SparseCholesky::Compute(const Eigen::SparseMatrix<double>& a) {

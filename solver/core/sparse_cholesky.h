@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -38,7 +39,18 @@ class SparseCholesky {
 
   // Symbolic analysis of the pattern of `a` (square; only the upper triangle, diagonal included,
   // is read, so a full symmetric matrix may be passed). Forgets any previous factorization.
-  absl::Status Analyze(const Eigen::SparseMatrix<double>& a);
+  // The fill-reducing ordering is CHOLMOD's AMD on `a`, or `ordering` when given: a permutation of
+  // 0 .. rows-1, ordering[k] = the row eliminated k-th (CHOLMOD then only postorders it).
+  absl::Status Analyze(const Eigen::SparseMatrix<double>& a,
+                       const std::vector<int>* ordering = nullptr);
+
+  // AMD ordering (CHOLMOD's) of the symmetric pattern given by a compressed-column structure
+  // (outer: n + 1 column starts, inner: the rows of each column, both triangles or one), for
+  // callers that order a smaller graph and expand it (e.g. one node per mesh vertex instead of
+  // one per unknown: the same elimination order for the 2 unknowns of a vertex, found on a
+  // graph with a quarter of the entries).
+  static absl::StatusOr<std::vector<int>> AmdOrdering(const std::vector<int>& outer,
+                                                      const std::vector<int>& inner);
 
   // Numeric factorization of `a`, which must have exactly the analyzed pattern (same compressed
   // structure). FailedPrecondition if `a` is not positive definite. Analyze and Factorize answer

@@ -24,13 +24,15 @@ struct ComeshBenchArgs {
   bool verbose = false;
   int repeat = 5;  // runs shorter than a second are repeated; the median time is reported
   bool malloc_defaults = false;  // --malloc-defaults: glibc's own thresholds (the CLI's are not)
+  int cancel_trials = 0;  // comesh-scaling: cancellation latency trials per row (--cancel-trials)
   solver::ComeshOptions options;
 };
 
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
 // --cure-keep C, --step-fraction F, --scale-by-inverse, --history M, --tolerance R, --laplacian
 // (BCQN's H0), --refresh K, --outer-inner K, --repeat N, --verbose, --malloc-defaults and (when
-// `with_max_vertices`) --max-vertices N and --min-vertices N; exits 2 with a usage line otherwise.
+// `with_max_vertices`) --max-vertices N, --min-vertices N, --cache DIR and --cancel-trials N;
+// exits 2 with a usage line otherwise.
 // Unless --malloc-defaults, keeps freed memory in the process as the CLI does
 // (solver/core/retain_memory.h), so the optimizer is timed as the animator's tool runs it.
 inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max_vertices) {
@@ -42,7 +44,9 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
                  "[--history M] [--tolerance R] [--laplacian] [--refresh K] [--repeat N] "
                  "[--verbose] [--malloc-defaults] [--json FILE]\n",
                  argv[0],
-                 with_max_vertices ? "[--max-vertices N] [--min-vertices N] [--cache DIR] " : "");
+                 with_max_vertices
+                     ? "[--max-vertices N] [--min-vertices N] [--cache DIR] [--cancel-trials N] "
+                     : "");
     std::exit(2);
   };
   for (int i = 1; i < argc; ++i) {
@@ -52,6 +56,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.max_vertices = std::atoi(next());
     } else if (a == "--min-vertices" && with_max_vertices) {
       args.min_vertices = std::atoi(next());
+    } else if (a == "--cancel-trials" && with_max_vertices) {
+      args.cancel_trials = std::max(0, std::atoi(next()));
     } else if (a == "--cache" && with_max_vertices) {
       args.cache_dir = next();
     } else if (a == "--json") {

@@ -9,12 +9,15 @@
 //
 //   comesh_scaling [--max-vertices N] [--min-vertices N] [--cache DIR]
 //                  [common options: comesh_bench_common.h]
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -93,6 +96,33 @@ absl::StatusOr<sv::Multimesh> LoadMultimesh(const std::string& path) {
   return m;
 }
 
+// Cancellation latency (issue: OptimizeComesh stops within 100 ms of a cancel): `trials` runs,
+// the i-th cancelled from another thread at (i + 0.5) / trials of `seconds` (the measured run
+// time), each timed from Cancel() to OptimizeComesh's return. Sorted seconds of the runs that
+// answered CANCELLED (a run that finished first is not counted).
+std::vector<double> CancelLatencies(const sv::Multimesh& mesh, const sv::ComeshOptions& options,
+                                    double seconds, int trials) {
+  using Clock = std::chrono::steady_clock;
+  std::vector<double> latency;
+  for (int i = 0; i < trials; ++i) {
+    sv::CancelToken token;
+    Clock::time_point cancelled_at;
+    std::thread canceller([&] {
+      std::this_thread::sleep_for(std::chrono::duration<double>(seconds * (i + 0.5) / trials));
+      cancelled_at = Clock::now();
+      token.Cancel();
+    });
+    const absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(mesh, options, &token, nullptr, nullptr, nullptr);
+    const Clock::time_point returned = Clock::now();
+    canceller.join();
+    if (absl::IsCancelled(out.status())) {
+      latency.push_back(std::chrono::duration<double>(returned - cancelled_at).count());
+    }
+  }
+  std::sort(latency.begin(), latency.end());
+  return latency;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -154,7 +184,20 @@ int main(int argc, char** argv) {
                 r.inner, paper.inner, r.outer, paper.outer, r.energy_evaluations, r.seconds,
                 paper.seconds, paper.seconds / r.seconds, r.map_energy, r.mesh_energy);
     std::fflush(stdout);
-    rows.push_back(inbetween::bench::ComeshRow(name, r, paper.seconds));
+    nlohmann::json row = inbetween::bench::ComeshRow(name, r, paper.seconds);
+    if (args.cancel_trials > 0) {
+      const std::vector<double> latency = CancelLatencies(*mesh, options, r.seconds,
+                                                          args.cancel_trials);
+      if (!latency.empty()) {
+        std::printf("  cancellation: %zu of %d trials cancelled; latency p50 %.1f ms, max %.1f ms\n",
+                    latency.size(), args.cancel_trials, 1e3 * latency[latency.size() / 2],
+                    1e3 * latency.back());
+        row["cancel_trials"] = latency.size();
+        row["cancel_latency_p50_ms"] = 1e3 * latency[latency.size() / 2];
+        row["cancel_latency_max_ms"] = 1e3 * latency.back();
+      }
+    }
+    rows.push_back(std::move(row));
     ours.emplace_back(r.vertices_before, r.seconds);
     papers.emplace_back(paper.before, paper.seconds);
   }

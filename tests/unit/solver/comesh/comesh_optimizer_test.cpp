@@ -151,6 +151,26 @@ TEST(ComeshOptimizerTest, CancelStopsWithCancelled) {
   EXPECT_EQ(calls, 3);
 }
 
+// A token set before the call: CANCELLED before any iteration, with either preconditioner (their
+// set-ups poll it too; SparseCholesky's own tests cover the polls inside a factorization, and
+// `scripts/bench comesh-scaling --cancel-trials N` measures the latency).
+TEST(ComeshOptimizerTest, CancelledBeforeTheFirstIterationStopsInTheSetUp) {
+  const Multimesh m = SquareToHexagon(10);
+  CancelToken cancel;
+  cancel.Cancel();
+  for (const bool hessian : {true, false}) {
+    ComeshOptions options;
+    options.hessian_preconditioner = hessian;
+    options.laplacian_preconditioner = true;
+    int calls = 0;
+    ProgressFn progress = [&](const std::string&, double, const std::string&) { ++calls; };
+    auto out = OptimizeComesh(m, options, &cancel, progress, nullptr);
+    EXPECT_TRUE(absl::IsCancelled(out.status())) << out.status();
+    EXPECT_NE(out.status().message().find("iteration 0"), std::string::npos) << out.status();
+    EXPECT_EQ(calls, 0);
+  }
+}
+
 TEST(ComeshOptimizerTest, RejectsInvertedInputNamingShape) {
   Multimesh m = SquareToHexagon(4);
   std::swap(m.shapes[1][6], m.shapes[1][7]);

@@ -57,6 +57,23 @@ TEST(ComeshTopologyTest, FlipsLongDiagonalsOfAShearedGridInAllShapes) {
   EXPECT_NEAR(Objective(m), report.objective_before, 1e-9 * report.objective_before);
 }
 
+// A set token stops the pass (CANCELLED, no mesh); a live one changes nothing.
+TEST(ComeshTopologyTest, CancelledPassAnswersCancelled) {
+  const Multimesh m = Sheared(6, 0.8);
+  CancelToken live, cancelled;
+  cancelled.Cancel();
+  TopologyReport plain, with_token;
+  auto a = ImproveTopology(m, 0.5, TopologyOptions{}, &plain);
+  auto b = ImproveTopology(m, 0.5, TopologyOptions{}, &with_token, &live);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_GT(plain.flips, 0);
+  EXPECT_EQ(plain.flips, with_token.flips);
+  EXPECT_EQ(a->triangles, b->triangles);
+  EXPECT_EQ(a->shapes, b->shapes);
+  auto c = ImproveTopology(m, 0.5, TopologyOptions{}, nullptr, &cancelled);
+  EXPECT_EQ(c.status().code(), absl::StatusCode::kCancelled) << c.status();
+}
+
 TEST(ComeshTopologyTest, CollapsesANeedlessVertexKeepingBoundaryAndValidity) {
   Multimesh m = testing::SquareGrid(6);
   m.shapes.push_back(testing::TutteHexagon(m));

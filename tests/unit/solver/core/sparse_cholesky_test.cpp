@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <thread>
 #include <vector>
@@ -241,6 +242,39 @@ TEST(SparseCholeskyTest, CancelledFactorizationAnswersCancelledAndCanBeRedone) {
   CancelToken live;
   EXPECT_EQ(indefinite.Factorize(GridMatrix(100, -0.5, 1.0, 3), &live).code(),
             absl::StatusCode::kFailedPrecondition);
+}
+
+// A caller's ordering (here AMD of a coarser graph expanded, as the comesh Hessian does, and the
+// reverse order) gives a correct factor; a non-permutation is refused.
+TEST(SparseCholeskyTest, AnalyzesWithAGivenOrdering) {
+  const Eigen::SparseMatrix<double> a = GridMatrix(30, 0.1);
+  const int n = static_cast<int>(a.rows());
+  std::vector<int> outer(a.outerIndexPtr(), a.outerIndexPtr() + n + 1);
+  std::vector<int> inner(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros());
+  absl::StatusOr<std::vector<int>> amd = SparseCholesky::AmdOrdering(outer, inner);
+  ASSERT_TRUE(amd.ok()) << amd.status();
+  std::vector<int> sorted = *amd;
+  std::sort(sorted.begin(), sorted.end());
+  for (int k = 0; k < n; ++k) ASSERT_EQ(sorted[k], k);
+  std::vector<int> reverse(n);
+  for (int k = 0; k < n; ++k) reverse[k] = n - 1 - k;
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Random(n, 1);
+  for (const std::vector<int>* ordering : {&*amd, &reverse}) {
+    SparseCholesky chol;
+    ASSERT_TRUE(chol.Analyze(a, ordering).ok());
+    ASSERT_TRUE(chol.Factorize(a).ok());
+    absl::StatusOr<Eigen::MatrixXd> x = chol.Solve(b);
+    ASSERT_TRUE(x.ok());
+    EXPECT_LT((a * *x - b).cwiseAbs().maxCoeff(), 1e-9);
+  }
+  std::vector<int> repeated = reverse;
+  repeated[0] = repeated[1];
+  SparseCholesky chol;
+  EXPECT_EQ(chol.Analyze(a, &repeated).code(), absl::StatusCode::kInvalidArgument);
+  std::vector<int> short_one(reverse.begin(), reverse.end() - 1);
+  EXPECT_EQ(chol.Analyze(a, &short_one).code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(SparseCholesky::AmdOrdering({0, 2}, {0, 1}).status().code(),
+            absl::StatusCode::kInvalidArgument);  // row 1 of a 1 x 1 pattern
 }
 
 // Supernodal factorizations on several threads at once (the comesh preconditioner factors its
