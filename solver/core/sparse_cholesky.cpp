@@ -7,8 +7,10 @@
 
 #include <cholmod.h>
 #include <dlfcn.h>
+#include <sys/mman.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
@@ -73,19 +75,7 @@ struct SparseCholesky::Impl {
     }
   }
 
-  explicit Impl(Method method) {
-    cholmod_start(&common);
-    common.print = 0;  // errors come back as absl::Status, not on stderr
-    common.supernodal = method == Method::kAuto ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
-    common.final_ll = false;
-    // Supernodal from flops / nnz(L) >= 200 (CHOLMOD's default switch is 40): on the comesh
-    // Hessians (2 unknowns per vertex) the simplicial factor with our substitutions was faster up
-    // to the 17k-vertex row of S-Table 2, the supernodal one from 35k (docs/benchmarks.md).
-    common.supernodal_switch = 200.0;
-    common.nmethods = 1;
-    common.method[0].ordering = CHOLMOD_AMD;
-    common.postorder = true;
-  }
+  explicit Impl(Method method);
   ~Impl() {
     if (factor != nullptr) cholmod_free_factor(&factor, &common);
     cholmod_finish(&common);
@@ -231,6 +221,53 @@ const BlasSetup& Blas() {
   return setup;
 }
 
+// CHOLMOD's large arrays (a supernodal factor's values: 34 MB for a 35k-vertex comesh shape,
+// hundreds of MB beyond) come from glibc's mmap path, fresh zero pages every time, and every 4 KiB
+// page costs a fault when first written (perf: 14% of the 35k-vertex row of S-Table 2; on a
+// cancelled factorization CHOLMOD zeroes the unfactored rest, faulting it all in). SuiteSparse
+// allocates through SuiteSparse_config's function pointers; ours ask the kernel for transparent
+// huge pages (madvise MADV_HUGEPAGE: 2 MiB pages, 512 times fewer faults) on blocks of
+// kHugeBlock bytes or more, and are glibc's malloc and friends otherwise. Where THP is off or
+// unsupported the madvise fails and changes nothing.
+constexpr size_t kHugeBlock = size_t{4} << 20;
+
+void AdviseHugePages(void* p, size_t bytes) {
+  if (p == nullptr || bytes < kHugeBlock) return;
+  const uintptr_t page = 4096;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(p) + page - 1) & ~(page - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(page - 1);
+  if (end > begin) (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+
+void* HugeMalloc(size_t bytes) {
+  void* p = std::malloc(bytes);
+  AdviseHugePages(p, bytes);
+  return p;
+}
+
+void* HugeCalloc(size_t count, size_t size) {
+  void* p = std::calloc(count, size);
+  if (size != 0 && count <= SIZE_MAX / size) AdviseHugePages(p, count * size);
+  return p;
+}
+
+void* HugeRealloc(void* old, size_t bytes) {
+  void* p = std::realloc(old, bytes);
+  AdviseHugePages(p, bytes);
+  return p;
+}
+
+void InstallAllocator() {
+  static const bool installed = [] {
+    SuiteSparse_config.malloc_func = HugeMalloc;
+    SuiteSparse_config.calloc_func = HugeCalloc;
+    SuiteSparse_config.realloc_func = HugeRealloc;
+    SuiteSparse_config.free_func = std::free;
+    return true;
+  }();
+  (void)installed;
+}
+
 // kCancelPoint: a supernodal factorization (CHOLMOD's cholmod_super_numeric) has no callback, but
 // it calls LAPACK's dpotrf_ once per supernode, on the supernode's dense diagonal block, and stops
 // as soon as one reports that block not positive definite at its first column (info == 1: the
@@ -316,6 +353,21 @@ absl::Status CheckShape(const Eigen::SparseMatrix<double>& a) {
 }
 
 }  // namespace
+
+SparseCholesky::Impl::Impl(Method method) {
+  InstallAllocator();
+  cholmod_start(&common);
+  common.print = 0;  // errors come back as absl::Status, not on stderr
+  common.supernodal = method == Method::kAuto ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
+  common.final_ll = false;
+  // Supernodal from flops / nnz(L) >= 200 (CHOLMOD's default switch is 40): on the comesh
+  // Hessians (2 unknowns per vertex) the simplicial factor with our substitutions was faster up
+  // to the 17k-vertex row of S-Table 2, the supernodal one from 35k (docs/benchmarks.md).
+  common.supernodal_switch = 200.0;
+  common.nmethods = 1;
+  common.method[0].ordering = CHOLMOD_AMD;
+  common.postorder = true;
+}
 
 SparseCholesky::SparseCholesky(Method method) : impl_(std::make_unique<Impl>(method)) {}
 SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
