@@ -271,24 +271,36 @@ void InstallAllocator() {
 // kCancelPoint: a supernodal factorization (CHOLMOD's cholmod_super_numeric) has no callback, but
 // it calls LAPACK's dpotrf_ once per supernode, on the supernode's dense diagonal block, and stops
 // as soon as one reports that block not positive definite at its first column (info == 1: the
-// rest of the factor is zeroed and the status becomes CHOLMOD_NOT_POSDEF). This file defines
-// dpotrf_, which the dynamic linker binds CHOLMOD's calls to (a definition in the executable comes
-// before the LAPACK library's), and forwards every call to the next definition (LAPACK's) unless
-// the calling thread is inside a cancellable Factorize whose token is set: then it answers
-// info = 1 and records that the stop was a cancellation, not a failed pivot. So a cancelled
-// supernodal factorization ends within one supernode's work (at most a few ms on meshes of 35k
-// vertices); any other caller of dpotrf_ gets LAPACK's result untouched.
+// status becomes CHOLMOD_NOT_POSDEF). This file defines dpotrf_, which the dynamic linker binds
+// CHOLMOD's calls to (a definition in the executable comes before the LAPACK library's), and
+// forwards every call to the next definition (LAPACK's) unless the calling thread is inside a
+// cancellable Factorize whose token is set: then it answers info = 1 and records that the stop
+// was a cancellation, not a failed pivot. Before returning, CHOLMOD zeroes the values of the
+// factor from that supernode to the end (L->x up to L->xsize: at 73k vertices, tens of MB of
+// memory not touched yet, 50-80 ms measured); the hook sets L->xsize to 0 for that moment (the
+// zeroing loop then does nothing) and Factorize restores it as soon as CHOLMOD returns. The
+// factor's values are then meaningless, which is what "not factorized" already says: the next
+// Factorize writes every supernode anew. So a cancelled supernodal factorization ends within one
+// supernode's work; any other caller of dpotrf_ gets LAPACK's result untouched.
 thread_local const CancelToken* tls_factor_cancel = nullptr;
+thread_local cholmod_factor* tls_factor = nullptr;
 thread_local bool tls_factor_cancelled = false;
+thread_local size_t tls_factor_xsize = 0;
 
-// Sets the calling thread's cancellation token for the scope of one supernodal factorization.
+// Sets the calling thread's cancellation token and factor for the scope of one supernodal
+// factorization; on leaving it, gives the factor back its xsize if the hook took it.
 class CancelPointScope {
  public:
-  explicit CancelPointScope(const CancelToken* cancel) {
+  CancelPointScope(const CancelToken* cancel, cholmod_factor* factor) {
     tls_factor_cancel = cancel;
+    tls_factor = factor;
     tls_factor_cancelled = false;
   }
-  ~CancelPointScope() { tls_factor_cancel = nullptr; }
+  ~CancelPointScope() {
+    if (tls_factor_cancelled && tls_factor != nullptr) tls_factor->xsize = tls_factor_xsize;
+    tls_factor_cancel = nullptr;
+    tls_factor = nullptr;
+  }
   CancelPointScope(const CancelPointScope&) = delete;
   CancelPointScope& operator=(const CancelPointScope&) = delete;
 };
@@ -442,9 +454,13 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a,
     if (ok < 0) return cancelled();
   } else {
     const BlasLock blas(/*uses_blas=*/m.factor->is_super != 0);
-    const CancelPointScope scope(m.factor->is_super != 0 ? cancel : nullptr);
-    ok = cholmod_factorize(&view, m.factor, &m.common);
-    if (tls_factor_cancelled) return cancelled();
+    bool stopped = false;
+    {
+      const CancelPointScope scope(m.factor->is_super != 0 ? cancel : nullptr, m.factor);
+      ok = cholmod_factorize(&view, m.factor, &m.common);
+      stopped = tls_factor_cancelled;
+    }
+    if (stopped) return cancelled();
   }
   if (!ok || m.common.status < CHOLMOD_OK) {
     return CholmodError(m.common, "numeric factorization");
@@ -635,6 +651,11 @@ extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* ld
   }();
   const inbetween::solver::CancelToken* cancel = inbetween::solver::tls_factor_cancel;
   if (cancel != nullptr && cancel->IsCancelled()) {
+    namespace sv = inbetween::solver;
+    if (!sv::tls_factor_cancelled && sv::tls_factor != nullptr) {
+      sv::tls_factor_xsize = sv::tls_factor->xsize;
+      sv::tls_factor->xsize = 0;  // CHOLMOD's zeroing of the rest: nothing to do (see above)
+    }
     inbetween::solver::tls_factor_cancelled = true;
     *info = 1;  // "not positive definite at the block's first column": CHOLMOD stops here
     return;
