@@ -61,7 +61,7 @@ class SparseCholesky {
   // same operations in the same order, so the factor is bit-identical to an uncancellable one),
   // a supernodal one stops at the next supernode (see kCancelPoint in the .cpp).
   absl::Status Factorize(const Eigen::SparseMatrix<double>& a, const CancelToken* cancel = nullptr);
-  static constexpr int kCancelRows = 2048;
+  static constexpr int kCancelRows = 256;
 
   // Analyze + Factorize.
   absl::Status Compute(const Eigen::SparseMatrix<double>& a);
