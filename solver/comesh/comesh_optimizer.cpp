@@ -487,6 +487,9 @@ class HessianPreconditioner {
       }
     }
     for (Block& block : h.blocks_) block.node_outer.push_back(static_cast<int>(block.node_inner.size()));
+    if (cancel != nullptr && cancel->IsCancelled()) {
+      return absl::CancelledError("comesh Hessian set-up cancelled");
+    }
     for (int s = 0; s < num_shapes; ++s) {
       Block& block = h.blocks_[s];
       const int size = h.begin_[s + 1] - h.begin_[s];
@@ -772,10 +775,18 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
                        const CancelToken* cancel, const ProgressFn& progress, int iteration_base,
                        InnerStats* stats) {
   Stopwatch clock;
+  auto cancelled_at = [&](int iter) {
+    return absl::CancelledError(
+        absl::StrCat("comesh optimization cancelled at iteration ", iteration_base + iter));
+  };
+  // The set-up's steps each poll the token (on 300k-vertex meshes each takes 0.1-0.3 s).
+  auto poll = [&] { return cancel != nullptr && cancel->IsCancelled(); };
   absl::StatusOr<ComeshObjective> objective =
       ComeshObjective::Create(mesh->triangles, mesh->shapes, options.map_weight, threads);
   if (!objective.ok()) return objective.status();
+  if (poll()) return cancelled_at(0);
   const Layout layout(*mesh, options.slide_boundary);
+  if (poll()) return cancelled_at(0);
   std::vector<Points>& shapes = mesh->shapes;
   std::vector<Points> grad_shapes;
   ComeshEnergies energies;
@@ -787,10 +798,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     stats->stop_reason = "no_free";
     return absl::OkStatus();
   }
-  auto cancelled_at = [&](int iter) {
-    return absl::CancelledError(
-        absl::StrCat("comesh optimization cancelled at iteration ", iteration_base + iter));
-  };
+  if (poll()) return cancelled_at(0);
   // H0: the shape-block Hessian (Newton-type) or the Laplacian model (BCQN).
   std::optional<HessianPreconditioner> hessian;
   std::optional<InitialHessian> laplacian;
@@ -1008,9 +1016,15 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
         "in (0, 1), cure_keep in [0, 1), blend >= 0");
   }
   const int threads = ResolveThreads(options.threads);
+  auto cancelled_before_start = [&] {
+    return cancel != nullptr && cancel->IsCancelled();
+  };
+  const absl::Status not_started = absl::CancelledError("comesh optimization cancelled at start");
+  if (cancelled_before_start()) return not_started;
   absl::StatusOr<ComeshObjective> objective =
       ComeshObjective::Create(mesh.triangles, mesh.shapes, options.map_weight, threads);
   if (!objective.ok()) return objective.status();
+  if (cancelled_before_start()) return not_started;
 
   ComeshReport rep;
   rep.vertices_before = rep.vertices_after = mesh.num_vertices();

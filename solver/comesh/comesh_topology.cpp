@@ -451,7 +451,9 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
   absl::StatusOr<ComeshObjective> objective =
       ComeshObjective::Create(mesh.triangles, mesh.shapes, map_weight);
   if (!objective.ok()) return objective.status();
+  if (cancelled()) return cancelled_status;
   Editor editor(mesh, *objective, options);
+  if (cancelled()) return cancelled_status;
   TopologyReport rep;
   rep.objective_before = editor.Objective();
   if (!std::isfinite(rep.objective_before)) {
