@@ -228,7 +228,9 @@ const BlasSetup& Blas() {
 // allocates through SuiteSparse_config's function pointers; ours ask the kernel for transparent
 // huge pages (madvise MADV_HUGEPAGE: 2 MiB pages, 512 times fewer faults) on blocks of
 // kHugeBlock bytes or more, and are glibc's malloc and friends otherwise. Where THP is off or
-// unsupported the madvise fails and changes nothing.
+// unsupported the madvise fails and changes nothing. Measured (docs/benchmarks.md, fifth
+// session): no change in S-Table 2's times beyond this VM's noise; the worst cancellation
+// latency at 35k vertices 121 -> 74 ms before the xsize change below made that zeroing moot.
 constexpr size_t kHugeBlock = size_t{4} << 20;
 
 void AdviseHugePages(void* p, size_t bytes) {
