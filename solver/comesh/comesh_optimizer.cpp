@@ -445,7 +445,7 @@ class HessianPreconditioner {
     auto nbrs = [&](int v) {
       return std::span<const int>(list.data() + start[v], static_cast<size_t>(count[v]));
     };
-    if (cancel != nullptr && cancel->IsCancelled()) {
+    if (Cancelled(cancel)) {
       return absl::CancelledError("comesh Hessian set-up cancelled");
     }
     // Shape s's unknowns are z[begin_[s], begin_[s + 1]) (Layout numbers them shape by shape).
@@ -487,7 +487,7 @@ class HessianPreconditioner {
       }
     }
     for (Block& block : h.blocks_) block.node_outer.push_back(static_cast<int>(block.node_inner.size()));
-    if (cancel != nullptr && cancel->IsCancelled()) {
+    if (Cancelled(cancel)) {
       return absl::CancelledError("comesh Hessian set-up cancelled");
     }
     for (int s = 0; s < num_shapes; ++s) {
@@ -555,11 +555,10 @@ class HessianPreconditioner {
   // vertices) or one supernode.
   absl::Status Refactor(const std::vector<Points>& shapes, bool analyze,
                         const CancelToken* cancel) {
-    auto cancelled = [&] { return cancel != nullptr && cancel->IsCancelled(); };
     ForEachShape([&](int s) {
       Block& block = blocks_[s];
       block.status = absl::OkStatus();
-      if (cancelled()) {
+      if (Cancelled(cancel)) {
         block.status = absl::CancelledError("comesh Hessian set-up cancelled");
         return;
       }
@@ -569,7 +568,7 @@ class HessianPreconditioner {
       }
       if (block.matrix.rows() == 0) return;
       if (analyze) block.status = Analyze(&block, cancel);
-      if (block.status.ok() && cancelled()) {
+      if (block.status.ok() && Cancelled(cancel)) {
         block.status = absl::CancelledError("comesh Hessian set-up cancelled");
       }
       if (block.status.ok()) block.status = block.solver->Factorize(block.matrix, cancel);
@@ -590,11 +589,11 @@ class HessianPreconditioner {
   // Symbolic analysis with the vertex graph's AMD ordering expanded to the unknowns.
   static absl::Status Analyze(Block* block, const CancelToken* cancel) {
     const absl::Status cancelled = absl::CancelledError("comesh Hessian set-up cancelled");
-    if (cancel != nullptr && cancel->IsCancelled()) return cancelled;
+    if (Cancelled(cancel)) return cancelled;
     absl::StatusOr<std::vector<int>> nodes =
         SparseCholesky::AmdOrdering(block->node_outer, block->node_inner);
     if (!nodes.ok()) return nodes.status();
-    if (cancel != nullptr && cancel->IsCancelled()) return cancelled;
+    if (Cancelled(cancel)) return cancelled;
     const int size = static_cast<int>(block->matrix.rows());
     std::vector<int> ordering;
     ordering.reserve(size);
@@ -637,7 +636,7 @@ class HessianPreconditioner {
     const int base = begin_[s];
     int count = 0;
     for (const Triangle& t : *triangles_) {
-      if ((++count & 4095) == 0 && cancel != nullptr && cancel->IsCancelled()) return false;
+      if ((++count & 4095) == 0 && Cancelled(cancel)) return false;
       int vars[3];
       bool any = false;
       for (int k = 0; k < 3; ++k) {
@@ -779,14 +778,13 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     return absl::CancelledError(
         absl::StrCat("comesh optimization cancelled at iteration ", iteration_base + iter));
   };
-  // The set-up's steps each poll the token (on 300k-vertex meshes each takes 0.1-0.3 s).
-  auto poll = [&] { return cancel != nullptr && cancel->IsCancelled(); };
+  // The set-up's steps each poll the token.
   absl::StatusOr<ComeshObjective> objective =
       ComeshObjective::Create(mesh->triangles, mesh->shapes, options.map_weight, threads);
   if (!objective.ok()) return objective.status();
-  if (poll()) return cancelled_at(0);
+  if (Cancelled(cancel)) return cancelled_at(0);
   const Layout layout(*mesh, options.slide_boundary);
-  if (poll()) return cancelled_at(0);
+  if (Cancelled(cancel)) return cancelled_at(0);
   std::vector<Points>& shapes = mesh->shapes;
   std::vector<Points> grad_shapes;
   ComeshEnergies energies;
@@ -798,7 +796,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     stats->stop_reason = "no_free";
     return absl::OkStatus();
   }
-  if (poll()) return cancelled_at(0);
+  if (Cancelled(cancel)) return cancelled_at(0);
   // H0: the shape-block Hessian (Newton-type) or the Laplacian model (BCQN).
   std::optional<HessianPreconditioner> hessian;
   std::optional<InitialHessian> laplacian;
@@ -839,7 +837,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   ComeshEnergies trial_energies;
 
   for (int iter = 0;; ++iter) {
-    if (cancel != nullptr && cancel->IsCancelled()) return cancelled_at(iter);
+    if (Cancelled(cancel)) return cancelled_at(iter);
     if (g.norm() <= options.gradient_tolerance * g0) {
       stats->stop_reason = "gradient";
       return absl::OkStatus();
@@ -909,7 +907,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     VectorXd z_new;
     for (int b = 0; b <= options.max_backtracks; ++b) {
       // Every trial is an energy evaluation (15 ms at 73k vertices): poll between them too.
-      if (b > 0 && cancel != nullptr && cancel->IsCancelled()) return cancelled_at(iter);
+      if (b > 0 && Cancelled(cancel)) return cancelled_at(iter);
       z_new = z + step * d;
       layout.Scatter(z_new, &trial);
       f_new = objective->Evaluate(trial, &trial_grad, &trial_energies);
@@ -1016,15 +1014,12 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
         "in (0, 1), cure_keep in [0, 1), blend >= 0");
   }
   const int threads = ResolveThreads(options.threads);
-  auto cancelled_before_start = [&] {
-    return cancel != nullptr && cancel->IsCancelled();
-  };
   const absl::Status not_started = absl::CancelledError("comesh optimization cancelled at start");
-  if (cancelled_before_start()) return not_started;
+  if (Cancelled(cancel)) return not_started;
   absl::StatusOr<ComeshObjective> objective =
       ComeshObjective::Create(mesh.triangles, mesh.shapes, options.map_weight, threads);
   if (!objective.ok()) return objective.status();
-  if (cancelled_before_start()) return not_started;
+  if (Cancelled(cancel)) return not_started;
 
   ComeshReport rep;
   rep.vertices_before = rep.vertices_after = mesh.num_vertices();
@@ -1067,7 +1062,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       break;
     }
     pass_start_objective = stats.objective;
-    if (cancel != nullptr && cancel->IsCancelled()) {
+    if (Cancelled(cancel)) {
       return absl::CancelledError(absl::StrCat("comesh optimization cancelled at outer ", outer));
     }
     TopologyReport topo;

@@ -446,14 +446,13 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
                                           const CancelToken* cancel) {
   // Polled before every candidate operation (a relaxed atomic load; a pass on 35k vertices takes
   // ~0.1 s, more than the 100 ms a cancel may take).
-  auto cancelled = [&] { return cancel != nullptr && cancel->IsCancelled(); };
   const absl::Status cancelled_status = absl::CancelledError("comesh topology pass cancelled");
   absl::StatusOr<ComeshObjective> objective =
       ComeshObjective::Create(mesh.triangles, mesh.shapes, map_weight);
   if (!objective.ok()) return objective.status();
-  if (cancelled()) return cancelled_status;
+  if (Cancelled(cancel)) return cancelled_status;
   Editor editor(mesh, *objective, options);
-  if (cancelled()) return cancelled_status;
+  if (Cancelled(cancel)) return cancelled_status;
   TopologyReport rep;
   rep.objective_before = editor.Objective();
   if (!std::isfinite(rep.objective_before)) {
@@ -473,7 +472,7 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
       if (everything) editor.TakeDirty();
       int flips = 0;
       for (const auto& [a, b] : edges) {
-        if (cancelled()) return false;
+        if (Cancelled(cancel)) return false;
         flips += editor.TryFlip(a, b);
       }
       rep.flips += flips;
@@ -490,7 +489,7 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
     }
     std::sort(candidates.begin(), candidates.end());
     for (const auto& [r, edge] : candidates) {
-      if (cancelled()) return cancelled_status;
+      if (Cancelled(cancel)) return cancelled_status;
       rep.collapses += editor.TryCollapse(edge.first, edge.second) ||
                        editor.TryCollapse(edge.second, edge.first);
     }
@@ -503,7 +502,7 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
     }
     std::sort(candidates.begin(), candidates.end());
     for (const auto& [r, edge] : candidates) {
-      if (cancelled()) return cancelled_status;
+      if (Cancelled(cancel)) return cancelled_status;
       rep.splits += editor.TrySplit(edge.first, edge.second);
     }
   }

@@ -18,6 +18,12 @@ class CancelToken {
   std::atomic<bool> cancelled_{false};
 };
 
+// True when `token` is given and set: the poll every cancellable loop makes (a null token means
+// "not cancellable").
+inline bool Cancelled(const CancelToken* token) {
+  return token != nullptr && token->IsCancelled();
+}
+
 // Progress callback: stage name, fraction done in [0, 1], short human-readable detail.
 using ProgressFn = std::function<void(const std::string& stage, double fraction,
                                       const std::string& detail)>;

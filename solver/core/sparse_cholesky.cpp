@@ -652,7 +652,7 @@ extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* ld
     return next;
   }();
   const inbetween::solver::CancelToken* cancel = inbetween::solver::tls_factor_cancel;
-  if (cancel != nullptr && cancel->IsCancelled()) {
+  if (inbetween::solver::Cancelled(cancel)) {
     namespace sv = inbetween::solver;
     if (!sv::tls_factor_cancelled && sv::tls_factor != nullptr) {
       sv::tls_factor_xsize = sv::tls_factor->xsize;

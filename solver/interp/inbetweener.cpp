@@ -507,7 +507,7 @@ absl::StatusOr<Coords> Inbetweener::Impl::Iterate(const Problem& p, Coords x, do
   int separated = 0;
   Coords next_rhs(num_vertices(), 2);
   while (iterations < options.max_iterations && energy > 0.0) {
-    if (cancel != nullptr && cancel->IsCancelled()) {
+    if (Cancelled(cancel)) {
       return absl::CancelledError("inbetweening cancelled");
     }
     absl::StatusOr<Coords> g = GlobalSolve(s, pinned, rhs, gauge);
@@ -808,7 +808,7 @@ absl::StatusOr<Frame> Inbetweener::Impl::Solve(const ExampleWeights& weights, co
                                                      num_vertices()));
     }
   }
-  if (cancel != nullptr && cancel->IsCancelled()) {
+  if (Cancelled(cancel)) {
     return absl::CancelledError("inbetweening cancelled");
   }
 

@@ -193,7 +193,6 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   auto notify = [&](const std::string& stage, double fraction, const std::string& detail) {
     if (progress) progress(stage, fraction, detail);
   };
-  auto cancelled = [&] { return cancel != nullptr && cancel->IsCancelled(); };
   const int num_shapes = static_cast<int>(drawings.size());
   if (num_shapes < 2) {
     return absl::InvalidArgumentError(
@@ -211,7 +210,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     }
   }
 
-  if (cancelled()) return absl::CancelledError("BuildMultimesh cancelled");
+  if (Cancelled(cancel)) return absl::CancelledError("BuildMultimesh cancelled");
   notify("boundaries", 0.0, absl::StrCat(num_shapes, " drawings"));
   std::vector<BoundaryGraph> graphs;
   for (int d = 0; d < num_shapes; ++d) {
@@ -274,7 +273,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     }
   }
 
-  if (cancelled()) return absl::CancelledError("BuildMultimesh cancelled");
+  if (Cancelled(cancel)) return absl::CancelledError("BuildMultimesh cancelled");
   notify("triangulate", 0.1,
          absl::StrCat("drawing ", ref + 1, ", ", num_edges, " boundary vertices"));
   TriangulateOptions triangulate_options;
@@ -402,7 +401,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
                    [ref](int a, int b) { return std::abs(a - ref) < std::abs(b - ref); });
   int done = 0;
   for (const int d : order) {
-    if (cancelled()) return absl::CancelledError("BuildMultimesh cancelled");
+    if (Cancelled(cancel)) return absl::CancelledError("BuildMultimesh cancelled");
     notify("map", 0.2 + 0.75 * done++ / (num_shapes - 1), absl::StrCat("drawing ", d + 1));
     Points shape = targets_of(d);
     const Points target = shape;

@@ -382,7 +382,6 @@ absl::StatusOr<Points> MapToBoundaryImpl(const Points& source,
   MapToBoundaryReport local_report;
   MapToBoundaryReport& rep = report ? *report : local_report;
   rep = MapToBoundaryReport();
-  auto cancelled = [&] { return cancel != nullptr && cancel->IsCancelled(); };
 
   Mapper mapper(source, triangles, boundary, target_boundary);
   Constraints fixed;  // boundary pinned at the target
@@ -448,7 +447,7 @@ absl::StatusOr<Points> MapToBoundaryImpl(const Points& source,
       pull.penalty *= 10;
       for (int it = 0; it < options.iterations_per_stage && rep.iterations < options.max_iterations;
            ++it) {
-        if (cancelled()) return absl::CancelledError("map: cancelled");
+        if (Cancelled(cancel)) return absl::CancelledError("map: cancelled");
         ++rep.iterations;
         const absl::StatusOr<double> iterated = mapper.Iterate(&x, pull);
         if (!iterated.ok()) return iterated.status();
@@ -494,7 +493,7 @@ absl::StatusOr<Points> MapToBoundaryImpl(const Points& source,
     return absl::FailedPreconditionError("the exactly placed boundary folds a triangle");
   }
   for (int it = 0; it < options.polish_iterations; ++it) {
-    if (cancelled()) return absl::CancelledError("map: cancelled");
+    if (Cancelled(cancel)) return absl::CancelledError("map: cancelled");
     ++rep.iterations;
     const absl::StatusOr<double> progress = mapper.Iterate(&x, fixed);
     if (!progress.ok()) return progress.status();
