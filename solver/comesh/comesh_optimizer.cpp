@@ -445,9 +445,7 @@ class HessianPreconditioner {
     auto nbrs = [&](int v) {
       return std::span<const int>(list.data() + start[v], static_cast<size_t>(count[v]));
     };
-    if (Cancelled(cancel)) {
-      return absl::CancelledError("comesh Hessian set-up cancelled");
-    }
+    if (Cancelled(cancel)) return SetUpCancelled();
     // Shape s's unknowns are z[begin_[s], begin_[s + 1]) (Layout numbers them shape by shape).
     h.begin_.assign(num_shapes + 1, layout.size());
     for (int i = static_cast<int>(layout.vars().size()) - 1; i >= 0; --i) {
@@ -486,10 +484,10 @@ class HessianPreconditioner {
         if (j >= 0 && node[j] >= 0) block.node_inner.push_back(node[j]);  // rows <= column
       }
     }
-    for (Block& block : h.blocks_) block.node_outer.push_back(static_cast<int>(block.node_inner.size()));
-    if (Cancelled(cancel)) {
-      return absl::CancelledError("comesh Hessian set-up cancelled");
+    for (Block& block : h.blocks_) {
+      block.node_outer.push_back(static_cast<int>(block.node_inner.size()));
     }
+    if (Cancelled(cancel)) return SetUpCancelled();
     for (int s = 0; s < num_shapes; ++s) {
       Block& block = h.blocks_[s];
       const int size = h.begin_[s + 1] - h.begin_[s];
@@ -535,6 +533,10 @@ class HessianPreconditioner {
   // the 2k and 4k rows of S-Table 2 took 10% and 20% less than with 20,000).
   static constexpr int kParallelUnknowns = 4000;
 
+  static absl::Status SetUpCancelled() {
+    return absl::CancelledError("comesh Hessian set-up cancelled");
+  }
+
   struct Block {
     // The vertex graph (see Create): node k's first unknown, and its upper-triangle pattern.
     std::vector<int> node_unknowns, node_outer, node_inner;
@@ -558,19 +560,13 @@ class HessianPreconditioner {
     ForEachShape([&](int s) {
       Block& block = blocks_[s];
       block.status = absl::OkStatus();
-      if (Cancelled(cancel)) {
-        block.status = absl::CancelledError("comesh Hessian set-up cancelled");
-        return;
-      }
       if (!AssembleShape(s, shapes, cancel)) {
-        block.status = absl::CancelledError("comesh Hessian set-up cancelled");
+        block.status = SetUpCancelled();
         return;
       }
       if (block.matrix.rows() == 0) return;
       if (analyze) block.status = Analyze(&block, cancel);
-      if (block.status.ok() && Cancelled(cancel)) {
-        block.status = absl::CancelledError("comesh Hessian set-up cancelled");
-      }
+      if (block.status.ok() && Cancelled(cancel)) block.status = SetUpCancelled();
       if (block.status.ok()) block.status = block.solver->Factorize(block.matrix, cancel);
     });
     for (size_t s = 0; s < blocks_.size(); ++s) {
@@ -588,12 +584,11 @@ class HessianPreconditioner {
 
   // Symbolic analysis with the vertex graph's AMD ordering expanded to the unknowns.
   static absl::Status Analyze(Block* block, const CancelToken* cancel) {
-    const absl::Status cancelled = absl::CancelledError("comesh Hessian set-up cancelled");
-    if (Cancelled(cancel)) return cancelled;
+    if (Cancelled(cancel)) return SetUpCancelled();
     absl::StatusOr<std::vector<int>> nodes =
         SparseCholesky::AmdOrdering(block->node_outer, block->node_inner);
     if (!nodes.ok()) return nodes.status();
-    if (Cancelled(cancel)) return cancelled;
+    if (Cancelled(cancel)) return SetUpCancelled();
     const int size = static_cast<int>(block->matrix.rows());
     std::vector<int> ordering;
     ordering.reserve(size);
@@ -624,7 +619,8 @@ class HessianPreconditioner {
     v[1] += b;
   }
 
-  // Returns false (block partly assembled) if `cancel` was set: polled every 4096 triangles.
+  // Returns false (block partly assembled) if `cancel` was set: polled at the first triangle and
+  // every 4096 after it.
   bool AssembleShape(int s, const std::vector<Points>& shapes, const CancelToken* cancel) {
     const Layout& layout = *layout_;
     const ComeshObjective& obj = *objective_;
@@ -636,7 +632,7 @@ class HessianPreconditioner {
     const int base = begin_[s];
     int count = 0;
     for (const Triangle& t : *triangles_) {
-      if ((++count & 4095) == 0 && Cancelled(cancel)) return false;
+      if ((count++ & 4095) == 0 && Cancelled(cancel)) return false;
       int vars[3];
       bool any = false;
       for (int k = 0; k < 3; ++k) {
