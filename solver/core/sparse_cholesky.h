@@ -16,6 +16,8 @@
 // contend for OpenBLAS's buffer lock). Single-threaded BLAS and a fixed ordering keep
 // the result bit-identical run to run on one machine. Objects on different threads factor and
 // solve concurrently (with a non-reentrant BLAS, the serial OpenBLAS, those calls are serialized).
+// CHOLMOD's own OpenMP regions run on the calling thread (see GOMP_parallel in the .cpp): a
+// factorization never starts threads of its own.
 #pragma once
 
 #include <Eigen/Core>

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <iterator>
 #include <random>
 #include <thread>
 #include <vector>
@@ -182,6 +184,25 @@ TEST(SparseCholeskyTest, AutoGoesSupernodalOnLargeMatricesWithTheSameSolution) {
   EXPECT_EQ(indefinite.Compute(GridMatrix(100, -0.5, 1.0, 3)).code(),
             absl::StatusCode::kFailedPrecondition);
   EXPECT_FALSE(indefinite.factorized());
+}
+
+// CHOLMOD's OpenMP regions run on the calling thread (the GOMP_parallel definition in
+// sparse_cholesky.cpp): a supernodal factorization starts no thread. Without that definition
+// libgomp starts a pool of 3 workers at the first region with its team of 4 (they stay alive).
+// ctest runs every test in its own process, so no earlier test has started them.
+int ThreadCount() {
+  return static_cast<int>(std::distance(std::filesystem::directory_iterator("/proc/self/task"),
+                                        std::filesystem::directory_iterator()));
+}
+
+TEST(SparseCholeskyTest, SupernodalFactorizationStartsNoThread) {
+  const Eigen::SparseMatrix<double> a = GridMatrix(100, 1e-3, 1.0, 3);
+  const int before = ThreadCount();
+  SparseCholesky super(SparseCholesky::Method::kAuto);
+  ASSERT_TRUE(super.Compute(a).ok());
+  ASSERT_TRUE(super.supernodal());
+  ASSERT_TRUE(super.Factorize(2.0 * a).ok());
+  EXPECT_EQ(ThreadCount(), before);
 }
 
 // With a cancellation token the simplicial factor is computed in row blocks (several here): the
