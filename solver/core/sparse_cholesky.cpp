@@ -374,10 +374,12 @@ SparseCholesky::Impl::Impl(Method method) {
   common.print = 0;  // errors come back as absl::Status, not on stderr
   common.supernodal = method == Method::kAuto ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
   common.final_ll = false;
-  // Supernodal from flops / nnz(L) >= 200 (CHOLMOD's default switch is 40): on the comesh
-  // Hessians (2 unknowns per vertex) the simplicial factor with our substitutions was faster up
-  // to the 17k-vertex row of S-Table 2, the supernodal one from 35k (docs/benchmarks.md).
-  common.supernodal_switch = 200.0;
+  // Supernodal from flops / nnz(L) >= 100 (CHOLMOD's default switch is 40): on the comesh
+  // Hessians (2 unknowns per vertex) the simplicial factor with our substitutions is faster up to
+  // the 8.6k-vertex row of S-Table 2 (at 40 the 2k and 4k rows took ~10% longer), the supernodal
+  // one from 17k (~9% less time there than at 200, once CHOLMOD's OpenMP teams were gone; see
+  // GOMP_parallel below and docs/benchmarks.md, sixth session).
+  common.supernodal_switch = 100.0;
   common.nmethods = 1;
   common.method[0].ordering = CHOLMOD_AMD;
   common.postorder = true;
