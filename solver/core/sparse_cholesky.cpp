@@ -667,29 +667,22 @@ extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* ld
   lapack(uplo, n, a, lda, info, uplo_length);
 }
 
-// CHOLMOD's OpenMP regions run with one thread. Debian's CHOLMOD (SuiteSparse 5.12, built with
-// OpenMP) opens parallel regions inside the supernodal factorization, per supernode (copying A
-// into it, clearing and scattering), each with a fixed team of CHOLMOD_OMP_NUM_THREADS = 4
+// CHOLMOD's OpenMP regions run on the calling thread. Debian's CHOLMOD (SuiteSparse 5.12, built
+// with OpenMP) opens parallel regions inside the supernodal factorization, per supernode (copying
+// A into it, clearing and scattering), each with a fixed team of CHOLMOD_OMP_NUM_THREADS = 4
 // threads (the compiled call passes 4 whenever the region's size test holds, so OMP_NUM_THREADS
 // does not change it). On a 2-core machine where our own threads already factor the two shapes
-// of a comesh concurrently, those teams oversubscribe the cores and their barriers cost futex
-// wake-ups and spinning: measured on S-Table 2's 35k row (docs/benchmarks.md, sixth session).
-// The executable defines GOMP_parallel, the libgomp entry point gcc compiles `#pragma omp
-// parallel` to (the dynamic linker binds CHOLMOD's calls to this definition, as for dpotrf_
-// above), and forwards every region to libgomp's with a team of one thread: the same work in the
-// same order, on the calling thread. CHOLMOD is the only library here that uses OpenMP (our own
-// code is not built with it); the regions only move data, so the factor is the same.
-extern "C" void GOMP_parallel(void (*fn)(void*), void* data, unsigned num_threads,
-                              unsigned flags) {
-  using Parallel = void (*)(void (*)(void*), void*, unsigned, unsigned);
-  static const Parallel libgomp = [] {
-    auto* next = reinterpret_cast<Parallel>(dlsym(RTLD_NEXT, "GOMP_parallel"));
-    if (next == nullptr) {
-      std::fprintf(stderr, "inbetween: libgomp's GOMP_parallel not found (%s)\n", dlerror());
-      std::abort();
-    }
-    return next;
-  }();
-  (void)num_threads;
-  libgomp(fn, data, 1, flags);
+// of a comesh concurrently, those teams oversubscribe the cores, and even a team of one costs a
+// futex system call per region (libgomp's barrier): measured on S-Table 2's 35k row
+// (docs/benchmarks.md, sixth session). The executable defines GOMP_parallel, the libgomp entry
+// point gcc compiles `#pragma omp parallel` to (the dynamic linker binds CHOLMOD's calls to this
+// definition, as for dpotrf_ above), and runs the region's body once on the calling thread, as
+// libgomp does for a team of one: outside any team, omp_get_num_threads() is 1 and
+// omp_get_thread_num() 0, so the body's worksharing loops (static schedules: CHOLMOD imports no
+// other libgomp entry point) cover every iteration, in order. CHOLMOD is the only library here
+// that uses OpenMP (our own code is not built with it); its regions only move data, so the factor
+// is the same.
+extern "C" void GOMP_parallel(void (*fn)(void*), void* data, unsigned /*num_threads*/,
+                              unsigned /*flags*/) {
+  fn(data);
 }
