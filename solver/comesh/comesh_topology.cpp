@@ -417,26 +417,41 @@ class Editor {
 
 std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Triangle>& triangles,
                                                           const std::vector<char>& alive) {
-  // Edges as 64-bit keys (a << 32 | b): sorting plain integers is much faster than pairs.
-  std::vector<uint64_t> all;
-  all.reserve(3 * triangles.size());
+  // Linear time: each edge (a, b), a < b, goes to the bucket of a (a counting sort on a), each
+  // bucket (a vertex's few higher neighbours) is sorted on its own, and equal b's in a bucket are
+  // one edge's uses. Measured 3.5% of the 35k-vertex S-Table 2 row with one std::sort of 3T keys.
+  int n = 0;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    if (alive[t]) n = std::max({n, triangles[t][0] + 1, triangles[t][1] + 1, triangles[t][2] + 1});
+  }
+  std::vector<int> start(n + 1, 0);
   for (size_t t = 0; t < triangles.size(); ++t) {
     if (!alive[t]) continue;
-    for (int k = 0; k < 3; ++k) {
-      const auto [a, b] = std::minmax(triangles[t][k], triangles[t][(k + 1) % 3]);
-      all.push_back(static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32 |
-                    static_cast<uint32_t>(b));
+    for (int k = 0; k < 3; ++k) ++start[std::min(triangles[t][k], triangles[t][(k + 1) % 3]) + 1];
+  }
+  for (int v = 0; v < n; ++v) start[v + 1] += start[v];
+  std::vector<int> higher(start[n]);
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (size_t t = 0; t < triangles.size(); ++t) {
+      if (!alive[t]) continue;
+      for (int k = 0; k < 3; ++k) {
+        const auto [a, b] = std::minmax(triangles[t][k], triangles[t][(k + 1) % 3]);
+        higher[fill[a]++] = b;
+      }
     }
   }
-  std::sort(all.begin(), all.end());
   std::vector<std::pair<std::pair<int, int>, int>> uses;
-  uses.reserve(all.size() / 2 + 1);
-  for (size_t i = 0; i < all.size();) {
-    size_t j = i;
-    while (j < all.size() && all[j] == all[i]) ++j;
-    uses.push_back({{static_cast<int>(all[i] >> 32), static_cast<int>(all[i] & 0xffffffffu)},
-                    static_cast<int>(j - i)});
-    i = j;
+  uses.reserve(higher.size() / 2 + 1);
+  for (int a = 0; a < n; ++a) {
+    const auto begin = higher.begin() + start[a], end = higher.begin() + start[a + 1];
+    std::sort(begin, end);
+    for (auto i = begin; i != end;) {
+      auto j = i;
+      while (j != end && *j == *i) ++j;
+      uses.push_back({{a, *i}, static_cast<int>(j - i)});
+      i = j;
+    }
   }
   return uses;
 }

@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <random>
+#include <utility>
+
 #include "solver/comesh/comesh_objective.h"
 #include "solver/mesh/validate.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
@@ -37,6 +41,38 @@ Multimesh Sheared(int k, double shear) {
   for (Point& p : m.shapes[0]) p.x() += shear * p.y();
   m.shapes.push_back(testing::Similar(m.shapes[0], 0.3, 1.5, Point(2, 0)));
   return m;
+}
+
+// EdgeUses: every edge of the live triangles once, (a, b) with a < b in increasing order, with
+// its number of live triangles; checked against a map on a random triangle soup with dead
+// triangles, repeated edges and unused vertex numbers.
+TEST(ComeshTopologyTest, EdgeUsesCountsEveryLiveEdgeInOrder) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> vertex(0, 40);
+  std::vector<Triangle> triangles;
+  std::vector<char> alive;
+  while (triangles.size() < 300) {
+    const Triangle t{vertex(rng), vertex(rng), vertex(rng)};
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    triangles.push_back(t);
+    alive.push_back(rng() % 4 != 0);
+  }
+  std::map<std::pair<int, int>, int> expected;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    if (!alive[t]) continue;
+    for (int k = 0; k < 3; ++k) {
+      ++expected[std::minmax(triangles[t][k], triangles[t][(k + 1) % 3])];
+    }
+  }
+  const auto uses = EdgeUses(triangles, alive);
+  ASSERT_EQ(uses.size(), expected.size());
+  size_t i = 0;
+  for (const auto& [edge, count] : expected) {
+    EXPECT_EQ(uses[i].first, edge);
+    EXPECT_EQ(uses[i].second, count);
+    ++i;
+  }
+  EXPECT_TRUE(EdgeUses(triangles, std::vector<char>(triangles.size(), 0)).empty());
 }
 
 TEST(ComeshTopologyTest, FlipsLongDiagonalsOfAShearedGridInAllShapes) {
