@@ -669,9 +669,9 @@ extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* ld
 
 // CHOLMOD's OpenMP regions run on the calling thread. Debian's CHOLMOD (SuiteSparse 5.12, built
 // with OpenMP) opens parallel regions inside the supernodal factorization, per supernode (copying
-// A into it, clearing and scattering), each with a fixed team of CHOLMOD_OMP_NUM_THREADS = 4
-// threads (the compiled call passes 4 whenever the region's size test holds, so OMP_NUM_THREADS
-// does not change it). On a 2-core machine where our own threads already factor the two shapes
+// A into it, clearing and scattering), each with a fixed team of 4 threads (the compiled call
+// passes 3 * test + 1 as the team size, the test being the region's size condition, so
+// OMP_NUM_THREADS does not change it). On a 2-core machine where our own threads already factor the two shapes
 // of a comesh concurrently, those teams oversubscribe the cores, and even a team of one costs a
 // futex system call per region (libgomp's barrier): measured on S-Table 2's 35k row
 // (docs/benchmarks.md, sixth session). The executable defines GOMP_parallel, the libgomp entry
