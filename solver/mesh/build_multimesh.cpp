@@ -21,6 +21,7 @@
 #include "solver/mesh/refine_boundary_fans.h"
 #include "solver/mesh/split_boundary_chords.h"
 #include "solver/mesh/validate.h"
+#include "solver/mesh/vertex_order.h"
 
 namespace inbetween::solver {
 namespace {
@@ -509,6 +510,10 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     }
   }
   if (mesh.cohesive_edges.empty()) mesh.cohesive_closed.clear();
+
+  // Vertices along a Hilbert curve of the first shape: every later stage loops over triangles
+  // and gathers their corners (vertex_order.h).
+  RenumberSpatially(&mesh);
 
   notify("validate", 0.95, absl::StrCat(mesh.num_vertices(), " vertices"));
   if (absl::Status valid = ValidateMultimesh(mesh); !valid.ok()) {
