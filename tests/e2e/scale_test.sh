@@ -40,10 +40,12 @@ for sid in "${SESSIONS[@]}"; do
   [[ $serving -eq 1 ]] || { echo "session $sid was served by $serving replicas"; exit 1; }
 done
 
-# The long stream: walk, 1200 frames (~20 MB of frames, far more than the buffers between the
-# replica and a paused CLI hold).
+# The long stream: walk, 6000 frames (~15 MB: 154 vertices, 2.5 kB per frame message), far more
+# than the buffers between the replica and a paused CLI hold. (1200 frames, ~3 MB, sometimes fit:
+# the replica had sent everything before it was killed and nothing was resumed.)
 WALK=("$INBETWEEN_SRC"/examples/walk/0[1-8]_*.svg)
-LONG=(animate "${WALK[@]}" --frames 1200 --format json)
+FRAMES=6000
+LONG=(animate "${WALK[@]}" --frames "$FRAMES" --format json)
 cli -q "${LONG[@]}" --out "$WORK/reference" >"$WORK/reference.out"
 SESSIONS+=("$(session_of "$WORK/reference.out")")
 
@@ -93,8 +95,8 @@ chaos_try() {
     fi
     cat "$err"; echo "round $r: no mid-stream resume reported"; return 1
   fi
-  [[ "$resume" -gt 0 && "$resume" -lt 1200 ]] || { echo "round $r: resumed at $resume"; return 1; }
-  echo "round $r: resumed at frame $resume on another replica; 1200 frames identical"
+  [[ "$resume" -gt 0 && "$resume" -lt "$FRAMES" ]] || { echo "round $r: resumed at $resume"; return 1; }
+  echo "round $r: resumed at frame $resume on another replica; $FRAMES frames identical"
   rm -rf "$out"
 }
 chaos_round() {
