@@ -2,8 +2,10 @@
 // inbetweening solver and the mapping loop over triangles and gather their corners' positions;
 // with the mesher's numbering (insertion order) a triangle's corners lie anywhere in memory (mean
 // index distance along an edge ~ n / 4 on the S-Table 2 meshes), with a Hilbert numbering a few
-// hundred. Measured on the 73k-vertex S-Table 2 row: ~20-30% less time per optimizer iteration
-// (docs/benchmarks.md, seventh session).
+// hundred. Measured on the 311k-vertex S-Table 2 row (one run each): Hessian set-up 20%, step
+// bound 33% and topology passes 40% less time, per iteration 16% less overall; at 35k-73k the
+// set-up and topology gains remain and the rest is within noise (docs/benchmarks.md, seventh
+// session).
 #pragma once
 
 #include <vector>

@@ -20,6 +20,9 @@ struct ComeshBenchArgs {
   int max_vertices = 40000;
   int min_vertices = 0;  // rows below it are skipped (e.g. to run the 311k row alone)
   std::string cache_dir;  // comesh-scaling: built multimeshes kept here and reused (--cache DIR)
+  // comesh-scaling: use a cached multimesh in its stored numbering instead of renumbering it along
+  // the Hilbert curve as BuildMultimesh does now (--cache-order; for comparing the two).
+  bool cache_order = false;
   std::string json_path;
   bool verbose = false;
   int repeat = 5;  // runs shorter than a second are repeated; the median time is reported
@@ -45,7 +48,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
                  "[--verbose] [--malloc-defaults] [--json FILE]\n",
                  argv[0],
                  with_max_vertices
-                     ? "[--max-vertices N] [--min-vertices N] [--cache DIR] [--cancel-trials N] "
+                     ? "[--max-vertices N] [--min-vertices N] [--cache DIR] [--cache-order] "
+                       "[--cancel-trials N] "
                      : "");
     std::exit(2);
   };
@@ -60,6 +64,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.cancel_trials = std::max(0, std::atoi(next()));
     } else if (a == "--cache" && with_max_vertices) {
       args.cache_dir = next();
+    } else if (a == "--cache-order" && with_max_vertices) {
+      args.cache_order = true;
     } else if (a == "--json") {
       args.json_path = next();
     } else if (a == "--threads") {

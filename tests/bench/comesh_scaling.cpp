@@ -5,9 +5,11 @@
 // beside the paper's and the ratio paper_seconds / seconds; --json FILE writes the rows.
 //
 // --cache DIR keeps each row's multimesh in DIR (CBOR) and reuses it on the next run: the 311k
-// row's multimesh takes far longer to build than to optimize.
+// row's multimesh takes far longer to build than to optimize. A cached multimesh is renumbered
+// along the Hilbert curve as BuildMultimesh numbers it (caches from before that change hold the
+// mesher's order); --cache-order keeps the stored order, for comparing the two.
 //
-//   comesh_scaling [--max-vertices N] [--min-vertices N] [--cache DIR]
+//   comesh_scaling [--max-vertices N] [--min-vertices N] [--cache DIR] [--cache-order]
 //                  [common options: comesh_bench_common.h]
 #include <algorithm>
 #include <chrono>
@@ -151,7 +153,7 @@ int main(int argc, char** argv) {
       mesh = LoadMultimesh(cached);
       // Caches written before BuildMultimesh numbered vertices along a Hilbert curve hold the
       // mesher's numbering; renumbering is idempotent, so this gives what a fresh build gives.
-      if (mesh.ok()) sv::RenumberSpatially(&*mesh);
+      if (mesh.ok() && !args.cache_order) sv::RenumberSpatially(&*mesh);
     }
     double request = paper.before;
     for (int attempt = 0; attempt < 4 && !mesh.ok(); ++attempt) {
