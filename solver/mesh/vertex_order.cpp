@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <utility>
 
 namespace inbetween::solver {
@@ -36,7 +37,8 @@ std::vector<int> HilbertOrder(const Points& points) {
   const int n = static_cast<int>(points.size());
   std::vector<int> to(n);
   if (n == 0) return to;
-  Point lo = points[0], hi = points[0];
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Point lo(kInf, kInf), hi(-kInf, -kInf);  // over the finite points (none: every cell is 0)
   for (const Point& p : points) {
     if (!p.allFinite()) continue;
     lo = lo.cwiseMin(p);
@@ -49,8 +51,8 @@ std::vector<int> HilbertOrder(const Points& points) {
   };
   std::vector<std::pair<uint64_t, int>> key(n);
   for (int v = 0; v < n; ++v) {
-    key[v] = {HilbertIndex(cell(points[v].x(), lo.x(), hi.x()), cell(points[v].y(), lo.y(), hi.y())),
-              v};
+    key[v] = {
+        HilbertIndex(cell(points[v].x(), lo.x(), hi.x()), cell(points[v].y(), lo.y(), hi.y())), v};
   }
   std::sort(key.begin(), key.end());
   for (int k = 0; k < n; ++k) to[key[k].second] = k;

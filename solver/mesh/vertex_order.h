@@ -1,12 +1,11 @@
-// Vertex numbering along a Hilbert curve, for memory locality. The comesh optimizer, the
-// inbetweening solver and the mapping loop over triangles and gather their corners' positions;
-// with the mesher's numbering (insertion order) a triangle's corners lie anywhere in memory (mean
-// index distance along an edge ~ n / 4 on the S-Table 2 meshes), with a Hilbert numbering a few
-// hundred. Measured on the 311k-vertex S-Table 2 row (one run each): Hessian set-up 20%, step
-// bound 33% and topology passes 40% less time, 16% less in total (270 inner iterations against
-// 260: the iteration counts move with the numbering); at 35k-73k the
-// set-up and topology gains remain and the rest is within noise (docs/benchmarks.md, seventh
-// session).
+// Vertex numbering along a Hilbert curve, for memory locality. The comesh optimizer and the
+// inbetweening solver loop over triangles and gather their corners' positions; with the mesher's
+// numbering (insertion order) a triangle's corners lie anywhere in memory (mean index distance
+// along an edge ~ n / 4 on the S-Table 2 meshes), with a Hilbert numbering a few hundred.
+// Measured on the 311k-vertex S-Table 2 row (one run each): Hessian set-up 20%, step bound 33%
+// and topology passes 40% less time, 16% less in total (270 inner iterations against 260: the
+// iteration counts move with the numbering); at 35k-73k the set-up and topology gains remain and
+// the rest is within noise (docs/benchmarks.md, seventh session).
 #pragma once
 
 #include <vector>

@@ -18,7 +18,7 @@ namespace inbetween::bench {
 
 struct ComeshBenchArgs {
   int max_vertices = 40000;
-  int min_vertices = 0;  // rows below it are skipped (e.g. to run the 311k row alone)
+  int min_vertices = 0;   // rows below it are skipped (e.g. to run the 311k row alone)
   std::string cache_dir;  // comesh-scaling: built multimeshes kept here and reused (--cache DIR)
   // comesh-scaling: use a cached multimesh in its stored numbering instead of renumbering it along
   // the Hilbert curve as BuildMultimesh does now (--cache-order; for comparing the two).

@@ -115,7 +115,8 @@ std::vector<double> CancelLatencies(const sv::Multimesh& mesh, const sv::ComeshO
       cancelled_at = Clock::now();
       token.Cancel();
     });
-    const absl::StatusOr<sv::Multimesh> out = sv::OptimizeComesh(mesh, options, &token, nullptr, nullptr, nullptr);
+    const absl::StatusOr<sv::Multimesh> out =
+        sv::OptimizeComesh(mesh, options, &token, nullptr, nullptr, nullptr);
     const Clock::time_point returned = Clock::now();
     canceller.join();
     if (absl::IsCancelled(out.status())) {
@@ -157,8 +158,8 @@ int main(int argc, char** argv) {
     }
     double request = paper.before;
     for (int attempt = 0; attempt < 4 && !mesh.ok(); ++attempt) {
-      const auto size = sv::testing::SizeFor(static_cast<int>(std::lround(request)), 4.0,
-                                             std::sqrt(2.0), 1.0);
+      const auto size =
+          sv::testing::SizeFor(static_cast<int>(std::lround(request)), 4.0, std::sqrt(2.0), 1.0);
       sv::MultimeshOptions mesh_options;
       mesh_options.boundary_vertices = size.boundary_vertices;
       mesh_options.max_edge_relative = size.max_edge_relative;
@@ -194,12 +195,13 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     nlohmann::json row = inbetween::bench::ComeshRow(name, r, paper.seconds);
     if (args.cancel_trials > 0) {
-      const std::vector<double> latency = CancelLatencies(*mesh, options, r.seconds,
-                                                          args.cancel_trials);
+      const std::vector<double> latency =
+          CancelLatencies(*mesh, options, r.seconds, args.cancel_trials);
       if (!latency.empty()) {
-        std::printf("  cancellation: %zu of %d trials cancelled; latency p50 %.1f ms, max %.1f ms\n",
-                    latency.size(), args.cancel_trials, 1e3 * latency[latency.size() / 2],
-                    1e3 * latency.back());
+        std::printf(
+            "  cancellation: %zu of %d trials cancelled; latency p50 %.1f ms, max %.1f ms\n",
+            latency.size(), args.cancel_trials, 1e3 * latency[latency.size() / 2],
+            1e3 * latency.back());
         row["cancel_trials"] = latency.size();
         row["cancel_latency_p50_ms"] = 1e3 * latency[latency.size() / 2];
         row["cancel_latency_max_ms"] = 1e3 * latency.back();

@@ -108,9 +108,10 @@ TEST(VertexOrderTest, HilbertOrderIsAPermutationAndIdempotent) {
 TEST(VertexOrderTest, RenumberKeepsTheMultimeshAndBringsCornersClose) {
   Multimesh mesh = ShuffledGrid(60, 5);
   mesh.cohesive_edges = {{mesh.boundary[0], mesh.boundary[1], mesh.boundary[3], mesh.boundary[2]}};
-  ASSERT_TRUE(ValidateMultimesh(Multimesh{mesh.triangles, mesh.shapes, mesh.boundary, {},
-                                          mesh.boundary_loops, {}})
-                  .ok());
+  ASSERT_TRUE(
+      ValidateMultimesh(
+          Multimesh{mesh.triangles, mesh.shapes, mesh.boundary, {}, mesh.boundary_loops, {}})
+          .ok());
   const Multimesh before = mesh;
   RenumberSpatially(&mesh);
   for (int s = 0; s < 2; ++s) {
