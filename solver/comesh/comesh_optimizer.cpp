@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -308,8 +309,8 @@ class InitialHessian {
     return h;
   }
 
-  // H0 g (without 1 / beta).
-  VectorXd ApplyInverse(const VectorXd& g) const {
+  // H0 g (without 1 / beta); an empty vector if `cancel` was set during the solve.
+  VectorXd ApplyInverse(const VectorXd& g, const CancelToken* cancel) const {
     if (!use_laplacian_) return g;
     const Layout& layout = *layout_;
     const int num_shapes = layout.num_shapes();
@@ -332,10 +333,8 @@ class InitialHessian {
       rhs(c, 2 * var.shape) = lifted.x();
       rhs(c, 2 * var.shape + 1) = lifted.y();
     }
-    if (size_ > 0) {
-      absl::StatusOr<Eigen::MatrixXd> sol = solver_->Solve(rhs);
-      if (sol.ok()) rhs = *std::move(sol);  // cannot fail after a successful factorization
-    }
+    // Fails only when cancelled, after a successful factorization.
+    if (size_ > 0 && !solver_->SolveInPlace(&rhs, 1, cancel).ok()) return VectorXd();
     for (const Layout::Var& var : layout.vars()) {
       const int c = compact_[var.vertex];
       if (c < 0) continue;
@@ -507,16 +506,22 @@ class HessianPreconditioner {
     return Refactor(shapes, false, cancel);
   }
 
-  VectorXd ApplyInverse(const VectorXd& g) const {
+  // H0 g; an empty vector if `cancel` was set during the solves (each shape's solve polls it).
+  VectorXd ApplyInverse(const VectorXd& g, const CancelToken* cancel) const {
     VectorXd x = g;
+    std::atomic<bool> cancelled{false};
     ForEachShape([&](int s) {
       const int size = begin_[s + 1] - begin_[s];
       if (size == 0) return;
       Eigen::MatrixXd part = x.segment(begin_[s], size);
-      (void)blocks_[s].solver->SolveInPlace(&part);  // cannot fail after a factorization
+      // Fails only when cancelled, after a successful factorization.
+      if (!blocks_[s].solver->SolveInPlace(&part, 1, cancel).ok()) {
+        cancelled = true;
+        return;
+      }
       x.segment(begin_[s], size) = part.col(0);
     });
-    return x;
+    return cancelled ? VectorXd() : x;
   }
   VectorXd Apply(const VectorXd& x) const {
     VectorXd out(x.size());
@@ -812,7 +817,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     laplacian.emplace(*std::move(h));
   }
   auto apply_inverse = [&](const VectorXd& v) {
-    return hessian ? hessian->ApplyInverse(v) : laplacian->ApplyInverse(v);
+    return hessian ? hessian->ApplyInverse(v, cancel) : laplacian->ApplyInverse(v, cancel);
   };
   auto apply = [&](const VectorXd& v) { return hessian ? hessian->Apply(v) : laplacian->Apply(v); };
   stats->phases.hessian += clock.Lap();
@@ -857,18 +862,25 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
         alpha[i] = pairs[i].rho * pairs[i].s.dot(q);
         q -= alpha[i] * pairs[i].y;
       }
-      VectorXd r = apply_inverse(q) / beta;
+      VectorXd r = apply_inverse(q);
+      if (r.size() == 0) return r;  // cancelled
+      r /= beta;
       for (size_t i = 0; i < pairs.size(); ++i) {
         const double b = pairs[i].rho * pairs[i].y.dot(r);
         r += (alpha[i] - b) * pairs[i].s;
       }
       return VectorXd(-r);
     };
+    // Besides the top of the loop and the line search's trials, the token is polled inside the
+    // direction's solves and after each phase below: at 165k vertices the direction, curing,
+    // step bound and first trial took up to ~150 ms between two polls.
     VectorXd d = direction();
+    if (d.size() == 0) return cancelled_at(iter);
     double slope = g.dot(d);
     if (!(slope < 0.0)) {  // lost descent (non-convexity): restart from the preconditioned gradient
       pairs.clear();
       d = direction();
+      if (d.size() == 0) return cancelled_at(iter);
       slope = g.dot(d);
       if (!(slope < 0.0)) {
         d = -g;
@@ -876,6 +888,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       }
     }
     stats->phases.direction += clock.Lap();
+    if (Cancelled(cancel)) return cancelled_at(iter);
     // disp: d as per-vertex displacements; CureDirection leaves those of the uncured d there.
     bool disp_is_d = false;
     if (options.cure) {
@@ -892,6 +905,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       }
     }
 
+    if (Cancelled(cancel)) return cancelled_at(iter);
     // Inversion-free backtracking line search.
     if (!disp_is_d) layout.Displacements(d, &disp);
     const double max_step =
@@ -902,8 +916,8 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     double f_new = f;
     VectorXd z_new;
     for (int b = 0; b <= options.max_backtracks; ++b) {
-      // Every trial is an energy evaluation (15 ms at 73k vertices): poll between them too.
-      if (b > 0 && Cancelled(cancel)) return cancelled_at(iter);
+      // Every trial is an energy evaluation (15 ms at 73k vertices): poll before each.
+      if (Cancelled(cancel)) return cancelled_at(iter);
       z_new = z + step * d;
       layout.Scatter(z_new, &trial);
       f_new = objective->Evaluate(trial, &trial_grad, &trial_energies);
@@ -934,7 +948,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     if (sy > 1e-12 * p.s.norm() * p.y.norm() && options.history > 0) {
       const VectorXd b0s = apply(p.s);
       if (options.scaling_by_inverse) {
-        beta = p.y.dot(apply_inverse(p.y)) / sy;
+        const VectorXd hy = apply_inverse(p.y);
+        if (hy.size() == 0) return cancelled_at(iter);
+        beta = p.y.dot(hy) / sy;
       } else {
         beta = sy / p.s.dot(b0s);
       }

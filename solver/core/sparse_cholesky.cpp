@@ -10,6 +10,7 @@
 #include <sys/mman.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -60,19 +61,18 @@ struct SparseCholesky::Impl {
   // The simplicial numeric factorization in row blocks of kCancelRows, polling `cancel` between
   // blocks: 1 on success (check common.status), 0 on a CHOLMOD error, -1 if cancelled.
   int FactorizeSimplicialInBlocks(cholmod_sparse* a, const CancelToken& cancel);
+  // The substitutions poll `cancel` (may be null) every kSolveCancelStride columns of L (simplicial)
+  // or supernodes and return false, y half solved, once it is set; true when done.
   template <int kColumns>
-  void Substitute(double* y, int columns) const;
+  bool Substitute(double* y, int columns, const CancelToken* cancel) const;
   template <int kColumns>
-  void SubstituteSupernodal(double* y, int columns, double* below) const;
+  bool SubstituteSupernodal(double* y, int columns, double* below, const CancelToken* cancel) const;
   // Solves in place for `columns` interleaved right-hand sides in the permuted order. `below`:
   // max_below x columns values of scratch (supernodal factors only).
   template <int kColumns>
-  void SolvePermuted(double* y, int columns, double* below) const {
-    if (super != nullptr) {
-      SubstituteSupernodal<kColumns>(y, columns, below);
-    } else {
-      Substitute<kColumns>(y, columns);
-    }
+  bool SolvePermuted(double* y, int columns, double* below, const CancelToken* cancel) const {
+    if (super != nullptr) return SubstituteSupernodal<kColumns>(y, columns, below, cancel);
+    return Substitute<kColumns>(y, columns, cancel);
   }
 
   explicit Impl(Method method);
@@ -112,9 +112,11 @@ void SparseCholesky::Impl::Extract() {
 // so the inner loops run over contiguous memory); no BLAS, so solves on several threads never
 // contend. `below`: scratch of max_below x columns values.
 template <int kColumns>
-void SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* below) const {
+bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* below,
+                                                const CancelToken* cancel) const {
   const int c = kColumns > 0 ? kColumns : columns;
   for (int s = 0; s < nsuper; ++s) {  // L z = y
+    if (s % kSolveCancelStride == 0 && Cancelled(cancel)) return false;
     const int k1 = super[s], nscol = super[s + 1] - k1;
     const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
     const int* rows = s_i + s_pi[s] + nscol;
@@ -140,6 +142,7 @@ void SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
     }
   }
   for (int s = nsuper - 1; s >= 0; --s) {  // L^T x = z
+    if (s % kSolveCancelStride == 0 && Cancelled(cancel)) return false;
     const int k1 = super[s], nscol = super[s + 1] - k1;
     const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
     const int* rows = s_i + s_pi[s] + nscol;
@@ -161,13 +164,15 @@ void SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
       }
     }
   }
+  return true;
 }
 
 // y: n rows of `columns` interleaved values (kColumns == columns, or 0 for any count).
 template <int kColumns>
-void SparseCholesky::Impl::Substitute(double* y, int columns) const {
+bool SparseCholesky::Impl::Substitute(double* y, int columns, const CancelToken* cancel) const {
   const int c = kColumns > 0 ? kColumns : columns;
   for (int j = 0; j < n; ++j) {  // L z = y, column oriented
+    if (j % kSolveCancelStride == 0 && Cancelled(cancel)) return false;
     const double* yj = y + static_cast<size_t>(j) * c;
     const int end = l_p[j] + l_nz[j];
     for (int k = l_p[j] + 1; k < end; ++k) {
@@ -181,6 +186,7 @@ void SparseCholesky::Impl::Substitute(double* y, int columns) const {
     for (int q = 0; q < c; ++q) y[static_cast<size_t>(j) * c + q] *= inv;
   }
   for (int j = n - 1; j >= 0; --j) {  // L^T x = z, dot products with L's columns
+    if (j % kSolveCancelStride == 0 && Cancelled(cancel)) return false;
     double* yj = y + static_cast<size_t>(j) * c;
     const int end = l_p[j] + l_nz[j];
     for (int k = l_p[j] + 1; k < end; ++k) {
@@ -189,6 +195,7 @@ void SparseCholesky::Impl::Substitute(double* y, int columns) const {
       for (int q = 0; q < c; ++q) yj[q] -= l * yi[q];
     }
   }
+  return true;
 }
 
 namespace {
@@ -575,13 +582,18 @@ absl::Status SparseCholesky::Compute(const Eigen::SparseMatrix<double>& a) {
   return Factorize(a);
 }
 
+namespace {
+absl::Status SolveCancelled() { return absl::CancelledError("SparseCholesky: solve cancelled"); }
+}  // namespace
+
 absl::StatusOr<Eigen::MatrixXd> SparseCholesky::Solve(const Eigen::MatrixXd& b) const {
   Eigen::MatrixXd x = b;
   if (absl::Status s = SolveInPlace(&x); !s.ok()) return s;
   return x;
 }
 
-absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const {
+absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads,
+                                          const CancelToken* cancel) const {
   const Impl& m = *impl_;
   if (!m.factorized) {
     return absl::FailedPreconditionError("SparseCholesky: Solve before a successful Factorize");
@@ -600,12 +612,17 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
   m.supernode_work.resize(static_cast<size_t>(m.max_below) * std::max(workers, c));
   if (workers > 1 && m.n >= kParallelRows) {
     // Column q in its own contiguous block of `work`, columns dealt round-robin to the workers.
+    std::atomic<bool> stopped{false};
     auto run = [&](int worker) {
       for (int q = worker; q < c; q += workers) {
         double* yq = y + static_cast<size_t>(q) * m.n;
         for (int k = 0; k < m.n; ++k) yq[k] = (*b)(m.perm[k], q);
-        m.SolvePermuted<1>(yq, 1,
-                           m.supernode_work.data() + static_cast<size_t>(worker) * m.max_below);
+        if (!m.SolvePermuted<1>(
+                yq, 1, m.supernode_work.data() + static_cast<size_t>(worker) * m.max_below,
+                cancel)) {
+          stopped = true;
+          return;
+        }
         for (int k = 0; k < m.n; ++k) (*b)(m.perm[k], q) = yq[k];
       }
     };
@@ -613,21 +630,23 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads) const
     for (int w = 1; w < workers; ++w) pool.emplace_back(run, w);
     run(0);
     for (std::thread& t : pool) t.join();
-    return absl::OkStatus();
+    return stopped ? SolveCancelled() : absl::OkStatus();
   }
   for (int k = 0; k < m.n; ++k) {
     for (int q = 0; q < c; ++q) y[static_cast<size_t>(k) * c + q] = (*b)(m.perm[k], q);
   }
+  bool done;
   switch (c) {
     case 1:
-      m.SolvePermuted<1>(y, c, m.supernode_work.data());
+      done = m.SolvePermuted<1>(y, c, m.supernode_work.data(), cancel);
       break;
     case 2:
-      m.SolvePermuted<2>(y, c, m.supernode_work.data());
+      done = m.SolvePermuted<2>(y, c, m.supernode_work.data(), cancel);
       break;
     default:
-      m.SolvePermuted<0>(y, c, m.supernode_work.data());
+      done = m.SolvePermuted<0>(y, c, m.supernode_work.data(), cancel);
   }
+  if (!done) return SolveCancelled();
   for (int k = 0; k < m.n; ++k) {
     for (int q = 0; q < c; ++q) (*b)(m.perm[k], q) = y[static_cast<size_t>(k) * c + q];
   }

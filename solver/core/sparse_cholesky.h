@@ -77,8 +77,13 @@ class SparseCholesky {
   // least kParallelRows rows, the columns are substituted separately on up to `threads` threads;
   // each column sees the same operations in the same order either way, so the result is
   // bit-identical for every thread count (supernodal factors too).
-  absl::Status SolveInPlace(Eigen::MatrixXd* b, int threads = 1) const;
+  // With a `cancel` token the substitutions poll it every kSolveCancelStride columns of L
+  // (simplicial) or supernodes and answer CANCELLED soon after it is set, leaving *b partly
+  // solved (a 2x311k-unknown comesh direction solve takes ~0.2 s, more than a cancel may wait).
+  absl::Status SolveInPlace(Eigen::MatrixXd* b, int threads = 1,
+                            const CancelToken* cancel = nullptr) const;
   static constexpr int kParallelRows = 8192;
+  static constexpr int kSolveCancelStride = 256;
 
   int rows() const;
   bool factorized() const;

@@ -265,6 +265,42 @@ TEST(SparseCholeskyTest, CancelledFactorizationAnswersCancelledAndCanBeRedone) {
             absl::StatusCode::kFailedPrecondition);
 }
 
+// A set token stops the substitutions (simplicial and supernodal, one column or several on two
+// threads) with CANCELLED; the factor is untouched, so the next solve is right, and a token that
+// is never set changes no bit of the result.
+TEST(SparseCholeskyTest, CancelledSolveAnswersCancelledAndTheFactorStaysUsable) {
+  for (const bool large : {false, true}) {
+    SCOPED_TRACE(large ? "supernodal" : "simplicial");
+    const Eigen::SparseMatrix<double> a = large ? GridMatrix(100, 1e-3, 1.0, 3) : GridMatrix(30, 0.1);
+    SparseCholesky chol(SparseCholesky::Method::kAuto);
+    ASSERT_TRUE(chol.Compute(a).ok());
+    ASSERT_EQ(chol.supernodal(), large);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Eigen::MatrixXd b(a.rows(), 2);
+    for (Eigen::Index k = 0; k < b.size(); ++k) b.data()[k] = u(rng);
+    Eigen::MatrixXd reference = b;
+    ASSERT_TRUE(chol.SolveInPlace(&reference).ok());
+
+    CancelToken unset;
+    Eigen::MatrixXd x = b;
+    ASSERT_TRUE(chol.SolveInPlace(&x, 2, &unset).ok());
+    EXPECT_EQ(x, reference);
+
+    CancelToken cancel;
+    cancel.Cancel();
+    for (const int threads : {1, 2}) {
+      Eigen::MatrixXd two = b, one = b.col(0);
+      EXPECT_EQ(chol.SolveInPlace(&two, threads, &cancel).code(), absl::StatusCode::kCancelled);
+      EXPECT_EQ(chol.SolveInPlace(&one, threads, &cancel).code(), absl::StatusCode::kCancelled);
+    }
+    x = b;
+    ASSERT_TRUE(chol.SolveInPlace(&x).ok());
+    EXPECT_EQ(x, reference);
+    EXPECT_LT((a * x - b).cwiseAbs().maxCoeff(), 1e-9);
+  }
+}
+
 // A caller's ordering (here AMD of a coarser graph expanded, as the comesh Hessian does, and the
 // reverse order) gives a correct factor; a non-permutation is refused.
 TEST(SparseCholeskyTest, AnalyzesWithAGivenOrdering) {
