@@ -106,6 +106,11 @@ struct ComeshOptions {
   double armijo = 1e-4;             // sufficient decrease constant c1
   int max_backtracks = 50;
   int threads = 0;  // <= 0: hardware concurrency; results do not depend on it
+  // Hessian blocks of at least this many unknowns are analysed (AMD + CHOLMOD's symbolic
+  // analysis, single library calls of up to ~1 s at 311k vertices) on a helper thread that a
+  // cancel leaves to finish on its own (RunCancellable); <= 0: always on the calling thread.
+  // Results do not depend on it.
+  int background_analysis_unknowns = 65536;
   // Outer topology loop: 0 = inner loop only (topology and vertex count unchanged).
   int max_outer = 30;
   double outer_tolerance = 1e-4;    // stop when a pass (or pass + short run) gains less
@@ -168,8 +173,13 @@ struct ComeshReport {
 
 // Optimizes every shape of `mesh` (positions, and with max_outer > 0 the shared topology).
 // InvalidArgument if the multimesh is inconsistent or a triangle is inverted or degenerate in
-// some shape (the message names shape and triangle); Cancelled if `cancel` fires (checked every
-// iteration). `progress` (may be empty) is called once per iteration; `report` may be null.
+// some shape (the message names shape and triangle); Cancelled if `cancel` fires: polled
+// between every phase of an iteration, inside the direction's solves and the line search,
+// inside the set-up's loops and factorizations and before every topology operation; the symbolic
+// analysis of a large Hessian block runs on a helper thread that a cancel leaves behind
+// (RunCancellable), so the call returns within ~0.1 s of the cancel at every S-Table 2 size
+// (docs/benchmarks.md). `progress` (may be empty) is called once per iteration; `report` may be
+// null.
 // The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are remapped to
 // the compacted vertex numbering. `resume` (may be null): continue from a checkpoint that a run
 // on the same `mesh` with the same options reported (InvalidArgument if its multimesh is not

@@ -53,16 +53,16 @@ struct SparseCholesky::Impl {
   const int* s_pi = nullptr;
   const int* s_px = nullptr;
   const int* s_i = nullptr;
-  int max_below = 0;                 // most rows below a supernode's diagonal block
-  mutable std::vector<double> work;  // interleaved right-hand sides, n x columns
+  int max_below = 0;                           // most rows below a supernode's diagonal block
+  mutable std::vector<double> work;            // interleaved right-hand sides, n x columns
   mutable std::vector<double> supernode_work;  // SubstituteSupernodal's scratch
 
   void Extract();
   // The simplicial numeric factorization in row blocks of kCancelRows, polling `cancel` between
   // blocks: 1 on success (check common.status), 0 on a CHOLMOD error, -1 if cancelled.
   int FactorizeSimplicialInBlocks(cholmod_sparse* a, const CancelToken& cancel);
-  // The substitutions poll `cancel` (may be null) every kSolveCancelStride columns of L (simplicial)
-  // or supernodes and return false, y half solved, once it is set; true when done.
+  // The substitutions poll `cancel` (may be null) every kSolveCancelStride columns of L
+  // (simplicial) or supernodes and return false, y half solved, once it is set; true when done.
   template <int kColumns>
   bool Substitute(double* y, int columns, const CancelToken* cancel) const;
   template <int kColumns>
@@ -506,8 +506,8 @@ int SparseCholesky::Impl::FactorizeSimplicialInBlocks(cholmod_sparse* a,
   // S = triu(P A P^T): two permuted transposes, as cholmod_factorize_p does for stype > 0.
   cholmod_sparse* s = a;
   if (factor->ordering != CHOLMOD_NATURAL) {
-    cholmod_sparse* lower = cholmod_ptranspose(a, 2, static_cast<int*>(factor->Perm), nullptr, 0,
-                                               &common);
+    cholmod_sparse* lower =
+        cholmod_ptranspose(a, 2, static_cast<int*>(factor->Perm), nullptr, 0, &common);
     if (lower == nullptr) return 0;
     s = cholmod_ptranspose(lower, 2, nullptr, nullptr, 0, &common);
     cholmod_free_sparse(&lower, &common);
@@ -531,8 +531,7 @@ int SparseCholesky::Impl::FactorizeSimplicialInBlocks(cholmod_sparse* a,
       break;
     }
     const int end = std::min(rows, k + kCancelRows);
-    if (!cholmod_rowfac(s, nullptr, beta, k, end, factor, &common) ||
-        common.status < CHOLMOD_OK) {
+    if (!cholmod_rowfac(s, nullptr, beta, k, end, factor, &common) || common.status < CHOLMOD_OK) {
       result = 0;
       break;
     }
@@ -617,9 +616,9 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads,
       for (int q = worker; q < c; q += workers) {
         double* yq = y + static_cast<size_t>(q) * m.n;
         for (int k = 0; k < m.n; ++k) yq[k] = (*b)(m.perm[k], q);
-        if (!m.SolvePermuted<1>(
-                yq, 1, m.supernode_work.data() + static_cast<size_t>(worker) * m.max_below,
-                cancel)) {
+        if (!m.SolvePermuted<1>(yq, 1,
+                                m.supernode_work.data() + static_cast<size_t>(worker) * m.max_below,
+                                cancel)) {
           stopped = true;
           return;
         }
@@ -690,9 +689,9 @@ extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* ld
 // with OpenMP) opens parallel regions inside the supernodal factorization, per supernode (copying
 // A into it, clearing and scattering), each with a fixed team of 4 threads (the compiled call
 // passes 3 * test + 1 as the team size, the test being the region's size condition, so
-// OMP_NUM_THREADS does not change it). On a 2-core machine where our own threads already factor the two shapes
-// of a comesh concurrently, those teams oversubscribe the cores, and even a team of one costs a
-// futex system call per region (libgomp's barrier): measured on S-Table 2's 35k row
+// OMP_NUM_THREADS does not change it). On a 2-core machine where our own threads already factor the
+// two shapes of a comesh concurrently, those teams oversubscribe the cores, and even a team of one
+// costs a futex system call per region (libgomp's barrier): measured on S-Table 2's 35k row
 // (docs/benchmarks.md, sixth session). The executable defines GOMP_parallel, the libgomp entry
 // point gcc compiles `#pragma omp parallel` to (the dynamic linker binds CHOLMOD's calls to this
 // definition, as for dpotrf_ above), and runs the region's body once on the calling thread, as

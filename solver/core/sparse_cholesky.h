@@ -9,15 +9,15 @@
 //
 // Method::kAuto lets CHOLMOD choose a supernodal LL^T factor when the matrix is large enough for
 // dense kernels to pay (flops / nnz(L) >= 100; CHOLMOD's own switch is 40, but our simplicial
-// substitutions were faster below 100 on the comesh Hessians; else the same simplicial factor): a supernodal factorization runs on BLAS (scripts/setup installs Debian's OpenBLAS,
-// pthread build, which SparseCholesky sets to one thread), measured 2.6 s against 70 s simplicial
-// for a 320k-unknown planar mesh matrix (docs/benchmarks.md). Its solves are our own
-// substitutions over the supernodes' dense blocks (no BLAS: solves on several threads never
-// contend for OpenBLAS's buffer lock). Single-threaded BLAS and a fixed ordering keep
-// the result bit-identical run to run on one machine. Objects on different threads factor and
-// solve concurrently (with a non-reentrant BLAS, the serial OpenBLAS, those calls are serialized).
-// CHOLMOD's own OpenMP regions run on the calling thread (see GOMP_parallel in the .cpp): a
-// factorization never starts threads of its own.
+// substitutions were faster below 100 on the comesh Hessians; else the same simplicial factor): a
+// supernodal factorization runs on BLAS (scripts/setup installs Debian's OpenBLAS, pthread build,
+// which SparseCholesky sets to one thread), measured 2.6 s against 70 s simplicial for a
+// 320k-unknown planar mesh matrix (docs/benchmarks.md). Its solves are our own substitutions over
+// the supernodes' dense blocks (no BLAS: solves on several threads never contend for OpenBLAS's
+// buffer lock). Single-threaded BLAS and a fixed ordering keep the result bit-identical run to run
+// on one machine. Objects on different threads factor and solve concurrently (with a non-reentrant
+// BLAS, the serial OpenBLAS, those calls are serialized). CHOLMOD's own OpenMP regions run on the
+// calling thread (see GOMP_parallel in the .cpp): a factorization never starts threads of its own.
 #pragma once
 
 #include <Eigen/Core>

@@ -111,8 +111,7 @@ void HammerStore(SessionStore& store) {
 
   absl::StatusOr<SessionState> final_state = store.Get(id);
   ASSERT_TRUE(final_state.ok()) << final_state.status();
-  EXPECT_EQ(final_state->session.display_name(),
-            std::to_string(kWriters * kIncrementsPerWriter));
+  EXPECT_EQ(final_state->session.display_name(), std::to_string(kWriters * kIncrementsPerWriter));
   EXPECT_EQ(final_state->session.version(), 1u + kWriters * kIncrementsPerWriter);
   EXPECT_EQ(store.Count(), 1u);
   // Not asserted (scheduling decides), but printed: how contended the run was.
@@ -139,7 +138,8 @@ TEST(StoreConcurrencyTest, DirStoreLosesNoUpdateWhileEvictingAndReloading) {
   }
   // What the writers left on disk is what a restarted server sees.
   {
-    absl::StatusOr<std::unique_ptr<DirSessionStore>> reopened = DirSessionStore::Open(root.string());
+    absl::StatusOr<std::unique_ptr<DirSessionStore>> reopened =
+        DirSessionStore::Open(root.string());
     ASSERT_TRUE(reopened.ok()) << reopened.status();
     absl::StatusOr<SessionPage> page = (*reopened)->List(10, "", "alice");
     ASSERT_TRUE(page.ok()) << page.status();

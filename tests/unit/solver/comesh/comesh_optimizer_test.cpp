@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
+#include <thread>
 
 #include "solver/comesh/comesh_objective.h"
 #include "solver/mesh/build_multimesh.h"
@@ -169,6 +171,39 @@ TEST(ComeshOptimizerTest, CancelledBeforeTheCallStopsBeforeAnyWork) {
     EXPECT_NE(out.status().message().find("at start"), std::string::npos) << out.status();
     EXPECT_EQ(calls, 0);
   }
+}
+
+// Every Hessian analysis on a helper thread (background_analysis_unknowns = 1, as blocks of 65,536
+// unknowns and more get by default): the same multimesh bit for bit, and cancels from another
+// thread at many moments (some inside an analysis, whose helper then finishes on its own after
+// OptimizeComesh returned) answer CANCELLED or finish, never anything else (and under the
+// sanitizer builds, touch nothing freed).
+TEST(ComeshOptimizerTest, AnalysisOnAHelperThreadGivesTheSameResultAndCancels) {
+  const Multimesh m = SquareToHexagon(12);
+  ComeshOptions options;
+  options.threads = 2;
+  const absl::StatusOr<Multimesh> inline_run = OptimizeComesh(m, options, nullptr, {}, nullptr);
+  ASSERT_TRUE(inline_run.ok()) << inline_run.status();
+  options.background_analysis_unknowns = 1;
+  CancelToken never;
+  const absl::StatusOr<Multimesh> helper_run = OptimizeComesh(m, options, &never, {}, nullptr);
+  ASSERT_TRUE(helper_run.ok()) << helper_run.status();
+  EXPECT_EQ(helper_run->shapes, inline_run->shapes);
+  EXPECT_EQ(helper_run->triangles, inline_run->triangles);
+  int cancelled = 0;
+  for (int delay_us = 0; delay_us < 20000; delay_us += 1000) {
+    CancelToken cancel;
+    std::thread canceller([&] {
+      std::this_thread::sleep_for(std::chrono::microseconds(delay_us));
+      cancel.Cancel();
+    });
+    const absl::StatusOr<Multimesh> out = OptimizeComesh(m, options, &cancel, {}, nullptr);
+    canceller.join();
+    if (out.ok()) continue;
+    EXPECT_TRUE(absl::IsCancelled(out.status())) << out.status();
+    ++cancelled;
+  }
+  EXPECT_GT(cancelled, 0);
 }
 
 TEST(ComeshOptimizerTest, RejectsInvertedInputNamingShape) {

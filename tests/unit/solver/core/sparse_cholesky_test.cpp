@@ -271,7 +271,8 @@ TEST(SparseCholeskyTest, CancelledFactorizationAnswersCancelledAndCanBeRedone) {
 TEST(SparseCholeskyTest, CancelledSolveAnswersCancelledAndTheFactorStaysUsable) {
   for (const bool large : {false, true}) {
     SCOPED_TRACE(large ? "supernodal" : "simplicial");
-    const Eigen::SparseMatrix<double> a = large ? GridMatrix(100, 1e-3, 1.0, 3) : GridMatrix(30, 0.1);
+    const Eigen::SparseMatrix<double> a =
+        large ? GridMatrix(100, 1e-3, 1.0, 3) : GridMatrix(30, 0.1);
     SparseCholesky chol(SparseCholesky::Method::kAuto);
     ASSERT_TRUE(chol.Compute(a).ok());
     ASSERT_EQ(chol.supernodal(), large);
