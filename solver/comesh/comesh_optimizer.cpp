@@ -599,10 +599,10 @@ class HessianPreconditioner {
 
   // Symbolic analysis with the vertex graph's AMD ordering expanded to the unknowns. AMD and
   // CHOLMOD's analysis are single library calls that grow with the mesh (at 311k vertices up to
-  // ~1 s per shape, far past the 100 ms a cancel may take): on blocks of `background` or more
-  // unknowns or more they run on a helper thread (RunCancellable) that owns its inputs (the node
-  // graph moved in, the matrix and solver shared), so a cancel returns at once and the helper
-  // finishes the abandoned analysis on its own.
+  // ~1 s per shape, far past the 100 ms a cancel may take): on blocks of `background` unknowns
+  // or more they run on a helper thread (RunCancellable) that owns its inputs (a copy of the node
+  // graph, the matrix and solver shared), so a cancel returns at once and the helper finishes
+  // the abandoned analysis on its own.
   static absl::Status Analyze(Block* block, int background, const CancelToken* cancel) {
     if (Cancelled(cancel)) return SetUpCancelled();
     struct Job {
