@@ -179,12 +179,11 @@ struct ComeshReport {
 // analysis of a large Hessian block runs on a helper thread that a cancel leaves behind
 // (RunCancellable). Measured from the cancel to the return: at most 69 ms up to 165k vertices,
 // up to ~0.18 s at 311k when the cancel falls in the factor's last dense supernodes, one LAPACK
-// call each (docs/benchmarks.md). `progress` (may be empty) is called once per iteration; `report` may be
-// null.
-// The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are remapped to
-// the compacted vertex numbering. `resume` (may be null): continue from a checkpoint that a run
-// on the same `mesh` with the same options reported (InvalidArgument if its multimesh is not
-// valid); the result and report equal that run's.
+// call each (docs/benchmarks.md). `progress` (may be empty) is called once per iteration; `report`
+// may be null. The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are
+// remapped to the compacted vertex numbering. `resume` (may be null): continue from a checkpoint
+// that a run on the same `mesh` with the same options reported (InvalidArgument if its multimesh is
+// not valid); the result and report equal that run's.
 absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOptions& options,
                                          const CancelToken* cancel, const ProgressFn& progress,
                                          ComeshReport* report,
