@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tests/unit/server/redis_fixture.h"
+#include "tests/unit/server/store_writers.h"
 #include "tests/unit/server/test_server.h"
 
 namespace inbetween::server::testing {
@@ -127,22 +128,8 @@ TEST_F(RedisSessionStoreTest, ConcurrentWritersOnTwoReplicasLoseNoUpdate) {
   std::vector<std::thread> writers;
   for (int w = 0; w < kWriters; ++w) {
     RedisSessionStore* store = (w % 2 == 0) ? a.get() : b.get();
-    writers.emplace_back([store, &id, &aborted] {
-      for (int done = 0; done < kIncrements;) {
-        auto state = store->Get(id);
-        ASSERT_TRUE(state.ok()) << state.status();
-        const uint64_t version = state->session.version();
-        state->session.set_display_name(
-            std::to_string(std::stoi(state->session.display_name()) + 1));
-        auto put = store->Put(*state, version);
-        if (put.ok()) {
-          ++done;
-        } else {
-          ASSERT_EQ(put.status().code(), absl::StatusCode::kAborted) << put.status();
-          ++aborted;
-        }
-      }
-    });
+    writers.emplace_back(
+        [store, &id, &aborted] { aborted += IncrementLoop(*store, id, kIncrements); });
   }
   for (std::thread& t : writers) t.join();
   auto final_state = b->Get(id);

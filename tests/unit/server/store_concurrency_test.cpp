@@ -21,11 +21,13 @@
 #include "server/heavy_jobs.h"
 #include "server/metrics.h"
 #include "server/session_store.h"
+#include "tests/unit/server/store_writers.h"
 
 namespace inbetween::server {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::IncrementLoop;
 
 constexpr int kWriters = 4;
 constexpr int kIncrementsPerWriter = 150;
@@ -35,32 +37,6 @@ SessionState NewState(const std::string& owner, const std::string& name) {
   state.owner = owner;
   state.session.set_display_name(name);
   return state;
-}
-
-// Read-modify-write with the optimistic version check, retried on ABORTED: each writer adds 1 to
-// the counter kept in display_name. Returns how many ABORTED answers it saw.
-int IncrementLoop(SessionStore& store, const std::string& id, int increments) {
-  int aborted = 0;
-  for (int i = 0; i < increments;) {
-    absl::StatusOr<SessionState> got = store.Get(id);
-    if (!got.ok()) {
-      ADD_FAILURE() << got.status();
-      return aborted;
-    }
-    const uint64_t version = got->session.version();
-    got->session.set_display_name(std::to_string(std::stoi(got->session.display_name()) + 1));
-    std::this_thread::yield();  // let another writer in between the read and the write
-    absl::StatusOr<SessionState> put = store.Put(*std::move(got), version);
-    if (put.ok()) {
-      ++i;
-    } else if (put.status().code() == absl::StatusCode::kAborted) {
-      ++aborted;
-    } else {
-      ADD_FAILURE() << put.status();
-      return aborted;
-    }
-  }
-  return aborted;
 }
 
 // Writers race on one session while other threads list, count, read, and create and delete
