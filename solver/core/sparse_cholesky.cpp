@@ -26,6 +26,9 @@
 // The kCancelPoint below explains why this file defines it.
 extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info,
                         size_t uplo_length);
+extern "C" void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k,
+                       const double* alpha, const double* a, const int* lda, const double* beta,
+                       double* c, const int* ldc, size_t uplo_length, size_t trans_length);
 
 namespace inbetween::solver {
 
@@ -280,21 +283,24 @@ void InstallAllocator() {
 // kCancelPoint: a supernodal factorization (CHOLMOD's cholmod_super_numeric) has no callback, but
 // it calls LAPACK's dpotrf_ once per supernode, on the supernode's dense diagonal block, and stops
 // as soon as one reports that block not positive definite at its first column (info == 1: the
-// status becomes CHOLMOD_NOT_POSDEF). This file defines dpotrf_, which the dynamic linker binds
-// CHOLMOD's calls to (a definition in the executable comes before the LAPACK library's), and
-// forwards every call to the next definition (LAPACK's) unless the calling thread is inside a
-// cancellable Factorize whose token is set: then it answers info = 1 and records that the stop
-// was a cancellation, not a failed pivot. Before returning, CHOLMOD zeroes the values of the
-// factor from that supernode to the end (L->x up to L->xsize: at 73k vertices, tens of MB of
-// memory not touched yet, 50-80 ms measured); the hook sets L->xsize to 0 for that moment (the
-// zeroing loop then does nothing) and Factorize restores it as soon as CHOLMOD returns. The
-// factor's values are then meaningless, which is what "not factorized" already says: the next
-// Factorize writes every supernode anew. So a cancelled supernodal factorization ends within one
-// supernode's work; any other caller of dpotrf_ gets LAPACK's result untouched.
+// status becomes CHOLMOD_NOT_POSDEF). This file defines dpotrf_ (and the BLAS-3 routines CHOLMOD
+// calls: dsyrk_, dgemm_, dtrsm_), which the dynamic linker binds CHOLMOD's calls to (a definition
+// in the executable comes before the libraries'), and forwards each call to the next definition
+// (LAPACK's, the BLAS's), large dense blocks in panels with a poll between them (kDensePanel).
+// Inside a cancellable Factorize whose token is set, the BLAS routines do nothing and dpotrf_
+// answers info = 1, recording that the stop was a cancellation, not a failed pivot. Before
+// returning, CHOLMOD zeroes the values of the factor from that supernode to the end (L->x up to
+// L->xsize: at 73k vertices, tens of MB of memory not touched yet, 50-80 ms measured); the hook
+// sets L->xsize to 0 for that moment (the zeroing loop then does nothing) and Factorize restores
+// it as soon as CHOLMOD returns. The factor's values are then meaningless, which is what "not
+// factorized" already says: the next Factorize writes every supernode anew. So a cancelled
+// supernodal factorization ends within one panel's work; callers outside a cancellable Factorize
+// get LAPACK's and the BLAS's results (large blocks computed in panels).
 thread_local const CancelToken* tls_factor_cancel = nullptr;
 thread_local cholmod_factor* tls_factor = nullptr;
 thread_local bool tls_factor_cancelled = false;
 thread_local size_t tls_factor_xsize = 0;
+thread_local bool tls_factor_xsize_taken = false;
 
 // Sets the calling thread's cancellation token and factor for the scope of one supernodal
 // factorization; on leaving it, gives the factor back its xsize if the hook took it.
@@ -304,9 +310,10 @@ class CancelPointScope {
     tls_factor_cancel = cancel;
     tls_factor = factor;
     tls_factor_cancelled = false;
+    tls_factor_xsize_taken = false;
   }
   ~CancelPointScope() {
-    if (tls_factor_cancelled && tls_factor != nullptr) tls_factor->xsize = tls_factor_xsize;
+    if (tls_factor_xsize_taken && tls_factor != nullptr) tls_factor->xsize = tls_factor_xsize;
     tls_factor_cancel = nullptr;
     tls_factor = nullptr;
   }
@@ -660,29 +667,169 @@ bool SparseCholesky::supernodal() const {
 
 }  // namespace inbetween::solver
 
+namespace inbetween::solver {
+namespace {
+
+// The next definitions (LAPACK's and the BLAS's) of the routines this file defines, looked up
+// once; a missing one is a broken installation, reported and fatal.
+template <class Fn>
+Fn NextDefinition(const char* name) {
+  auto* next = reinterpret_cast<Fn>(dlsym(RTLD_NEXT, name));
+  if (next == nullptr) {
+    std::fprintf(stderr, "inbetween: %s not found after this executable (%s)\n", name, dlerror());
+    std::abort();
+  }
+  return next;
+}
+
+using DpotrfFn = void (*)(const char*, const int*, double*, const int*, int*, size_t);
+using DsyrkFn = void (*)(const char*, const char*, const int*, const int*, const double*,
+                         const double*, const int*, const double*, double*, const int*, size_t,
+                         size_t);
+using DgemmFn = void (*)(const char*, const char*, const int*, const int*, const int*,
+                         const double*, const double*, const int*, const double*, const int*,
+                         const double*, double*, const int*, size_t, size_t);
+using DtrsmFn = void (*)(const char*, const char*, const char*, const char*, const int*, const int*,
+                         const double*, const double*, const int*, double*, const int*, size_t,
+                         size_t, size_t, size_t);
+
+DpotrfFn LapackPotrf() {
+  static const DpotrfFn f = NextDefinition<DpotrfFn>("dpotrf_");
+  return f;
+}
+DsyrkFn BlasSyrk() {
+  static const DsyrkFn f = NextDefinition<DsyrkFn>("dsyrk_");
+  return f;
+}
+DgemmFn BlasGemm() {
+  static const DgemmFn f = NextDefinition<DgemmFn>("dgemm_");
+  return f;
+}
+DtrsmFn BlasTrsm() {
+  static const DtrsmFn f = NextDefinition<DtrsmFn>("dtrsm_");
+  return f;
+}
+
+// True once the calling thread's factorization is cancelled (and from then on): the BLAS hooks
+// below skip their work, the factor being thrown away anyway.
+bool FactorizationCancelled() {
+  if (tls_factor_cancelled) return true;
+  if (!Cancelled(tls_factor_cancel)) return false;
+  tls_factor_cancelled = true;
+  return true;
+}
+
+// kDensePanel: the dense blocks of a supernodal factorization are factored and updated in panels
+// of this many columns, with a poll between panels (kCancelPoint). The last supernodes of S-Table
+// 2's 311k-vertex row are 2,492 columns wide: LAPACK's dpotrf_ on it took 118 ms and a dsyrk_ of
+// 1,926 x 735 95 ms, single calls (measured with a temporary timer on every call, ninth session).
+// A panel of 256 columns bounds the work between polls to ~30 ms there. Blocks below
+// kPanelFrom columns go to LAPACK/BLAS whole. The panelling depends on sizes only, never on
+// whether a token is set, so results are the same with and without one.
+constexpr int kDensePanel = SparseCholesky::kDensePanel;
+constexpr int kPanelFrom = 2 * kDensePanel;
+
+// Answers CHOLMOD's dpotrf_ call as a failed first pivot, so that it stops at this supernode, and
+// takes the factor's xsize for the moment CHOLMOD zeroes the rest (see kCancelPoint).
+void StopAtThisSupernode(int* info) {
+  if (!tls_factor_xsize_taken && tls_factor != nullptr) {
+    tls_factor_xsize = tls_factor->xsize;
+    tls_factor->xsize = 0;  // CHOLMOD's zeroing of the rest: nothing to do
+    tls_factor_xsize_taken = true;
+  }
+  *info = 1;  // "not positive definite at the block's first column"
+}
+
+// Lower-triangular dense Cholesky of the n x n column-major block `a`, right-looking in panels of
+// kDensePanel columns: factor the panel's diagonal block (LAPACK), solve the rows below it
+// (dtrsm_), subtract their outer product from the trailing block (dsyrk_). Polls before every
+// panel; cancelled: *info = 1 (see kCancelPoint). info > 0 otherwise names the first column whose
+// pivot is not positive, as LAPACK's does.
+void PanelledPotrf(int n, double* a, int lda, int* info) {
+  const double one = 1.0, minus_one = -1.0;
+  const auto at = [&](int row, int col) { return a + row + static_cast<size_t>(col) * lda; };
+  for (int j = 0; j < n; j += kDensePanel) {
+    if (FactorizationCancelled()) {
+      StopAtThisSupernode(info);
+      return;
+    }
+    const int b = std::min(kDensePanel, n - j), rest = n - j - b;
+    LapackPotrf()("L", &b, at(j, j), &lda, info, 1);
+    if (*info != 0) {
+      *info += j;
+      return;
+    }
+    if (rest == 0) break;
+    BlasTrsm()("R", "L", "T", "N", &rest, &b, &one, at(j, j), &lda, at(j + b, j), &lda, 1, 1, 1, 1);
+    // Through this file's dsyrk_, which panels a large update again.
+    dsyrk_("L", "N", &rest, &b, &minus_one, at(j + b, j), &lda, &one, at(j + b, j + b), &lda, 1, 1);
+  }
+  *info = 0;
+}
+
+}  // namespace
+}  // namespace inbetween::solver
+
 extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info,
                         size_t uplo_length) {
-  using Dpotrf = void (*)(const char*, const int*, double*, const int*, int*, size_t);
-  static const Dpotrf lapack = [] {
-    auto* next = reinterpret_cast<Dpotrf>(dlsym(RTLD_NEXT, "dpotrf_"));
-    if (next == nullptr) {
-      std::fprintf(stderr, "inbetween: LAPACK's dpotrf_ not found (%s)\n", dlerror());
-      std::abort();
-    }
-    return next;
-  }();
-  const inbetween::solver::CancelToken* cancel = inbetween::solver::tls_factor_cancel;
-  if (inbetween::solver::Cancelled(cancel)) {
-    namespace sv = inbetween::solver;
-    if (!sv::tls_factor_cancelled && sv::tls_factor != nullptr) {
-      sv::tls_factor_xsize = sv::tls_factor->xsize;
-      sv::tls_factor->xsize = 0;  // CHOLMOD's zeroing of the rest: nothing to do (see above)
-    }
-    inbetween::solver::tls_factor_cancelled = true;
-    *info = 1;  // "not positive definite at the block's first column": CHOLMOD stops here
+  namespace sv = inbetween::solver;
+  if (sv::FactorizationCancelled()) {
+    sv::StopAtThisSupernode(info);
     return;
   }
-  lapack(uplo, n, a, lda, info, uplo_length);
+  if (*n >= sv::kPanelFrom && (*uplo == 'L' || *uplo == 'l')) {
+    sv::PanelledPotrf(*n, a, *lda, info);
+    return;
+  }
+  sv::LapackPotrf()(uplo, n, a, lda, info, uplo_length);
+}
+
+// C = alpha A A^T + beta C (lower, A not transposed: CHOLMOD's update of an ancestor) in column
+// panels of kDensePanel: each panel's diagonal block (dsyrk_) and the rows below it (dgemm_), a
+// poll before each; every entry of C is still one call's sum over all of A's columns. Other forms
+// and small blocks go to the BLAS whole. Skipped once the factorization is cancelled.
+extern "C" void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k,
+                       const double* alpha, const double* a, const int* lda, const double* beta,
+                       double* c, const int* ldc, size_t uplo_length, size_t trans_length) {
+  namespace sv = inbetween::solver;
+  if (sv::FactorizationCancelled()) return;
+  const bool lower_n = (*uplo == 'L' || *uplo == 'l') && (*trans == 'N' || *trans == 'n');
+  if (!lower_n || *n < sv::kPanelFrom) {
+    sv::BlasSyrk()(uplo, trans, n, k, alpha, a, lda, beta, c, ldc, uplo_length, trans_length);
+    return;
+  }
+  for (int j = 0; j < *n; j += sv::kDensePanel) {
+    if (j > 0 && sv::FactorizationCancelled()) return;
+    const int b = std::min(sv::kDensePanel, *n - j), rest = *n - j - b;
+    double* cj = c + j + static_cast<size_t>(j) * *ldc;
+    sv::BlasSyrk()("L", "N", &b, k, alpha, a + j, lda, beta, cj, ldc, 1, 1);
+    if (rest > 0) {
+      sv::BlasGemm()("N", "T", &rest, &b, k, alpha, a + j + b, lda, a + j, lda, beta, cj + b, ldc,
+                     1, 1);
+    }
+  }
+}
+
+// CHOLMOD's other BLAS-3 calls in a supernodal factorization: passed through, skipped once the
+// factorization is cancelled (their largest took under 10 ms at 311k vertices).
+extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
+                       const int* k, const double* alpha, const double* a, const int* lda,
+                       const double* b, const int* ldb, const double* beta, double* c,
+                       const int* ldc, size_t transa_length, size_t transb_length) {
+  namespace sv = inbetween::solver;
+  if (sv::FactorizationCancelled()) return;
+  sv::BlasGemm()(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, transa_length,
+                 transb_length);
+}
+
+extern "C" void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag,
+                       const int* m, const int* n, const double* alpha, const double* a,
+                       const int* lda, double* b, const int* ldb, size_t side_length,
+                       size_t uplo_length, size_t transa_length, size_t diag_length) {
+  namespace sv = inbetween::solver;
+  if (sv::FactorizationCancelled()) return;
+  sv::BlasTrsm()(side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb, side_length, uplo_length,
+                 transa_length, diag_length);
 }
 
 // CHOLMOD's OpenMP regions run on the calling thread. Debian's CHOLMOD (SuiteSparse 5.12, built

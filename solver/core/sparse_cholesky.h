@@ -61,9 +61,11 @@ class SparseCholesky {
   // it is set (then the object is not factorized; Factorize again to use it): a simplicial factor
   // is computed in row blocks of kCancelRows rows (CHOLMOD's incremental row factorization, the
   // same operations in the same order, so the factor is bit-identical to an uncancellable one),
-  // a supernodal one stops at the next supernode (see kCancelPoint in the .cpp).
+  // a supernodal one stops at the next supernode or, in a supernode of 2 * kDensePanel columns or
+  // more, at the next panel of kDensePanel columns (see kCancelPoint in the .cpp).
   absl::Status Factorize(const Eigen::SparseMatrix<double>& a, const CancelToken* cancel = nullptr);
   static constexpr int kCancelRows = 256;
+  static constexpr int kDensePanel = 256;
 
   // Analyze + Factorize.
   absl::Status Compute(const Eigen::SparseMatrix<double>& a);

@@ -4,11 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <iterator>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
+
+#include "absl/strings/str_cat.h"
 
 namespace inbetween::solver {
 namespace {
@@ -333,6 +337,93 @@ TEST(SparseCholeskyTest, AnalyzesWithAGivenOrdering) {
   EXPECT_EQ(chol.Analyze(a, &short_one).code(), absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(SparseCholesky::AmdOrdering({0, 2}, {0, 1}).status().code(),
             absl::StatusCode::kInvalidArgument);  // row 1 of a 1 x 1 pattern
+}
+
+// A dense SPD matrix as a sparse one (upper triangle): A = B B^T / n + I, B uniform in [-1, 1].
+Eigen::SparseMatrix<double> DenseSpd(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::MatrixXd b(n, n);
+  for (Eigen::Index k = 0; k < b.size(); ++k) b.data()[k] = u(rng);
+  const Eigen::MatrixXd a = b * b.transpose() / n + Eigen::MatrixXd::Identity(n, n);
+  std::vector<Eigen::Triplet<double>> upper;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i <= j; ++i) upper.emplace_back(i, j, a(i, j));
+  }
+  Eigen::SparseMatrix<double> m(n, n);
+  m.setFromTriplets(upper.begin(), upper.end());
+  m.makeCompressed();
+  return m;
+}
+
+// A dense block of SparseCholesky::kDensePanel * 2 columns or more (one supernode here) is
+// factored in panels by this file's dpotrf_/dsyrk_ (sparse_cholesky.cpp): the solution is right,
+// and a pivot that fails in a later panel is reported at its own column, as LAPACK would.
+TEST(SparseCholeskyTest, LargeDenseSupernodesAreFactoredInPanels) {
+  const int n = 5 * SparseCholesky::kDensePanel + 37;
+  Eigen::SparseMatrix<double> a = DenseSpd(n, 5);
+  SparseCholesky super(SparseCholesky::Method::kAuto), simplicial;
+  ASSERT_TRUE(super.Compute(a).ok());
+  ASSERT_TRUE(super.supernodal());
+  ASSERT_TRUE(simplicial.Compute(a).ok());
+  const Eigen::SparseMatrix<double> full = a.selfadjointView<Eigen::Upper>();
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Random(n, 2);
+  Eigen::MatrixXd x = b, y = b;
+  ASSERT_TRUE(super.SolveInPlace(&x).ok());
+  ASSERT_TRUE(simplicial.SolveInPlace(&y).ok());
+  EXPECT_LT((full * x - b).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 1e-10 * y.cwiseAbs().maxCoeff());
+
+  // In the identity order, a hugely negative diagonal entry at column 3 * kDensePanel + 5 is the
+  // first pivot that fails (the leading block before it is SPD).
+  const int bad = 3 * SparseCholesky::kDensePanel + 5;
+  a.coeffRef(bad, bad) = -1e3;
+  std::vector<int> identity(n);
+  for (int k = 0; k < n; ++k) identity[k] = k;
+  SparseCholesky indefinite(SparseCholesky::Method::kAuto);
+  ASSERT_TRUE(indefinite.Analyze(a, &identity).ok());
+  ASSERT_TRUE(indefinite.supernodal());
+  const absl::Status status = indefinite.Factorize(a);
+  EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition) << status;
+  EXPECT_NE(status.message().find(absl::StrCat("pivot ", bad, " of ", n)), std::string::npos)
+      << status;
+}
+
+// A cancel may land anywhere in a panelled factorization (between panels, or in a BLAS call the
+// hooks then skip): the answer is OK with a right factor or CANCELLED, never "not positive
+// definite", and a factorization without the token afterwards is right.
+TEST(SparseCholeskyTest, CancelAtAnyMomentOfAPanelledFactorizationIsClean) {
+  const int n = 8 * SparseCholesky::kDensePanel;
+  const Eigen::SparseMatrix<double> a = DenseSpd(n, 7);
+  const Eigen::SparseMatrix<double> full = a.selfadjointView<Eigen::Upper>();
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Ones(n, 1);
+  SparseCholesky chol(SparseCholesky::Method::kAuto);
+  ASSERT_TRUE(chol.Analyze(a).ok());
+  ASSERT_TRUE(chol.supernodal());
+  // Cancels spread from before the start to after the end of an uncancelled factorization.
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_TRUE(chol.Factorize(a).ok());
+  const std::chrono::duration<double> whole = std::chrono::steady_clock::now() - start;
+  int cancelled = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    CancelToken token;
+    std::thread canceller([&token, trial, whole] {
+      std::this_thread::sleep_for(whole * trial / 10);
+      token.Cancel();
+    });
+    const absl::Status status = chol.Factorize(a, &token);
+    canceller.join();
+    ASSERT_TRUE(status.ok() || absl::IsCancelled(status)) << "trial " << trial << ": " << status;
+    if (!status.ok()) {
+      ++cancelled;
+      EXPECT_FALSE(chol.factorized());
+      ASSERT_TRUE(chol.Factorize(a).ok()) << "trial " << trial;
+    }
+    Eigen::MatrixXd x = b;
+    ASSERT_TRUE(chol.SolveInPlace(&x).ok());
+    EXPECT_LT((full * x - b).cwiseAbs().maxCoeff(), 1e-10) << "trial " << trial;
+  }
+  RecordProperty("cancelled", cancelled);
 }
 
 // Supernodal factorizations on several threads at once (the comesh preconditioner factors its
