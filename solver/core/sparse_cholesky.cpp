@@ -118,6 +118,10 @@ template <int kColumns>
 bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* below,
                                                 const CancelToken* cancel) const {
   const int c = kColumns > 0 ? kColumns : columns;
+  // Columns of a supernode handled side by side (kGroup at a time); every entry of y and of
+  // `below` still sees its operations in the same order as one column at a time, so the result
+  // is bit-identical to that.
+  constexpr int kGroup = 4;
   for (int s = 0; s < nsuper; ++s) {  // L z = y
     if (s % kSolveCancelStride == 0 && Cancelled(cancel)) return false;
     const int k1 = super[s], nscol = super[s + 1] - k1;
@@ -126,17 +130,36 @@ bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
     const double* block = l_x + s_px[s];
     double* ys = y + static_cast<size_t>(k1) * c;
     std::fill(below, below + static_cast<size_t>(nbelow) * c, 0.0);
-    for (int j = 0; j < nscol; ++j) {
-      const double* col = block + static_cast<size_t>(j) * nsrow;
-      double* yj = ys + static_cast<size_t>(j) * c;
-      const double inv = 1.0 / col[j];
-      for (int q = 0; q < c; ++q) yj[q] *= inv;
-      for (int i = j + 1; i < nscol; ++i) {
-        for (int q = 0; q < c; ++q) ys[static_cast<size_t>(i) * c + q] -= col[i] * yj[q];
+    for (int j0 = 0; j0 < nscol; j0 += kGroup) {
+      const int group = std::min(kGroup, nscol - j0);
+      for (int j = j0; j < j0 + group; ++j) {
+        const double* col = block + static_cast<size_t>(j) * nsrow;
+        double* yj = ys + static_cast<size_t>(j) * c;
+        const double inv = 1.0 / col[j];
+        for (int q = 0; q < c; ++q) yj[q] *= inv;
+        for (int i = j + 1; i < nscol; ++i) {
+          for (int q = 0; q < c; ++q) ys[static_cast<size_t>(i) * c + q] -= col[i] * yj[q];
+        }
       }
-      const double* lower = col + nscol;
-      for (int r = 0; r < nbelow; ++r) {
-        for (int q = 0; q < c; ++q) below[static_cast<size_t>(r) * c + q] += lower[r] * yj[q];
+      // below += lower_j * y_j for the group's columns in column order, one pass over `below`.
+      const double* lower = block + static_cast<size_t>(j0) * nsrow + nscol;
+      const double* yg = ys + static_cast<size_t>(j0) * c;
+      if (group == kGroup) {
+        for (int r = 0; r < nbelow; ++r) {
+          for (int q = 0; q < c; ++q) {
+            double acc = below[static_cast<size_t>(r) * c + q];
+            for (int g = 0; g < kGroup; ++g) acc += lower[r + g * nsrow] * yg[g * c + q];
+            below[static_cast<size_t>(r) * c + q] = acc;
+          }
+        }
+        continue;
+      }
+      for (int g = 0; g < group; ++g) {
+        for (int r = 0; r < nbelow; ++r) {
+          for (int q = 0; q < c; ++q) {
+            below[static_cast<size_t>(r) * c + q] += lower[r + g * nsrow] * yg[g * c + q];
+          }
+        }
       }
     }
     for (int r = 0; r < nbelow; ++r) {
@@ -155,15 +178,36 @@ bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
       const double* yr = y + static_cast<size_t>(rows[r]) * c;
       for (int q = 0; q < c; ++q) below[static_cast<size_t>(r) * c + q] = yr[q];
     }
-    for (int j = nscol - 1; j >= 0; --j) {
-      const double* col = block + static_cast<size_t>(j) * nsrow;
-      double* yj = ys + static_cast<size_t>(j) * c;
-      const double* lower = col + nscol;
-      for (int q = 0; q < c; ++q) {
-        double sum = 0.0;
-        for (int r = 0; r < nbelow; ++r) sum += lower[r] * below[static_cast<size_t>(r) * c + q];
-        for (int i = j + 1; i < nscol; ++i) sum += col[i] * ys[static_cast<size_t>(i) * c + q];
-        yj[q] = (yj[q] - sum) / col[j];
+    for (int j1 = nscol; j1 > 0; j1 -= kGroup) {
+      const int group = std::min(kGroup, j1), j0 = j1 - group;
+      const double* lower = block + static_cast<size_t>(j0) * nsrow + nscol;
+      const size_t stride = static_cast<size_t>(nsrow);
+      for (int q = 0; q < c; ++q) {  // right-hand sides are independent
+        // Each column's dot product with `below` (one sum per column, in row order), the
+        // group's columns side by side: independent sums, one pass over `below`.
+        double sums[kGroup] = {0.0, 0.0, 0.0, 0.0};
+        if (group == kGroup) {
+          for (int r = 0; r < nbelow; ++r) {
+            const double b = below[static_cast<size_t>(r) * c + q];
+            sums[0] += lower[r] * b;
+            sums[1] += lower[r + stride] * b;
+            sums[2] += lower[r + 2 * stride] * b;
+            sums[3] += lower[r + 3 * stride] * b;
+          }
+        } else {
+          for (int g = 0; g < group; ++g) {
+            for (int r = 0; r < nbelow; ++r) {
+              sums[g] += lower[r + g * stride] * below[static_cast<size_t>(r) * c + q];
+            }
+          }
+        }
+        for (int j = j1 - 1; j >= j0; --j) {
+          const double* col = block + static_cast<size_t>(j) * nsrow;
+          double sum = sums[j - j0];
+          for (int i = j + 1; i < nscol; ++i) sum += col[i] * ys[static_cast<size_t>(i) * c + q];
+          double& yj = ys[static_cast<size_t>(j) * c + q];
+          yj = (yj - sum) / col[j];
+        }
       }
     }
   }
