@@ -122,10 +122,20 @@ bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
   // `below` still sees its operations in the same order as one column at a time, so the result
   // is bit-identical to that.
   constexpr int kGroup = 4;
+  constexpr size_t kSolvePollEntries = size_t{1} << 18;  // ~2 MB of L: about a millisecond
+  // Polled every kSolveCancelStride supernodes and, in between, whenever kSolvePollEntries of
+  // L's entries were read since the last poll (the supernodes near the root are large).
+  size_t entries = 0;
+  auto poll = [&](int s, int nsrow, int nscol) {
+    entries += static_cast<size_t>(nsrow) * nscol;
+    if (s % kSolveCancelStride != 0 && entries < kSolvePollEntries) return false;
+    entries = 0;
+    return Cancelled(cancel);
+  };
   for (int s = 0; s < nsuper; ++s) {  // L z = y
-    if (s % kSolveCancelStride == 0 && Cancelled(cancel)) return false;
     const int k1 = super[s], nscol = super[s + 1] - k1;
     const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
+    if (poll(s, nsrow, nscol)) return false;
     const int* rows = s_i + s_pi[s] + nscol;
     const double* block = l_x + s_px[s];
     double* ys = y + static_cast<size_t>(k1) * c;
@@ -168,9 +178,9 @@ bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
     }
   }
   for (int s = nsuper - 1; s >= 0; --s) {  // L^T x = z
-    if (s % kSolveCancelStride == 0 && Cancelled(cancel)) return false;
     const int k1 = super[s], nscol = super[s + 1] - k1;
     const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
+    if (poll(s, nsrow, nscol)) return false;
     const int* rows = s_i + s_pi[s] + nscol;
     const double* block = l_x + s_px[s];
     double* ys = y + static_cast<size_t>(k1) * c;
