@@ -60,6 +60,17 @@ struct SparseCholesky::Impl {
   mutable std::vector<double> work;            // interleaved right-hand sides, n x columns
   mutable std::vector<double> supernode_work;  // SubstituteSupernodal's scratch
 
+  // The supernodal factorization's input S = tril(P A P^T), which cholmod_factorize would build by
+  // a permuted transpose on every call (~0.2 s at 311k vertices, no poll possible inside): its
+  // pattern is built once per analysis (BuildPermutedLower), each Factorize scatters A's values
+  // into it in polled spans (lower_map[k]: position in lower_x of A's k-th stored value, -1 below
+  // the diagonal, which is not read) and calls cholmod_super_numeric directly.
+  std::vector<int> lower_p, lower_i, lower_map;
+  std::vector<double> lower_x;
+  void BuildPermutedLower();
+  // Scatters a's values into lower_x, polling `cancel` every kScatterPoll values; false if set.
+  bool ScatterPermutedLower(const Eigen::SparseMatrix<double>& a, const CancelToken* cancel);
+
   void Extract();
   // The simplicial numeric factorization in row blocks of kCancelRows, polling `cancel` between
   // blocks: 1 on success (check common.status), 0 on a CHOLMOD error, -1 if cancelled.
@@ -86,6 +97,58 @@ struct SparseCholesky::Impl {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 };
+
+void SparseCholesky::Impl::BuildPermutedLower() {
+  const int* p = static_cast<const int*>(factor->Perm);
+  std::vector<int> inverse(n);
+  for (int k = 0; k < n; ++k) inverse[p[k]] = k;
+  const size_t nnz = inner.size();
+  // Entry k of A (row i <= column j) goes to S(max, min) of the permuted indices. Bucketed by
+  // S's row first, then placed column by column in row order: S's columns come out sorted.
+  std::vector<int> row_of(nnz, -1), col_of(nnz, -1);
+  std::vector<int> row_start(n + 1, 0);
+  lower_p.assign(n + 1, 0);
+  for (int j = 0; j < n; ++j) {
+    for (int k = outer[j]; k < outer[j + 1]; ++k) {
+      if (inner[k] > j) continue;
+      const int a = inverse[inner[k]], b = inverse[j];
+      row_of[k] = std::max(a, b);
+      col_of[k] = std::min(a, b);
+      ++row_start[row_of[k] + 1];
+      ++lower_p[col_of[k] + 1];
+    }
+  }
+  for (int r = 0; r < n; ++r) row_start[r + 1] += row_start[r];
+  for (int c = 0; c < n; ++c) lower_p[c + 1] += lower_p[c];
+  std::vector<int> by_row(row_start[n]);
+  std::vector<int> next(row_start.begin(), row_start.end() - 1);
+  for (size_t k = 0; k < nnz; ++k) {
+    if (row_of[k] >= 0) by_row[next[row_of[k]]++] = static_cast<int>(k);
+  }
+  lower_i.assign(lower_p[n], 0);
+  lower_x.assign(lower_p[n], 0.0);
+  lower_map.assign(nnz, -1);
+  next.assign(lower_p.begin(), lower_p.end() - 1);
+  for (const int k : by_row) {
+    const int at = next[col_of[k]]++;
+    lower_i[at] = row_of[k];
+    lower_map[k] = at;
+  }
+}
+
+bool SparseCholesky::Impl::ScatterPermutedLower(const Eigen::SparseMatrix<double>& a,
+                                                const CancelToken* cancel) {
+  constexpr size_t kScatterPoll = size_t{1} << 20;
+  const double* values = a.valuePtr();
+  for (size_t begin = 0; begin < lower_map.size(); begin += kScatterPoll) {
+    if (Cancelled(cancel)) return false;
+    const size_t end = std::min(lower_map.size(), begin + kScatterPoll);
+    for (size_t k = begin; k < end; ++k) {
+      if (lower_map[k] >= 0) lower_x[lower_map[k]] = values[k];
+    }
+  }
+  return true;
+}
 
 void SparseCholesky::Impl::Extract() {
   perm = static_cast<const int*>(factor->Perm);
@@ -492,6 +555,11 @@ absl::Status SparseCholesky::Analyze(const Eigen::SparseMatrix<double>& a,
   if (m.factor == nullptr || m.common.status < CHOLMOD_OK) {
     return CholmodError(m.common, "symbolic analysis");
   }
+  m.lower_p.clear();
+  m.lower_i.clear();
+  m.lower_x.clear();
+  m.lower_map.clear();
+  if (m.factor->is_super) m.BuildPermutedLower();
   return absl::OkStatus();
 }
 
@@ -525,11 +593,33 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a,
     ok = m.FactorizeSimplicialInBlocks(&view, *cancel);
     if (ok < 0) return cancelled();
   } else {
-    const BlasLock blas(/*uses_blas=*/m.factor->is_super != 0);
+    const bool super = m.factor->is_super != 0;
+    if (super && !m.ScatterPermutedLower(a, cancel)) return cancelled();
+    const BlasLock blas(/*uses_blas=*/super);
     bool stopped = false;
     {
-      const CancelPointScope scope(m.factor->is_super != 0 ? cancel : nullptr, m.factor);
-      ok = cholmod_factorize(&view, m.factor, &m.common);
+      const CancelPointScope scope(super ? cancel : nullptr, m.factor);
+      if (super) {
+        // What cholmod_factorize does for a supernodal factor of a symmetric-upper matrix (with
+        // final_asis: no conversion afterwards), S = tril(P A P^T) being ready.
+        cholmod_sparse lower{};
+        lower.nrow = lower.ncol = static_cast<size_t>(m.n);
+        lower.nzmax = m.lower_x.size();
+        lower.p = m.lower_p.data();
+        lower.i = m.lower_i.data();
+        lower.x = m.lower_x.data();
+        lower.stype = -1;
+        lower.itype = CHOLMOD_INT;
+        lower.xtype = CHOLMOD_REAL;
+        lower.dtype = CHOLMOD_DOUBLE;
+        lower.sorted = 1;
+        lower.packed = 1;
+        double beta[2] = {0.0, 0.0};
+        m.common.status = CHOLMOD_OK;
+        ok = cholmod_super_numeric(&lower, nullptr, beta, m.factor, &m.common);
+      } else {
+        ok = cholmod_factorize(&view, m.factor, &m.common);
+      }
       stopped = tls_factor_cancelled;
     }
     if (stopped) return cancelled();

@@ -123,6 +123,36 @@ TEST(SparseCholeskyTest, ReadsOnlyTheUpperTriangle) {
   EXPECT_LT((a * *x - b).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+// The same for a supernodal factor, whose input tril(P A P^T) is built from the upper triangle
+// once per analysis and refilled by each Factorize: values below the diagonal (here nonsense)
+// are never read, and a refactorization reads the new values.
+TEST(SparseCholeskyTest, SupernodalReadsOnlyTheUpperTriangleAndTheNewValues) {
+  const Eigen::SparseMatrix<double> a = GridMatrix(100, 1e-2, 1.0, 3);
+  Eigen::SparseMatrix<double> noisy = a;
+  for (int j = 0; j < noisy.outerSize(); ++j) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(noisy, j); it; ++it) {
+      if (it.row() > it.col()) it.valueRef() = -1e6;  // would make the matrix indefinite
+    }
+  }
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Ones(a.rows(), 1);
+  SparseCholesky chol(SparseCholesky::Method::kAuto);
+  ASSERT_TRUE(chol.Compute(noisy).ok());
+  ASSERT_TRUE(chol.supernodal());
+  absl::StatusOr<Eigen::MatrixXd> x = chol.Solve(b);
+  ASSERT_TRUE(x.ok());
+  EXPECT_LT((a * *x - b).cwiseAbs().maxCoeff(), 1e-9);
+  Eigen::SparseMatrix<double> scaled = noisy;
+  for (int j = 0; j < scaled.outerSize(); ++j) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(scaled, j); it; ++it) {
+      if (it.row() <= it.col()) it.valueRef() *= 4.0;
+    }
+  }
+  ASSERT_TRUE(chol.Factorize(scaled).ok());
+  x = chol.Solve(b);
+  ASSERT_TRUE(x.ok());
+  EXPECT_LT((4.0 * a * *x - b).cwiseAbs().maxCoeff(), 1e-9);
+}
+
 TEST(SparseCholeskyTest, ReportsMisuse) {
   SparseCholesky chol;
   EXPECT_EQ(chol.Solve(Eigen::MatrixXd::Ones(4, 1)).status().code(),
