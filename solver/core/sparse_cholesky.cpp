@@ -837,22 +837,16 @@ using DtrsmFn = void (*)(const char*, const char*, const char*, const char*, con
                          const double*, const double*, const int*, double*, const int*, size_t,
                          size_t, size_t, size_t);
 
-DpotrfFn LapackPotrf() {
-  static const DpotrfFn f = NextDefinition<DpotrfFn>("dpotrf_");
+// Each Fn type above names one routine, so one cached lookup per type.
+template <class Fn>
+Fn Next(const char* name) {
+  static const Fn f = NextDefinition<Fn>(name);
   return f;
 }
-DsyrkFn BlasSyrk() {
-  static const DsyrkFn f = NextDefinition<DsyrkFn>("dsyrk_");
-  return f;
-}
-DgemmFn BlasGemm() {
-  static const DgemmFn f = NextDefinition<DgemmFn>("dgemm_");
-  return f;
-}
-DtrsmFn BlasTrsm() {
-  static const DtrsmFn f = NextDefinition<DtrsmFn>("dtrsm_");
-  return f;
-}
+DpotrfFn LapackPotrf() { return Next<DpotrfFn>("dpotrf_"); }
+DsyrkFn BlasSyrk() { return Next<DsyrkFn>("dsyrk_"); }
+DgemmFn BlasGemm() { return Next<DgemmFn>("dgemm_"); }
+DtrsmFn BlasTrsm() { return Next<DtrsmFn>("dtrsm_"); }
 
 // True once the calling thread's factorization is cancelled (and from then on): the BLAS hooks
 // below skip their work, the factor being thrown away anyway.
