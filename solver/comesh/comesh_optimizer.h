@@ -178,9 +178,9 @@ struct ComeshReport {
 // inside the set-up's loops and factorizations and before every topology operation; the symbolic
 // analysis of a large Hessian block runs on a helper thread that a cancel leaves behind
 // (RunCancellable); large dense supernodes are factored in polled panels. Measured from the
-// cancel to the return: at most 69 ms up to 165k vertices; at 311k p50 28 ms, max 119 ms in 8
-// trials (the longest stretches left: the curvature pair's fresh vectors, a topology step;
-// docs/benchmarks.md). `progress` (may be empty) is called once per iteration; `report`
+// cancel to the return: at most 69 ms up to 165k vertices; at 311k p50 23 ms, max 35 ms in 8
+// trials (a topology pass's edge lists, up to ~0.2 s without a poll, are the longest stretch
+// left; docs/benchmarks.md). `progress` (may be empty) is called once per iteration; `report`
 // may be null. The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are
 // remapped to the compacted vertex numbering. `resume` (may be null): continue from a checkpoint
 // that a run on the same `mesh` with the same options reported (InvalidArgument if its multimesh is
