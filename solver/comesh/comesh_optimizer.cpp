@@ -497,15 +497,11 @@ class HessianPreconditioner {
     }
     if (Cancelled(cancel)) return SetUpCancelled();
     // The blocks' patterns (fresh memory, its pages faulted in as they are written): copied in
-    // polled spans of kSetUpPoll * 256 entries, as AssembleShape zeroes the values.
+    // polled spans, as AssembleShape zeroes the values.
     auto copy_polled = [cancel](const std::vector<int>& from, int* to) {
-      constexpr size_t kSpan = size_t{kSetUpPoll} * 256;
-      for (size_t begin = 0; begin < from.size(); begin += kSpan) {
-        if (Cancelled(cancel)) return false;
-        const size_t end = std::min(from.size(), begin + kSpan);
+      return InPolledSpans(from.size(), cancel, [&](size_t begin, size_t end) {
         std::copy(from.begin() + begin, from.begin() + end, to + begin);
-      }
-      return !Cancelled(cancel);
+      });
     };
     for (int s = 0; s < num_shapes; ++s) {
       Block& block = h.blocks_[s];
@@ -651,6 +647,18 @@ class HessianPreconditioner {
   }
   static constexpr int kSetUpPoll = 4096;
 
+  // Calls f(begin, end) over [0, n) in spans of kSetUpPoll * 256 items, polling `cancel` before
+  // each span and after the last; false (work partly done) if it was set.
+  template <typename F>
+  static bool InPolledSpans(size_t n, const CancelToken* cancel, F&& f) {
+    constexpr size_t kSpan = size_t{kSetUpPoll} * 256;
+    for (size_t begin = 0; begin < n; begin += kSpan) {
+      if (Cancelled(cancel)) return false;
+      f(begin, std::min(n, begin + kSpan));
+    }
+    return !Cancelled(cancel);
+  }
+
   // Adds `value` at (row, col) of a block (binary search in the column).
   static void Add(Eigen::SparseMatrix<double>* m, int row, int col, double value) {
     const int* begin = m->innerIndexPtr() + m->outerIndexPtr()[col];
@@ -675,11 +683,11 @@ class HessianPreconditioner {
     const ComeshObjective& obj = *objective_;
     Eigen::SparseMatrix<double>* m = blocks_[s].matrix.get();
     // Zeroing a fresh block faults its pages in (~130 ms at 311k vertices): in polled spans.
-    constexpr Eigen::Index kSpan = Eigen::Index{kSetUpPoll} * 256;
-    for (Eigen::Index begin = 0; begin < m->nonZeros(); begin += kSpan) {
-      if (Cancelled(cancel)) return false;
-      std::fill(m->valuePtr() + begin, m->valuePtr() + std::min(m->nonZeros(), begin + kSpan), 0.0);
-    }
+    const bool zeroed =
+        InPolledSpans(static_cast<size_t>(m->nonZeros()), cancel, [m](size_t begin, size_t end) {
+          std::fill(m->valuePtr() + begin, m->valuePtr() + end, 0.0);
+        });
+    if (!zeroed) return false;
     const int num_shapes = layout.num_shapes();
     const double w = obj.map_weight();
     const int next = (s + 1) % num_shapes, prev = (s + num_shapes - 1) % num_shapes;
