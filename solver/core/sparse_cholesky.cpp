@@ -426,13 +426,14 @@ class CancelPointScope {
   CancelPointScope(const CancelToken* cancel, cholmod_factor* factor) {
     tls_factor_cancel = cancel;
     tls_factor = factor;
-    tls_factor_cancelled = false;
-    tls_factor_xsize_taken = false;
   }
   ~CancelPointScope() {
     if (tls_factor_xsize_taken && tls_factor != nullptr) tls_factor->xsize = tls_factor_xsize;
     tls_factor_cancel = nullptr;
     tls_factor = nullptr;
+    // The BLAS hooks skip their work while this is set: it must not outlive the factorization.
+    tls_factor_cancelled = false;
+    tls_factor_xsize_taken = false;
   }
   CancelPointScope(const CancelPointScope&) = delete;
   CancelPointScope& operator=(const CancelPointScope&) = delete;

@@ -419,9 +419,17 @@ TEST(SparseCholeskyTest, LargeDenseSupernodesAreFactoredInPanels) {
       << status;
 }
 
+// sparse_cholesky.cpp defines dgemm_ (for CHOLMOD), skipping the work while a cancelled
+// factorization winds down on the calling thread.
+extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
+                       const int* k, const double* alpha, const double* a, const int* lda,
+                       const double* b, const int* ldb, const double* beta, double* c,
+                       const int* ldc, size_t transa_length, size_t transb_length);
+
 // A cancel may land anywhere in a panelled factorization (between panels, or in a BLAS call the
 // hooks then skip): the answer is OK with a right factor or CANCELLED, never "not positive
-// definite", and a factorization without the token afterwards is right.
+// definite", BLAS calls on the thread compute again afterwards, and a factorization without the
+// token is right.
 TEST(SparseCholeskyTest, CancelAtAnyMomentOfAPanelledFactorizationIsClean) {
   const int n = 8 * SparseCholesky::kDensePanel;
   const Eigen::SparseMatrix<double> a = DenseSpd(n, 7);
@@ -444,6 +452,14 @@ TEST(SparseCholeskyTest, CancelAtAnyMomentOfAPanelledFactorizationIsClean) {
     const absl::Status status = chol.Factorize(a, &token);
     canceller.join();
     ASSERT_TRUE(status.ok() || absl::IsCancelled(status)) << "trial " << trial << ": " << status;
+    // BLAS on this thread computes again afterwards (the hooks' skipping ends with the call).
+    const Eigen::MatrixXd lhs = Eigen::MatrixXd::Random(3, 4), rhs = Eigen::MatrixXd::Random(4, 2);
+    Eigen::MatrixXd product = Eigen::MatrixXd::Zero(3, 2);
+    const int rows = 3, cols = 2, inner = 4;
+    const double one = 1.0, zero = 0.0;
+    dgemm_("N", "N", &rows, &cols, &inner, &one, lhs.data(), &rows, rhs.data(), &inner, &zero,
+           product.data(), &rows, 1, 1);
+    EXPECT_LT((product - lhs * rhs).cwiseAbs().maxCoeff(), 1e-12) << "trial " << trial;
     if (!status.ok()) {
       ++cancelled;
       EXPECT_FALSE(chol.factorized());
