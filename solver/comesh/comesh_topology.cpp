@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -38,7 +39,11 @@ class Editor {
     removed_.assign(n, 0);
     locked_.assign(n, 0);
     protected_.assign(n, 0);
-    const auto uses = EdgeUses(triangles_, alive_);
+    std::vector<std::pair<std::pair<int, int>, int>> uses;
+    if (!EdgeUses(triangles_, alive_, cancel, &uses)) {
+      cancelled_ = true;
+      return;
+    }
     for (size_t t = 0; t < triangles_.size(); ++t) {
       if (t % 4096 == 0 && Cancelled(cancel)) {
         cancelled_ = true;
@@ -73,13 +78,16 @@ class Editor {
   int num_triangles() const { return t_; }
   bool cancelled() const { return cancelled_; }
 
-  // Interior edges (each once) as (a, b) with a < b.
-  std::vector<std::pair<int, int>> InteriorEdges() const {
-    std::vector<std::pair<int, int>> edges;
-    for (const auto& [edge, count] : EdgeUses(triangles_, alive_)) {
-      if (count == 2) edges.push_back(edge);
+  // Interior edges (each once) as (a, b) with a < b, into *edges; false if `cancel` was set
+  // (polled every 4096 items).
+  bool InteriorEdges(const CancelToken* cancel, std::vector<std::pair<int, int>>* edges) const {
+    std::vector<std::pair<std::pair<int, int>, int>> uses;
+    if (!EdgeUses(triangles_, alive_, cancel, &uses)) return false;
+    edges->clear();
+    for (const auto& [edge, count] : uses) {
+      if (count == 2) edges->push_back(edge);
     }
-    return edges;
+    return true;
   }
 
   // The vertices marked since the last call (ascending), and clears the marks.
@@ -91,10 +99,14 @@ class Editor {
     return out;
   }
 
-  // The interior edges (a, b), a < b, with an endpoint in `vertices`, ascending (each once).
-  std::vector<std::pair<int, int>> InteriorEdgesAt(const std::vector<int>& vertices) const {
+  // The interior edges (a, b), a < b, with an endpoint in `vertices`, ascending (each once),
+  // into *interior; false if `cancel` was set (polled every 4096 vertices and edges).
+  bool InteriorEdgesAt(const std::vector<int>& vertices, const CancelToken* cancel,
+                       std::vector<std::pair<int, int>>* interior) const {
     std::vector<std::pair<int, int>> edges;
-    for (int v : vertices) {
+    for (size_t i = 0; i < vertices.size(); ++i) {
+      if (i % 4096 == 0 && Cancelled(cancel)) return false;
+      const int v = vertices[i];
       if (v >= static_cast<int>(incident_.size())) continue;
       for (int t : incident_[v]) {
         for (int u : triangles_[t]) {
@@ -102,14 +114,17 @@ class Editor {
         }
       }
     }
+    if (Cancelled(cancel)) return false;
     std::sort(edges.begin(), edges.end());
     edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-    std::vector<std::pair<int, int>> interior;
+    interior->clear();
     int t1 = -1, t2 = -1;
-    for (const auto& [a, b] : edges) {
-      if (EdgeTriangles(a, b, &t1, &t2)) interior.push_back({a, b});
+    for (size_t i = 0; i < edges.size(); ++i) {
+      if (i % 4096 == 0 && Cancelled(cancel)) return false;
+      const auto [a, b] = edges[i];
+      if (EdgeTriangles(a, b, &t1, &t2)) interior->push_back({a, b});
     }
-    return interior;
+    return true;
   }
 
   // Length of edge (a, b) relative to the mean edge length, max (or min) over shapes.
@@ -425,15 +440,25 @@ class Editor {
 
 std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Triangle>& triangles,
                                                           const std::vector<char>& alive) {
+  std::vector<std::pair<std::pair<int, int>, int>> uses;
+  EdgeUses(triangles, alive, nullptr, &uses);
+  return uses;
+}
+
+bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& alive,
+              const CancelToken* cancel, std::vector<std::pair<std::pair<int, int>, int>>* uses) {
   // Linear time: each edge (a, b), a < b, goes to the bucket of a (a counting sort on a), each
   // bucket (a vertex's few higher neighbours) is sorted on its own, and equal b's in a bucket are
   // one edge's uses. Measured 3.5% of the 35k-vertex S-Table 2 row with one std::sort of 3T keys.
+  auto poll = [cancel](size_t i) { return i % 4096 == 0 && Cancelled(cancel); };
   int n = 0;
   for (size_t t = 0; t < triangles.size(); ++t) {
+    if (poll(t)) return false;
     if (alive[t]) n = std::max({n, triangles[t][0] + 1, triangles[t][1] + 1, triangles[t][2] + 1});
   }
   std::vector<int> start(n + 1, 0);
   for (size_t t = 0; t < triangles.size(); ++t) {
+    if (poll(t)) return false;
     if (!alive[t]) continue;
     for (int k = 0; k < 3; ++k) ++start[std::min(triangles[t][k], triangles[t][(k + 1) % 3]) + 1];
   }
@@ -442,6 +467,7 @@ std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Tria
   {
     std::vector<int> fill(start.begin(), start.end() - 1);
     for (size_t t = 0; t < triangles.size(); ++t) {
+      if (poll(t)) return false;
       if (!alive[t]) continue;
       for (int k = 0; k < 3; ++k) {
         const auto [a, b] = std::minmax(triangles[t][k], triangles[t][(k + 1) % 3]);
@@ -449,19 +475,20 @@ std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Tria
       }
     }
   }
-  std::vector<std::pair<std::pair<int, int>, int>> uses;
-  uses.reserve(higher.size() / 2 + 1);
+  uses->clear();
+  uses->reserve(higher.size() / 2 + 1);
   for (int a = 0; a < n; ++a) {
+    if (poll(static_cast<size_t>(a))) return false;
     const auto begin = higher.begin() + start[a], end = higher.begin() + start[a + 1];
     std::sort(begin, end);
     for (auto i = begin; i != end;) {
       auto j = i;
       while (j != end && *j == *i) ++j;
-      uses.push_back({{a, *i}, static_cast<int>(j - i)});
+      uses->push_back({{a, *i}, static_cast<int>(j - i)});
       i = j;
     }
   }
-  return uses;
+  return !Cancelled(cancel);
 }
 
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
@@ -490,8 +517,11 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
   auto flip_sweeps = [&](bool all_edges) {
     for (int sweep = 0; options.flips && sweep < options.flip_sweeps; ++sweep) {
       const bool everything = all_edges && sweep == 0;
-      const std::vector<std::pair<int, int>> edges =
-          everything ? editor.InteriorEdges() : editor.InteriorEdgesAt(editor.TakeDirty());
+      std::vector<std::pair<int, int>> edges;
+      if (!(everything ? editor.InteriorEdges(cancel, &edges)
+                       : editor.InteriorEdgesAt(editor.TakeDirty(), cancel, &edges))) {
+        return false;
+      }
       if (everything) editor.TakeDirty();
       int flips = 0;
       for (const auto& [a, b] : edges) {
@@ -504,13 +534,30 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
     return true;
   };
   if (!flip_sweeps(/*all_edges=*/true)) return cancelled_status;
-  if (options.collapses) {
-    std::vector<std::pair<double, std::pair<int, int>>> candidates;
-    for (const auto& [a, b] : editor.InteriorEdges()) {
-      const double r = editor.RelativeLength(a, b, /*max=*/true);
-      if (r < options.collapse_ratio) candidates.push_back({r, {a, b}});
+  // The interior edges whose relative length (max over shapes) passes `keep`, as (key, edge)
+  // sorted by key; false if cancelled.
+  std::vector<std::pair<int, int>> interior;
+  std::vector<std::pair<double, std::pair<int, int>>> candidates;
+  auto candidates_by = [&](auto&& key) {
+    if (!editor.InteriorEdges(cancel, &interior)) return false;
+    candidates.clear();
+    for (size_t i = 0; i < interior.size(); ++i) {
+      if (i % 4096 == 0 && Cancelled(cancel)) return false;
+      const auto [a, b] = interior[i];
+      if (const std::optional<double> k = key(editor.RelativeLength(a, b, /*max=*/true))) {
+        candidates.push_back({*k, {a, b}});
+      }
     }
     std::sort(candidates.begin(), candidates.end());
+    return !Cancelled(cancel);
+  };
+  if (options.collapses) {
+    if (!candidates_by([&](double r) -> std::optional<double> {
+          if (r < options.collapse_ratio) return r;
+          return std::nullopt;
+        })) {
+      return cancelled_status;
+    }
     for (const auto& [r, edge] : candidates) {
       if (Cancelled(cancel)) return cancelled_status;
       rep.collapses += editor.TryCollapse(edge.first, edge.second) ||
@@ -518,12 +565,12 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
     }
   }
   if (options.splits) {
-    std::vector<std::pair<double, std::pair<int, int>>> candidates;
-    for (const auto& [a, b] : editor.InteriorEdges()) {
-      const double r = editor.RelativeLength(a, b, /*max=*/true);
-      if (r > options.split_ratio) candidates.push_back({-r, {a, b}});
+    if (!candidates_by([&](double r) -> std::optional<double> {
+          if (r > options.split_ratio) return -r;
+          return std::nullopt;
+        })) {
+      return cancelled_status;
     }
-    std::sort(candidates.begin(), candidates.end());
     for (const auto& [r, edge] : candidates) {
       if (Cancelled(cancel)) return cancelled_status;
       rep.splits += editor.TrySplit(edge.first, edge.second);

@@ -55,10 +55,15 @@ struct TopologyReport {
 // pairs: the topology pass and the optimizer list edges often.
 std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Triangle>& triangles,
                                                           const std::vector<char>& alive);
+// The same into *uses, polling `cancel` every 4096 triangles and vertices (~0.15 s at 311k
+// vertices without polls); false (and *uses unspecified) if it was set.
+bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& alive,
+              const CancelToken* cancel, std::vector<std::pair<std::pair<int, int>, int>>* uses);
 
 // One topology pass. `mesh` must be valid (positive triangles in every shape). The returned
 // multimesh is valid too and has objective_after <= objective_before. CANCELLED (and no mesh) if
-// `cancel` is set during the pass (polled before every candidate operation).
+// `cancel` is set during the pass (polled before every candidate operation and every 4096 items
+// of the edge and candidate lists).
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
                                           const TopologyOptions& options,
                                           TopologyReport* report = nullptr,

@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <map>
 #include <random>
+#include <thread>
 #include <utility>
 
 #include "solver/comesh/comesh_objective.h"
@@ -73,6 +75,13 @@ TEST(ComeshTopologyTest, EdgeUsesCountsEveryLiveEdgeInOrder) {
     ++i;
   }
   EXPECT_TRUE(EdgeUses(triangles, std::vector<char>(triangles.size(), 0)).empty());
+  // The polled variant: the same list with a live token, false with a set one.
+  CancelToken live, set;
+  set.Cancel();
+  std::vector<std::pair<std::pair<int, int>, int>> polled{{{7, 8}, 1}};
+  ASSERT_TRUE(EdgeUses(triangles, alive, &live, &polled));
+  EXPECT_EQ(polled, uses);
+  EXPECT_FALSE(EdgeUses(triangles, alive, &set, &polled));
 }
 
 TEST(ComeshTopologyTest, FlipsLongDiagonalsOfAShearedGridInAllShapes) {
@@ -108,6 +117,54 @@ TEST(ComeshTopologyTest, CancelledPassAnswersCancelled) {
   EXPECT_EQ(a->shapes, b->shapes);
   auto c = ImproveTopology(m, 0.5, TopologyOptions{}, nullptr, &cancelled);
   EXPECT_EQ(c.status().code(), absl::StatusCode::kCancelled) << c.status();
+}
+
+// A cancel at any moment of a pass that flips and collapses (every step of it: the editor's set-up,
+// the edge lists, the collapse and split candidate lists, the operations) answers CANCELLED or,
+// when it came too late, exactly the uncancelled result; never a different mesh.
+TEST(ComeshTopologyTest, CancelAtAnyMomentAnswersCancelledOrTheSameMesh) {
+  Multimesh m = Sheared(40, 0.8);
+  // Short edges (collapse candidates): every 7th vertex pulled toward its next neighbour in both
+  // shapes, where that inverts no triangle.
+  for (int v = 0; v + 1 < m.num_vertices(); v += 7) {
+    Multimesh moved = m;
+    for (Points& x : moved.shapes) x[v] = x[v + 1] + 0.15 * (x[v] - x[v + 1]);
+    if (CountInverted(moved.triangles, moved.shapes[0]) == 0 &&
+        CountInverted(moved.triangles, moved.shapes[1]) == 0) {
+      m = std::move(moved);
+    }
+  }
+  ASSERT_TRUE(ValidateMultimesh(m).ok());
+  TopologyOptions options;
+  TopologyReport report;
+  const auto start = std::chrono::steady_clock::now();
+  const auto expected = ImproveTopology(m, 0.5, options, &report);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(expected.ok()) << expected.status();
+  ASSERT_GT(report.flips, 0);
+  ASSERT_GT(report.collapses, 0);
+  int cancelled = 0, finished = 0;
+  constexpr int kTrials = 40;
+  for (int i = 0; i < kTrials; ++i) {
+    CancelToken token;
+    std::thread canceller([&] {
+      std::this_thread::sleep_for(std::chrono::duration<double>(seconds * i / (kTrials - 8)));
+      token.Cancel();
+    });
+    const auto out = ImproveTopology(m, 0.5, options, nullptr, &token);
+    canceller.join();
+    if (!out.ok()) {
+      EXPECT_EQ(out.status().code(), absl::StatusCode::kCancelled) << out.status();
+      ++cancelled;
+      continue;
+    }
+    ++finished;
+    EXPECT_EQ(out->triangles, expected->triangles);
+    EXPECT_EQ(out->shapes, expected->shapes);
+  }
+  EXPECT_GT(cancelled, 0);
+  EXPECT_GT(finished, 0);  // the last trials start after the uncancelled pass's time
 }
 
 TEST(ComeshTopologyTest, CollapsesANeedlessVertexKeepingBoundaryAndValidity) {
