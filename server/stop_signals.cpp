@@ -1,6 +1,7 @@
 #include "server/stop_signals.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -43,6 +44,13 @@ bool InstallStopSignals() {
 int WaitForStopSignal() {
   unsigned char byte = 0;
   for (;;) {
+    // A timed wait rather than a blocking read: ThreadSanitizer (scripts/sanitize tsan) runs a
+    // handler only when the thread the kernel gave the signal to next enters the sanitizer's
+    // runtime, and a read that never returns is not such a point (the server did not stop on
+    // SIGTERM under TSan). Each wake-up costs nothing measurable.
+    pollfd ready{stop_pipe[0], POLLIN, 0};
+    const int n = poll(&ready, 1, /*timeout_ms=*/200);
+    if (n == 0 || (n < 0 && errno == EINTR)) continue;
     const ssize_t got = read(stop_pipe[0], &byte, 1);
     if (got == 1) return byte;
     if (got < 0 && errno == EINTR) continue;

@@ -9,7 +9,9 @@
 // whole catalogue must equal, bit for bit, the frames of the same job run alone before it.
 //
 // Usage: bad_input_runner --server HOST:PORT --token T --other-token T2 --healthy-token T3
-//                         --cases DIR --examples DIR [--only NAME]
+//                         --cases DIR --examples DIR [--only NAME] [--deadline-seconds S]
+// (S: each call's deadline unless its step sets deadline_ms; 60 by default, longer for the
+// sanitizer builds, whose server runs several times slower)
 #include <grpcpp/create_channel.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/impl/codegen/client_unary_call.h>
@@ -45,6 +47,7 @@ using Clock = std::chrono::steady_clock;
 
 struct Config {
   std::string server, token, other_token, healthy_token, cases, examples, only;
+  int deadline_seconds = 60;
 };
 
 std::string ReadFile(const fs::path& path) {
@@ -237,7 +240,8 @@ class Runner {
       ctx->AddMetadata("authorization", "Bearer " + token);
     }
     if (!session.empty()) ctx->AddMetadata("x-session-id", session);
-    ctx->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+    ctx->set_deadline(std::chrono::system_clock::now() +
+                      std::chrono::seconds(config_.deadline_seconds));
     return ctx;
   }
 
@@ -750,6 +754,8 @@ int main(int argc, char** argv) {
       config.examples = value;
     else if (flag == "--only")
       config.only = value;
+    else if (flag == "--deadline-seconds")
+      config.deadline_seconds = std::stoi(value);
     else {
       std::cerr << "bad_input_runner: unknown flag " << flag << "\n";
       return 2;
@@ -757,7 +763,8 @@ int main(int argc, char** argv) {
   }
   if (config.server.empty() || config.cases.empty() || config.examples.empty()) {
     std::cerr << "usage: bad_input_runner --server HOST:PORT --token T --other-token T2 "
-                 "--healthy-token T3 --cases DIR --examples DIR [--only NAME]\n";
+                 "--healthy-token T3 --cases DIR --examples DIR [--only NAME] "
+                 "[--deadline-seconds S]\n";
     return 2;
   }
   try {
