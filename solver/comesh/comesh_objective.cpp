@@ -98,7 +98,7 @@ double ComeshObjective::TriangleTerm(const Triangle& t, const std::vector<Points
 }
 
 double ComeshObjective::Evaluate(const std::vector<Points>& shapes, std::vector<Points>* gradient,
-                                 ComeshEnergies* energies) const {
+                                 ComeshEnergies* energies, const CancelToken* cancel) const {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   constexpr int kChunk = 2048;  // triangles per chunk (fixed: results independent of threads)
   const int n = num_shapes();
@@ -110,6 +110,7 @@ double ComeshObjective::Evaluate(const std::vector<Points>& shapes, std::vector<
   // Per chunk: sum of D_t / N_i and of C_t / A_i over its triangles and shapes; NaN if invalid.
   std::vector<double> mesh_part(chunks, 0.0), map_part(chunks, 0.0);
   ParallelChunks(num_triangles, kChunk, threads_, [&](int chunk, int begin, int end) {
+    if (Cancelled(cancel)) return;  // the result is NaN below
     double mesh_sum = 0.0, map_sum = 0.0;
     std::array<Point, 3> g_odt, g_i, g_j;
     for (int t = begin; t < end; ++t) {
@@ -147,6 +148,8 @@ double ComeshObjective::Evaluate(const std::vector<Points>& shapes, std::vector<
     map_part[chunk] = map_sum;
   });
   double mesh_sum = 0.0, map_sum = 0.0;
+  // Chunks skipped after a cancel left zeros: the sums mean nothing then.
+  if (Cancelled(cancel)) return std::numeric_limits<double>::quiet_NaN();
   for (int c = 0; c < chunks; ++c) {
     mesh_sum += mesh_part[c];
     map_sum += map_part[c];

@@ -425,21 +425,23 @@ class HessianPreconditioner {
     const int n = layout.num_vertices();
     const int num_shapes = layout.num_shapes();
     // Each vertex's neighbours and itself, ascending: nbrs(v) (compressed rows, one allocation).
+    // The loops below poll `cancel` every kSetUpPoll items: at 311k vertices the pattern took
+    // ~0.56 s, the node graph and matrix ~0.37 s, these neighbour lists ~0.12 s.
     std::vector<int> start(n + 1, 0), list(9 * triangles.size());
-    for (const Triangle& t : triangles) {
-      for (int a = 0; a < 3; ++a) start[t[a] + 1] += 3;
+    for (size_t t = 0; t < triangles.size(); ++t) {
+      if (t % kSetUpPoll == 0 && Cancelled(cancel)) return SetUpCancelled();
+      for (int a = 0; a < 3; ++a) start[triangles[t][a] + 1] += 3;
     }
     for (int v = 0; v < n; ++v) start[v + 1] += start[v];
     {
       std::vector<int> fill(start.begin(), start.end() - 1);
-      for (const Triangle& t : triangles) {
+      for (size_t t = 0; t < triangles.size(); ++t) {
+        if (t % kSetUpPoll == 0 && Cancelled(cancel)) return SetUpCancelled();
         for (int a = 0; a < 3; ++a) {
-          for (int b = 0; b < 3; ++b) list[fill[t[a]]++] = t[b];
+          for (int b = 0; b < 3; ++b) list[fill[triangles[t][a]]++] = triangles[t][b];
         }
       }
     }
-    // The loops below poll `cancel` every kSetUpPoll items: at 311k vertices the pattern took
-    // ~0.56 s, the node graph and matrix ~0.37 s, these neighbour lists ~0.12 s.
     std::vector<int> count(n);
     for (int v = 0; v < n; ++v) {
       if (v % kSetUpPoll == 0 && Cancelled(cancel)) return SetUpCancelled();
@@ -462,6 +464,21 @@ class HessianPreconditioner {
     // the same shape at the vertex and its neighbours, ascending (offsets grow with the vertex).
     std::vector<std::vector<int>> outer(num_shapes), inner(num_shapes);
     for (int s = 0; s < num_shapes; ++s) outer[s].assign(h.begin_[s + 1] - h.begin_[s] + 1, 0);
+    // Room for every entry first (at most 2 rows per neighbour and column): growing by doubling
+    // copied ~16 MB at once at 311k vertices, ~0.1 s without a poll.
+    {
+      std::vector<size_t> bound(num_shapes, 0);
+      for (size_t i = 0; i < layout.vars().size(); ++i) {
+        if (i % kSetUpPoll == 0 && Cancelled(cancel)) return SetUpCancelled();
+        const Layout::Var& var = layout.vars()[i];
+        bound[var.shape] += (var.slider ? 2 : 4) * static_cast<size_t>(count[var.vertex]);
+      }
+      for (int s = 0; s < num_shapes; ++s) {
+        inner[s].reserve(bound[s]);
+        // As many graph entries as vertex neighbours at most (rows <= column, below).
+        h.blocks_[s].node_inner.reserve(bound[s] / 2);
+      }
+    }
     for (size_t i = 0; i < layout.vars().size(); ++i) {
       if (i % kSetUpPoll == 0 && Cancelled(cancel)) return SetUpCancelled();
       const Layout::Var& var = layout.vars()[i];
@@ -847,7 +864,8 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   std::vector<Points>& shapes = mesh->shapes;
   std::vector<Points> grad_shapes;
   ComeshEnergies energies;
-  double f = objective->Evaluate(shapes, &grad_shapes, &energies);
+  double f = objective->Evaluate(shapes, &grad_shapes, &energies, cancel);
+  if (Cancelled(cancel)) return cancelled_at(0);  // f is NaN then
   ++stats->evaluations;
   stats->energies = energies;
   stats->objective = f;
@@ -979,10 +997,11 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       if (Cancelled(cancel)) return cancelled_at(iter);
       z_new = z + step * d;
       layout.Scatter(z_new, &trial);
-      f_new = objective->Evaluate(trial, &trial_grad, &trial_energies);
+      f_new = objective->Evaluate(trial, &trial_grad, &trial_energies, cancel);
       ++stats->evaluations;
-      // And after it: with the curvature pair's update below, an accepted trial was the longest
-      // stretch without a poll at 311k vertices (avg 188 ms, max 346 ms: ninth session).
+      // And after it (f_new is NaN if it was cancelled inside; ~0.1 s at 311k vertices): with
+      // the curvature pair's update below, an accepted trial was the longest stretch without a
+      // poll at 311k vertices (avg 188 ms, max 346 ms: ninth session).
       if (Cancelled(cancel)) return cancelled_at(iter);
       if (std::isfinite(f_new) && f_new <= f + options.armijo * step * slope) {
         accepted = true;

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <thread>
 
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
 
@@ -59,6 +61,40 @@ TEST(ComeshObjectiveTest, ReportsConformalAndGridEnergies) {
   EXPECT_NEAR(e.mesh, 2.0 / std::sqrt(3.0), 1e-12);
   EXPECT_NEAR(f, 2 * (0.75 * e.mesh + 0.25 * e.map), 1e-12);
   EXPECT_EQ(e.objective, f);
+}
+
+// A live token changes nothing; a set one gives NaN; a cancel at any moment of a parallel
+// evaluation gives NaN or exactly the uncancelled value (never a partial sum).
+TEST(ComeshObjectiveTest, CancelGivesNaNOrTheExactValue) {
+  const Multimesh m = testing::SquareGrid(100);  // 20,000 triangles: parallel chunks
+  const std::vector<Points> shapes = {testing::SmoothlyDistorted(m.shapes[0], 0.05),
+                                      testing::TutteHexagon(m)};
+  auto o = ComeshObjective::Create(m.triangles, shapes, 0.5, /*threads=*/2);
+  ASSERT_TRUE(o.ok()) << o.status();
+  std::vector<Points> g, g_live;
+  const double f = o->Evaluate(shapes, &g);
+  CancelToken live, set;
+  set.Cancel();
+  EXPECT_EQ(o->Evaluate(shapes, &g_live, nullptr, &live), f);
+  EXPECT_EQ(g_live, g);
+  EXPECT_TRUE(std::isnan(o->Evaluate(shapes, &g_live, nullptr, &set)));
+  int nan = 0, exact = 0;
+  for (int i = 0; i < 60; ++i) {
+    CancelToken token;
+    std::thread canceller([&] {
+      std::this_thread::sleep_for(std::chrono::microseconds(50 * i));
+      token.Cancel();
+    });
+    const double value = o->Evaluate(shapes, nullptr, nullptr, &token);
+    canceller.join();
+    if (std::isnan(value)) {
+      ++nan;
+    } else {
+      EXPECT_EQ(value, f) << "trial " << i;
+      ++exact;
+    }
+  }
+  EXPECT_GT(nan, 0);
 }
 
 TEST(ComeshObjectiveTest, InvertedShapeGivesInfinity) {
