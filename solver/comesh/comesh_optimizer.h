@@ -177,10 +177,11 @@ struct ComeshReport {
 // between every phase of an iteration, inside the direction's solves and the line search,
 // inside the set-up's loops and factorizations and before every topology operation; the symbolic
 // analysis of a large Hessian block runs on a helper thread that a cancel leaves behind
-// (RunCancellable); large dense supernodes are factored in polled panels. Measured from the
-// cancel to the return: at most 69 ms up to 165k vertices; at 311k p50 23 ms, max 35 ms in 8
-// trials (a topology pass's edge lists, up to ~0.2 s without a poll, are the longest stretch
-// left; docs/benchmarks.md). `progress` (may be empty) is called once per iteration; `report`
+// (RunCancellable); large dense supernodes are factored in polled panels; energy evaluations
+// poll per chunk of triangles. Measured from the cancel to the return: at most 69 ms up to 165k
+// vertices; at 311k p50 23-29 ms, max 35 ms and 115 ms in two sets of 8 trials (stretches of
+// ~0.1 s without a poll remain inside CHOLMOD's numeric factorization; docs/benchmarks.md).
+// `progress` (may be empty) is called once per iteration; `report`
 // may be null. The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are
 // remapped to the compacted vertex numbering. `resume` (may be null): continue from a checkpoint
 // that a run on the same `mesh` with the same options reported (InvalidArgument if its multimesh is
