@@ -19,6 +19,31 @@ double Area2(const Point& a, const Point& b, const Point& c) {
   return ab.x() * ac.y() - ab.y() * ac.x();
 }
 
+// Edges (a, b), a < b, grouped by a in linear time: `for_each_edge(emit)` calls emit(a, b) for
+// every edge (repeats allowed; it returns false when cancelled) and is called twice, to count and
+// to fill (a counting sort on a). Then each bucket (a vertex's few higher neighbours, ascending)
+// is sorted on its own and handed to bucket(a, begin, end). Polls `cancel` every 4096 buckets;
+// false if it was set. One std::sort of all the pairs instead took 3.5% of the 35k-vertex S-Table
+// 2 row, and ~0.1 s without a poll at 311k vertices.
+template <typename ForEachEdge, typename Bucket>
+bool ForEachBucket(int n, ForEachEdge&& for_each_edge, Bucket&& bucket, const CancelToken* cancel) {
+  std::vector<int> start(n + 1, 0);
+  if (!for_each_edge([&](int a, int) { ++start[a + 1]; })) return false;
+  for (int a = 0; a < n; ++a) start[a + 1] += start[a];
+  std::vector<int> higher(start[n]);
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    if (!for_each_edge([&](int a, int b) { higher[fill[a]++] = b; })) return false;
+  }
+  for (int a = 0; a < n; ++a) {
+    if (a % 4096 == 0 && Cancelled(cancel)) return false;
+    const auto begin = higher.begin() + start[a], end = higher.begin() + start[a + 1];
+    std::sort(begin, end);
+    bucket(a, begin, end);
+  }
+  return !Cancelled(cancel);
+}
+
 // Mutable triangle soup with vertex -> triangle incidence and the running objective sums.
 class Editor {
  public:
@@ -103,43 +128,32 @@ class Editor {
   // into *interior; false if `cancel` was set (polled every 4096 vertices and edges).
   bool InteriorEdgesAt(const std::vector<int>& vertices, const CancelToken* cancel,
                        std::vector<std::pair<int, int>>* interior) const {
-    // Each edge (a, b), a < b, of the vertices' triangles into the bucket of a (a counting sort
-    // on a; one std::sort of all the pairs took ~0.1 s without a poll at 311k vertices), each
-    // bucket sorted on its own and its repeats skipped: ascending (a, b), each once.
+    // Ascending (a, b), each once: a bucket's repeats skipped.
     const int n = static_cast<int>(incident_.size());
-    auto for_each_edge = [&](auto&& f) {
+    auto for_each_edge = [&](auto&& emit) {
       for (size_t i = 0; i < vertices.size(); ++i) {
         if (i % 4096 == 0 && Cancelled(cancel)) return false;
         const int v = vertices[i];
         if (v >= n) continue;
         for (int t : incident_[v]) {
           for (int u : triangles_[t]) {
-            if (u != v) f(std::min(u, v), std::max(u, v));
+            if (u != v) emit(std::min(u, v), std::max(u, v));
           }
         }
       }
       return true;
     };
-    std::vector<int> start(n + 1, 0);
-    if (!for_each_edge([&](int a, int) { ++start[a + 1]; })) return false;
-    for (int a = 0; a < n; ++a) start[a + 1] += start[a];
-    std::vector<int> higher(start[n]);
-    {
-      std::vector<int> fill(start.begin(), start.end() - 1);
-      if (!for_each_edge([&](int a, int b) { higher[fill[a]++] = b; })) return false;
-    }
     interior->clear();
     int t1 = -1, t2 = -1;
-    for (int a = 0; a < n; ++a) {
-      if (a % 4096 == 0 && Cancelled(cancel)) return false;
-      const auto begin = higher.begin() + start[a], end = higher.begin() + start[a + 1];
-      std::sort(begin, end);
-      for (auto i = begin; i != end; ++i) {
-        if (i != begin && *i == *(i - 1)) continue;
-        if (EdgeTriangles(a, *i, &t1, &t2)) interior->push_back({a, *i});
-      }
-    }
-    return true;
+    return ForEachBucket(
+        n, for_each_edge,
+        [&](int a, auto begin, auto end) {
+          for (auto i = begin; i != end; ++i) {
+            if (i != begin && *i == *(i - 1)) continue;
+            if (EdgeTriangles(a, *i, &t1, &t2)) interior->push_back({a, *i});
+          }
+        },
+        cancel);
   }
 
   // Length of edge (a, b) relative to the mean edge length, max (or min) over shapes.
@@ -462,48 +476,39 @@ std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Tria
 
 bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& alive,
               const CancelToken* cancel, std::vector<std::pair<std::pair<int, int>, int>>* uses) {
-  // Linear time: each edge (a, b), a < b, goes to the bucket of a (a counting sort on a), each
-  // bucket (a vertex's few higher neighbours) is sorted on its own, and equal b's in a bucket are
-  // one edge's uses. Measured 3.5% of the 35k-vertex S-Table 2 row with one std::sort of 3T keys.
-  auto poll = [cancel](size_t i) { return i % 4096 == 0 && Cancelled(cancel); };
+  // Equal b's in a bucket (ForEachBucket) are one edge's uses.
   int n = 0;
+  size_t live = 0;
   for (size_t t = 0; t < triangles.size(); ++t) {
-    if (poll(t)) return false;
-    if (alive[t]) n = std::max({n, triangles[t][0] + 1, triangles[t][1] + 1, triangles[t][2] + 1});
-  }
-  std::vector<int> start(n + 1, 0);
-  for (size_t t = 0; t < triangles.size(); ++t) {
-    if (poll(t)) return false;
+    if (t % 4096 == 0 && Cancelled(cancel)) return false;
     if (!alive[t]) continue;
-    for (int k = 0; k < 3; ++k) ++start[std::min(triangles[t][k], triangles[t][(k + 1) % 3]) + 1];
+    ++live;
+    n = std::max({n, triangles[t][0] + 1, triangles[t][1] + 1, triangles[t][2] + 1});
   }
-  for (int v = 0; v < n; ++v) start[v + 1] += start[v];
-  std::vector<int> higher(start[n]);
-  {
-    std::vector<int> fill(start.begin(), start.end() - 1);
+  auto for_each_edge = [&](auto&& emit) {
     for (size_t t = 0; t < triangles.size(); ++t) {
-      if (poll(t)) return false;
+      if (t % 4096 == 0 && Cancelled(cancel)) return false;
       if (!alive[t]) continue;
       for (int k = 0; k < 3; ++k) {
         const auto [a, b] = std::minmax(triangles[t][k], triangles[t][(k + 1) % 3]);
-        higher[fill[a]++] = b;
+        emit(a, b);
       }
     }
-  }
+    return true;
+  };
   uses->clear();
-  uses->reserve(higher.size() / 2 + 1);
-  for (int a = 0; a < n; ++a) {
-    if (poll(static_cast<size_t>(a))) return false;
-    const auto begin = higher.begin() + start[a], end = higher.begin() + start[a + 1];
-    std::sort(begin, end);
-    for (auto i = begin; i != end;) {
-      auto j = i;
-      while (j != end && *j == *i) ++j;
-      uses->push_back({{a, *i}, static_cast<int>(j - i)});
-      i = j;
-    }
-  }
-  return !Cancelled(cancel);
+  uses->reserve(3 * live / 2 + 1);  // interior edges have two uses
+  return ForEachBucket(
+      n, for_each_edge,
+      [&](int a, auto begin, auto end) {
+        for (auto i = begin; i != end;) {
+          auto j = i;
+          while (j != end && *j == *i) ++j;
+          uses->push_back({{a, *i}, static_cast<int>(j - i)});
+          i = j;
+        }
+      },
+      cancel);
 }
 
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
