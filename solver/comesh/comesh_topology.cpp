@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <utility>
 #include <vector>
 
@@ -554,30 +553,25 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
     return true;
   };
   if (!flip_sweeps(/*all_edges=*/true)) return cancelled_status;
-  // The interior edges whose relative length (max over shapes) passes `keep`, as (key, edge)
-  // sorted by key; false if cancelled.
+  // The interior edges with sign * r < sign * ratio, r their relative length (max over shapes),
+  // as (sign * r, edge) ascending: sign +1 lists the shortest first below a ratio (collapses),
+  // -1 the longest first above it (splits); false if cancelled.
   std::vector<std::pair<int, int>> interior;
   std::vector<std::pair<double, std::pair<int, int>>> candidates;
-  auto candidates_by = [&](auto&& key) {
+  auto candidates_by = [&](double sign, double ratio) {
     if (!editor.InteriorEdges(cancel, &interior)) return false;
     candidates.clear();
     for (size_t i = 0; i < interior.size(); ++i) {
       if (i % 4096 == 0 && Cancelled(cancel)) return false;
       const auto [a, b] = interior[i];
-      if (const std::optional<double> k = key(editor.RelativeLength(a, b, /*max=*/true))) {
-        candidates.push_back({*k, {a, b}});
-      }
+      const double key = sign * editor.RelativeLength(a, b, /*max=*/true);
+      if (key < sign * ratio) candidates.push_back({key, {a, b}});
     }
     std::sort(candidates.begin(), candidates.end());
     return !Cancelled(cancel);
   };
   if (options.collapses) {
-    if (!candidates_by([&](double r) -> std::optional<double> {
-          if (r < options.collapse_ratio) return r;
-          return std::nullopt;
-        })) {
-      return cancelled_status;
-    }
+    if (!candidates_by(+1.0, options.collapse_ratio)) return cancelled_status;
     for (const auto& [r, edge] : candidates) {
       if (Cancelled(cancel)) return cancelled_status;
       rep.collapses += editor.TryCollapse(edge.first, edge.second) ||
@@ -585,12 +579,7 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
     }
   }
   if (options.splits) {
-    if (!candidates_by([&](double r) -> std::optional<double> {
-          if (r > options.split_ratio) return -r;
-          return std::nullopt;
-        })) {
-      return cancelled_status;
-    }
+    if (!candidates_by(-1.0, options.split_ratio)) return cancelled_status;
     for (const auto& [r, edge] : candidates) {
       if (Cancelled(cancel)) return cancelled_status;
       rep.splits += editor.TrySplit(edge.first, edge.second);
