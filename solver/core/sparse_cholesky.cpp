@@ -70,6 +70,28 @@ struct SparseCholesky::Impl {
   void BuildPermutedLower();
   // Scatters a's values into lower_x, polling `cancel` every kScatterPoll values; false if set.
   bool ScatterPermutedLower(const Eigen::SparseMatrix<double>& a, const CancelToken* cancel);
+  // A supernodal factor fresh from an analysis holds no values: cholmod_super_numeric allocates
+  // them (cholmod_change_factor, as here) and their pages are first touched as it clears each
+  // supernode, inside the one library call (at 311k vertices 50-144 ms at a stretch between two
+  // of our BLAS hooks, the largest supernodes being last), and every analysis (one per topology
+  // pass) did so again: the values are hundreds of MB there, so glibc maps them anew each time.
+  // This gives the factor the previous factor's value array when it is large enough (its pages
+  // are resident: CHOLMOD clears each supernode itself before using it), else a new one with
+  // 1/8 more room, whose pages it touches in polled spans of kTouchPoll values when `cancel` is
+  // given. cholmod_super_numeric then finds the factor numeric. 1 when done, 0 on a CHOLMOD error
+  // (common.status), -1 if cancelled (the factor is then numeric with meaningless values, which
+  // the next Factorize overwrites like any refactorization's).
+  int AllocateSupernodalValues(const CancelToken* cancel);
+  // Frees the factor, keeping a supernodal factor's value array as the spare for the next one.
+  void FreeFactor();
+  void FreeSpare() {
+    if (spare_x != nullptr) cholmod_free(spare_capacity, sizeof(double), spare_x, &common);
+    spare_x = nullptr;
+    spare_capacity = 0;
+  }
+  void* spare_x = nullptr;
+  size_t spare_capacity = 0;  // values
+  size_t x_capacity = 0;      // values factor->x has room for (0: factor->xsize)
 
   void Extract();
   // The simplicial numeric factorization in row blocks of kCancelRows, polling `cancel` between
@@ -91,7 +113,8 @@ struct SparseCholesky::Impl {
 
   explicit Impl(Method method);
   ~Impl() {
-    if (factor != nullptr) cholmod_free_factor(&factor, &common);
+    FreeFactor();
+    FreeSpare();
     cholmod_finish(&common);
   }
   Impl(const Impl&) = delete;
@@ -148,6 +171,51 @@ bool SparseCholesky::Impl::ScatterPermutedLower(const Eigen::SparseMatrix<double
     }
   }
   return true;
+}
+
+int SparseCholesky::Impl::AllocateSupernodalValues(const CancelToken* cancel) {
+  constexpr size_t kTouchPoll = size_t{1} << 19;  // 4 MB of doubles
+  // Allocates factor->xsize values (malloc, pages not touched yet).
+  if (!cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/1, /*to_packed=*/1,
+                             /*to_monotonic=*/1, factor, &common) ||
+      common.status < CHOLMOD_OK) {
+    return 0;
+  }
+  const size_t need = factor->xsize;
+  if (spare_x != nullptr && spare_capacity >= need) {
+    cholmod_free(need, sizeof(double), factor->x, &common);
+    factor->x = spare_x;
+    x_capacity = spare_capacity;
+    spare_x = nullptr;
+    spare_capacity = 0;
+    return 1;
+  }
+  FreeSpare();
+  const size_t capacity = need + need / 8;
+  void* x = cholmod_malloc(capacity, sizeof(double), &common);
+  if (x == nullptr) return 0;
+  cholmod_free(need, sizeof(double), factor->x, &common);
+  factor->x = x;
+  x_capacity = capacity;
+  if (cancel == nullptr) return 1;
+  double* values = static_cast<double*>(x);
+  for (size_t begin = 0; begin < need; begin += kTouchPoll) {
+    if (cancel->IsCancelled()) return -1;
+    std::fill(values + begin, values + std::min(need, begin + kTouchPoll), 0.0);
+  }
+  return 1;
+}
+
+void SparseCholesky::Impl::FreeFactor() {
+  if (factor == nullptr) return;
+  if (factor->is_super && factor->xtype != CHOLMOD_PATTERN && factor->x != nullptr) {
+    FreeSpare();
+    spare_x = factor->x;
+    spare_capacity = std::max(x_capacity, factor->xsize);
+    factor->x = nullptr;
+  }
+  x_capacity = 0;
+  cholmod_free_factor(&factor, &common);
 }
 
 void SparseCholesky::Impl::Extract() {
@@ -539,7 +607,7 @@ absl::Status SparseCholesky::Analyze(const Eigen::SparseMatrix<double>& a,
     }
   }
   Impl& m = *impl_;
-  if (m.factor != nullptr) cholmod_free_factor(&m.factor, &m.common);
+  m.FreeFactor();
   m.factorized = false;
   m.n = static_cast<int>(a.rows());
   m.outer.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1);
@@ -596,6 +664,11 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a,
   } else {
     const bool super = m.factor->is_super != 0;
     if (super && !m.ScatterPermutedLower(a, cancel)) return cancelled();
+    if (super && m.factor->xtype == CHOLMOD_PATTERN) {
+      const int allocated = m.AllocateSupernodalValues(cancel);
+      if (allocated < 0) return cancelled();
+      if (allocated == 0) return CholmodError(m.common, "numeric factorization");
+    }
     const BlasLock blas(/*uses_blas=*/super);
     bool stopped = false;
     {

@@ -427,10 +427,11 @@ extern "C" void dgemm_(const char* transa, const char* transb, const int* m, con
                        const int* ldc, size_t transa_length, size_t transb_length);
 
 // A cancel may land anywhere in a panelled factorization (between panels, or in a BLAS call the
-// hooks then skip): the answer is OK with a right factor or CANCELLED, never "not positive
-// definite", BLAS calls on the thread compute again afterwards, and a factorization without the
-// token is right.
-TEST(SparseCholeskyTest, CancelAtAnyMomentOfAPanelledFactorizationIsClean) {
+// hooks then skip), and in the first one after an analysis also while the factor's values are
+// allocated and their pages touched: the answer is OK with a right factor or CANCELLED, never
+// "not positive definite", BLAS calls on the thread compute again afterwards, and a
+// factorization without the token is right.
+void CancelAtSpreadMoments(bool fresh_analysis) {
   const int n = 8 * SparseCholesky::kDensePanel;
   const Eigen::SparseMatrix<double> a = DenseSpd(n, 7);
   const Eigen::SparseMatrix<double> full = a.selfadjointView<Eigen::Upper>();
@@ -443,7 +444,14 @@ TEST(SparseCholeskyTest, CancelAtAnyMomentOfAPanelledFactorizationIsClean) {
   ASSERT_TRUE(chol.Factorize(a).ok());
   const std::chrono::duration<double> whole = std::chrono::steady_clock::now() - start;
   int cancelled = 0;
+  const Eigen::SparseMatrix<double> small = DenseSpd(SparseCholesky::kDensePanel, 3);
   for (int trial = 0; trial < 12; ++trial) {
+    if (fresh_analysis) {
+      // A smaller factor first, so that `a`'s values need a new array (see the .cpp).
+      ASSERT_TRUE(chol.Analyze(small).ok());
+      ASSERT_TRUE(chol.Factorize(small).ok());
+      ASSERT_TRUE(chol.Analyze(a).ok());
+    }
     CancelToken token;
     std::thread canceller([&token, trial, whole] {
       std::this_thread::sleep_for(whole * trial / 10);
@@ -469,7 +477,35 @@ TEST(SparseCholeskyTest, CancelAtAnyMomentOfAPanelledFactorizationIsClean) {
     ASSERT_TRUE(chol.SolveInPlace(&x).ok());
     EXPECT_LT((full * x - b).cwiseAbs().maxCoeff(), 1e-10) << "trial " << trial;
   }
-  RecordProperty("cancelled", cancelled);
+  ::testing::Test::RecordProperty("cancelled", cancelled);
+}
+
+TEST(SparseCholeskyTest, CancelAtAnyMomentOfAPanelledFactorizationIsClean) {
+  CancelAtSpreadMoments(/*fresh_analysis=*/false);
+}
+
+TEST(SparseCholeskyTest, CancelAtAnyMomentOfTheFirstFactorizationAfterAnAnalysisIsClean) {
+  CancelAtSpreadMoments(/*fresh_analysis=*/true);
+}
+
+// One object analyzes and factors supernodal matrices of changing size and pattern in turn (a
+// new factor reuses the previous one's value array when it is large enough): every solution is
+// right, with and without a cancellation token.
+TEST(SparseCholeskyTest, ReanalysesOfOtherPatternsFactorCorrectly) {
+  SparseCholesky chol(SparseCholesky::Method::kAuto);
+  const CancelToken live;
+  int step = 0;
+  for (int n : {90, 100, 70, 100, 60, 95}) {
+    const Eigen::SparseMatrix<double> a = GridMatrix(n, 1e-2 * n, 1.0, 3);
+    ASSERT_TRUE(chol.Analyze(a).ok());
+    ASSERT_TRUE(chol.supernodal()) << n;
+    ASSERT_TRUE(chol.Factorize(a, step++ % 2 == 0 ? &live : nullptr).ok()) << n;
+    const Eigen::SparseMatrix<double> full = a.selfadjointView<Eigen::Upper>();
+    const Eigen::MatrixXd b = Eigen::MatrixXd::Ones(a.rows(), 1);
+    Eigen::MatrixXd x = b;
+    ASSERT_TRUE(chol.SolveInPlace(&x).ok());
+    EXPECT_LT((full * x - b).cwiseAbs().maxCoeff(), 1e-8) << n;
+  }
 }
 
 // Supernodal factorizations on several threads at once (the comesh preconditioner factors its
