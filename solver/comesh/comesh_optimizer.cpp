@@ -82,7 +82,9 @@ absl::Status ValidateInput(const Multimesh& mesh) {
 // (in that shape) moves along that line; every other vertex is fixed.
 class Layout {
  public:
-  Layout(const Multimesh& mesh, bool slide_boundary) {
+  // With a `cancel` token (may be null) the edge list polls it (~0.1 s at 311k vertices); if it
+  // was set, cancelled() is true and the layout is empty.
+  Layout(const Multimesh& mesh, bool slide_boundary, const CancelToken* cancel = nullptr) {
     const int n = mesh.num_vertices();
     num_vertices_ = n;
     num_shapes_ = mesh.num_shapes();
@@ -90,9 +92,13 @@ class Layout {
     for (const Triangle& t : mesh.triangles) {
       for (int k = 0; k < 3; ++k) used[t[k]] = 1;
     }
+    std::vector<std::pair<std::pair<int, int>, int>> uses;
+    if (!EdgeUses(mesh.triangles, std::vector<char>(mesh.triangles.size(), 1), cancel, &uses)) {
+      cancelled_ = true;
+      return;
+    }
     std::vector<std::vector<int>> boundary_nbrs(n);
-    for (const auto& [edge, count] :
-         EdgeUses(mesh.triangles, std::vector<char>(mesh.triangles.size(), 1))) {
+    for (const auto& [edge, count] : uses) {
       if (count % 2 == 0) continue;  // as before: an edge used an odd number of times
       boundary_nbrs[edge.first].push_back(edge.second);
       boundary_nbrs[edge.second].push_back(edge.first);
@@ -140,6 +146,7 @@ class Layout {
     Point base;       // position at the start, sliders only
   };
 
+  bool cancelled() const { return cancelled_; }
   int size() const { return size_; }
   int num_shapes() const { return num_shapes_; }
   int num_vertices() const { return num_vertices_; }
@@ -191,6 +198,7 @@ class Layout {
   int num_shapes_ = 0;
   int num_vertices_ = 0;
   int size_ = 0;
+  bool cancelled_ = false;
   std::vector<Var> vars_;
   std::vector<std::vector<int>> index_;  // [shape][vertex] -> var or -1
 };
@@ -567,13 +575,32 @@ class HessianPreconditioner {
     });
     return cancelled ? VectorXd() : x;
   }
-  VectorXd Apply(const VectorXd& x) const {
-    VectorXd out(x.size());
+  // H x; empty if `cancel` was set. Each block's product is Eigen's column-by-column one (the
+  // same sums in the same order) in spans of kApplyColumns columns with a poll before each: one
+  // product took ~0.1 s at 311k vertices.
+  VectorXd Apply(const VectorXd& x, const CancelToken* cancel) const {
+    constexpr int kApplyColumns = 1 << 14;
+    VectorXd out = VectorXd::Zero(x.size());
+    std::atomic<bool> cancelled{false};
     ForEachShape([&](int s) {
-      const int size = begin_[s + 1] - begin_[s];
-      if (size > 0) out.segment(begin_[s], size) = *blocks_[s].matrix * x.segment(begin_[s], size);
+      const Eigen::SparseMatrix<double>& m = *blocks_[s].matrix;
+      const int begin = begin_[s], size = begin_[s + 1] - begin_[s];
+      const int* outer = m.outerIndexPtr();
+      const int* inner = m.innerIndexPtr();
+      const double* values = m.valuePtr();
+      double* y = out.data() + begin;
+      for (int j0 = 0; j0 < size; j0 += kApplyColumns) {
+        if (Cancelled(cancel)) {
+          cancelled = true;
+          return;
+        }
+        for (int j = j0; j < std::min(size, j0 + kApplyColumns); ++j) {
+          const double xj = x[begin + j];
+          for (int k = outer[j]; k < outer[j + 1]; ++k) y[inner[k]] += values[k] * xj;
+        }
+      }
     });
-    return out;
+    return cancelled ? VectorXd() : out;
   }
 
  private:
@@ -785,18 +812,21 @@ class HessianPreconditioner {
 // keeps the linearised area at cure_keep * c0 if all corners are scaled alike; a vertex takes the
 // smallest factor of its triangles). A few blocking triangles then no longer shrink the step of
 // the whole mesh. Returns the number of scaled unknowns; `disp` is scratch (the displacements of
-// the uncured d).
+// the uncured d). -1 (d untouched) if `cancel` was set: polled before each chunk of triangles
+// (the whole took up to ~0.14 s at 311k vertices between two polls).
 int CureDirection(const std::vector<Triangle>& triangles, const std::vector<Points>& shapes,
-                  const Layout& layout, double cure_keep, int threads, std::vector<Points>* disp,
-                  VectorXd* d) {
+                  const Layout& layout, double cure_keep, int threads, const CancelToken* cancel,
+                  std::vector<Points>* disp, VectorXd* d) {
   constexpr int kChunk = 4096;
   layout.Displacements(*d, disp);
+  if (Cancelled(cancel)) return -1;
   // Per triangle and shape, the factor its moving corners need (1: none), in parallel; then each
   // vertex takes the smallest of its triangles' factors (serial, in triangle order).
   const int num_triangles = static_cast<int>(triangles.size());
   const int num_shapes = layout.num_shapes();
   std::vector<double> need(static_cast<size_t>(num_triangles) * num_shapes, 1.0);
   ParallelChunks(num_triangles, kChunk, threads, [&](int, int begin, int end) {
+    if (Cancelled(cancel)) return;  // `need` partly filled: not used
     for (int s = 0; s < num_shapes; ++s) {
       const Points& x = shapes[s];
       const Points& dx = (*disp)[s];
@@ -807,9 +837,11 @@ int CureDirection(const std::vector<Triangle>& triangles, const std::vector<Poin
       }
     }
   });
+  if (Cancelled(cancel)) return -1;
   std::vector<double> factor(layout.vars().size(), 1.0);
   for (int s = 0; s < num_shapes; ++s) {
     for (int ti = 0; ti < num_triangles; ++ti) {
+      if (ti % (16 * kChunk) == 0 && Cancelled(cancel)) return -1;
       const double c = need[static_cast<size_t>(s) * num_triangles + ti];
       if (c >= 1.0) continue;
       for (int k = 0; k < 3; ++k) {
@@ -868,8 +900,8 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       ComeshObjective::Create(mesh->triangles, mesh->shapes, options.map_weight, threads);
   if (!objective.ok()) return objective.status();
   if (Cancelled(cancel)) return cancelled_at(0);
-  const Layout layout(*mesh, options.slide_boundary);
-  if (Cancelled(cancel)) return cancelled_at(0);
+  const Layout layout(*mesh, options.slide_boundary, cancel);
+  if (layout.cancelled() || Cancelled(cancel)) return cancelled_at(0);
   std::vector<Points>& shapes = mesh->shapes;
   std::vector<Points> grad_shapes;
   ComeshEnergies energies;
@@ -905,7 +937,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   auto apply_inverse = [&](const VectorXd& v) {
     return hessian ? hessian->ApplyInverse(v, cancel) : laplacian->ApplyInverse(v, cancel);
   };
-  auto apply = [&](const VectorXd& v) { return hessian ? hessian->Apply(v) : laplacian->Apply(v); };
+  auto apply = [&](const VectorXd& v) {
+    return hessian ? hessian->Apply(v, cancel) : laplacian->Apply(v);
+  };
   stats->phases.hessian += clock.Lap();
 
   VectorXd z = layout.Gather(shapes);
@@ -942,10 +976,13 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       stats->phases.hessian += clock.Lap();
     }
     // L-BFGS two-loop recursion with H0 = B0^{-1} / beta.
+    // Empty if `cancel` was set: polled before each pair's vector operations too (the whole
+    // recursion, solves aside, took ~0.1 s at 311k vertices between two polls).
     auto direction = [&]() {
       VectorXd q = g;
       std::vector<double> alpha(pairs.size());
       for (int i = static_cast<int>(pairs.size()) - 1; i >= 0; --i) {
+        if (Cancelled(cancel)) return VectorXd();
         alpha[i] = pairs[i].rho * pairs[i].s.dot(q);
         q -= alpha[i] * pairs[i].y;
       }
@@ -953,9 +990,11 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       if (r.size() == 0) return r;  // cancelled
       r /= beta;
       for (size_t i = 0; i < pairs.size(); ++i) {
+        if (Cancelled(cancel)) return VectorXd();
         const double b = pairs[i].rho * pairs[i].y.dot(r);
         r += (alpha[i] - b) * pairs[i].s;
       }
+      if (Cancelled(cancel)) return VectorXd();
       return VectorXd(-r);
     };
     // Besides the top of the loop and the line search's trials, the token is polled inside the
@@ -981,8 +1020,10 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     if (options.cure) {
       VectorXd cured = d;
       disp_is_d = true;
-      if (CureDirection(mesh->triangles, shapes, layout, options.cure_keep, objective->threads(),
-                        &disp, &cured) > 0) {
+      const int scaled = CureDirection(mesh->triangles, shapes, layout, options.cure_keep,
+                                       objective->threads(), cancel, &disp, &cured);
+      if (scaled < 0) return cancelled_at(iter);
+      if (scaled > 0) {
         const double cured_slope = g.dot(cured);
         if (cured_slope < 0.0) {
           d = std::move(cured);
@@ -995,6 +1036,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     if (Cancelled(cancel)) return cancelled_at(iter);
     // Inversion-free backtracking line search.
     if (!disp_is_d) layout.Displacements(d, &disp);
+    if (Cancelled(cancel)) return cancelled_at(iter);
     const double max_step =
         MaxNonInvertingStep(mesh->triangles, shapes, disp, objective->threads());
     double step = std::min(1.0, options.max_step_fraction * max_step);
@@ -1007,6 +1049,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       if (Cancelled(cancel)) return cancelled_at(iter);
       z_new = z + step * d;
       layout.Scatter(z_new, &trial);
+      if (Cancelled(cancel)) return cancelled_at(iter);
       f_new = objective->Evaluate(trial, &trial_grad, &trial_energies, cancel);
       ++stats->evaluations;
       // And after it (f_new is NaN if it was cancelled inside; ~0.1 s at 311k vertices): with
@@ -1034,17 +1077,19 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     }
 
     const VectorXd g_new = layout.GatherGradient(trial_grad);
+    if (Cancelled(cancel)) return cancelled_at(iter);
     // The pair's vectors reuse the storage of the pair last dropped from the history (or not
     // kept): two fresh vectors every iteration cost ~30 ms of page faults at 311k vertices.
     Pair p = std::move(spare);
     p.s = z_new - z;
     p.y = g_new - g;
     p.rho = 0.0;
+    if (Cancelled(cancel)) return cancelled_at(iter);
     const double sy = p.s.dot(p.y);
     if (Cancelled(cancel)) return cancelled_at(iter);
     if (sy > 1e-12 * p.s.norm() * p.y.norm() && options.history > 0) {
-      const VectorXd b0s = apply(p.s);
-      if (Cancelled(cancel)) return cancelled_at(iter);
+      const VectorXd b0s = apply(p.s);  // empty if cancelled
+      if (b0s.size() != p.s.size() || Cancelled(cancel)) return cancelled_at(iter);
       if (options.scaling_by_inverse) {
         const VectorXd hy = apply_inverse(p.y);
         if (hy.size() == 0) return cancelled_at(iter);
