@@ -206,6 +206,40 @@ TEST(ComeshOptimizerTest, AnalysisOnAHelperThreadGivesTheSameResultAndCancels) {
   EXPECT_GT(cancelled, 0);
 }
 
+// Cancels spread over a whole run with the shape-block Hessian on two threads (every phase of an
+// iteration polls: the two-loop recursion, the solves, the Hessian product, curing, the step
+// bound, the trials, the pair update, and the set-up's layout, assembly and factorizations):
+// each answer is CANCELLED or exactly the uncancelled result, never another error or mesh.
+TEST(ComeshOptimizerTest, CancelAtAnyMomentAnswersCancelledOrTheSameResult) {
+  const Multimesh m = SquareToHexagon(16);
+  ComeshOptions options;
+  options.threads = 2;
+  CancelToken never;
+  const auto start = std::chrono::steady_clock::now();
+  const absl::StatusOr<Multimesh> whole = OptimizeComesh(m, options, &never, {}, nullptr);
+  const std::chrono::duration<double> seconds = std::chrono::steady_clock::now() - start;
+  ASSERT_TRUE(whole.ok()) << whole.status();
+  int cancelled = 0;
+  for (int trial = 0; trial < 24; ++trial) {
+    CancelToken cancel;
+    std::thread canceller([&] {
+      std::this_thread::sleep_for(seconds * trial / 20);
+      cancel.Cancel();
+    });
+    const absl::StatusOr<Multimesh> out = OptimizeComesh(m, options, &cancel, {}, nullptr);
+    canceller.join();
+    if (out.ok()) {
+      EXPECT_EQ(out->shapes, whole->shapes) << "trial " << trial;
+      EXPECT_EQ(out->triangles, whole->triangles) << "trial " << trial;
+      continue;
+    }
+    EXPECT_TRUE(absl::IsCancelled(out.status())) << "trial " << trial << ": " << out.status();
+    ++cancelled;
+  }
+  EXPECT_GT(cancelled, 0);
+  RecordProperty("cancelled", cancelled);
+}
+
 TEST(ComeshOptimizerTest, RejectsInvertedInputNamingShape) {
   Multimesh m = SquareToHexagon(4);
   std::swap(m.shapes[1][6], m.shapes[1][7]);
