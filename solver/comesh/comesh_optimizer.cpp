@@ -407,6 +407,11 @@ class InitialHessian {
   std::unique_ptr<SparseCholesky> solver_;  // by pointer: keeps InitialHessian movable
 };
 
+// Each shape's SparseCholesky, kept from one inner run to the next: a new analysis then reuses
+// the previous factor's value array (hundreds of MB at 311k vertices, its pages already mapped;
+// see SparseCholesky) instead of allocating and faulting in a new one.
+using SharedFactors = std::vector<std::shared_ptr<SparseCholesky>>;
+
 // Newton-type initial Hessian: the comesh objective's Hessian, block diagonal by shape (the mixed
 // shape-shape MIPS blocks are left out) and made positive definite per triangle and shape
 // (comesh_hessian.h: the edge-space 4 x 4 sum of that shape's ODT term and its two MIPS terms,
@@ -417,20 +422,12 @@ class InitialHessian {
 // at new positions and refactors on the same patterns. Shapes are assembled, factored and solved on
 // separate threads (large meshes only): each touches only its own block, in a fixed order, so
 // results do not depend on the thread count.
-// Each shape's SparseCholesky, kept from one inner run to the next: a new analysis then reuses
-// the previous factor's value array (hundreds of MB at 311k vertices, its pages already mapped;
-// see SparseCholesky) instead of allocating and faulting in a new one.
-using SharedFactors = std::vector<std::shared_ptr<SparseCholesky>>;
-
 class HessianPreconditioner {
  public:
-  static absl::StatusOr<HessianPreconditioner> Create(const std::vector<Triangle>& triangles,
-                                                      const Layout& layout,
-                                                      const ComeshObjective& objective,
-                                                      const std::vector<Points>& shapes,
-                                                      int background_analysis,
-                                                      const CancelToken* cancel,
-                                                      SharedFactors* factors) {
+  static absl::StatusOr<HessianPreconditioner> Create(
+      const std::vector<Triangle>& triangles, const Layout& layout,
+      const ComeshObjective& objective, const std::vector<Points>& shapes, int background_analysis,
+      const CancelToken* cancel, SharedFactors* factors) {
     HessianPreconditioner h;
     h.background_analysis_ = background_analysis;
     h.triangles_ = &triangles;
@@ -546,7 +543,9 @@ class HessianPreconditioner {
       }
       if (factors->size() <= static_cast<size_t>(s)) factors->resize(s + 1);
       std::shared_ptr<SparseCholesky>& solver = (*factors)[s];
-      if (solver == nullptr) solver = std::make_shared<SparseCholesky>(SparseCholesky::Method::kAuto);
+      if (solver == nullptr) {
+        solver = std::make_shared<SparseCholesky>(SparseCholesky::Method::kAuto);
+      }
       block.solver = solver;
     }
     h.threads_ = layout.size() >= kParallelUnknowns ? objective.threads() : 1;
@@ -919,9 +918,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   std::optional<HessianPreconditioner> hessian;
   std::optional<InitialHessian> laplacian;
   if (options.hessian_preconditioner && mesh->num_shapes() <= options.hessian_max_shapes) {
-    absl::StatusOr<HessianPreconditioner> h = HessianPreconditioner::Create(
-        mesh->triangles, layout, *objective, shapes, options.background_analysis_unknowns, cancel,
-        factors);
+    absl::StatusOr<HessianPreconditioner> h =
+        HessianPreconditioner::Create(mesh->triangles, layout, *objective, shapes,
+                                      options.background_analysis_unknowns, cancel, factors);
     if (absl::IsCancelled(h.status())) return cancelled_at(0);
     if (!h.ok()) return h.status();
     hessian.emplace(*std::move(h));

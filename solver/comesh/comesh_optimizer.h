@@ -178,9 +178,10 @@ struct ComeshReport {
 // inside the set-up's loops and factorizations and before every topology operation; the symbolic
 // analysis of a large Hessian block runs on a helper thread that a cancel leaves behind
 // (RunCancellable); large dense supernodes are factored in polled panels; energy evaluations
-// poll per chunk of triangles. Measured from the cancel to the return: at most 69 ms up to 165k
-// vertices; at 311k p50 23-29 ms, max 35 ms and 115 ms in two sets of 8 trials (stretches of
-// ~0.1 s without a poll remain inside CHOLMOD's numeric factorization; docs/benchmarks.md).
+// poll per chunk of triangles; the two-loop recursion, the Hessian product and curing poll in
+// spans; a fresh factor's values are allocated and touched in polled spans. Measured from the
+// cancel to the return: at most 69 ms up to 165k vertices; at 311k (eleventh session, on a
+// machine where that row took 150 s) p50 34.5 ms, max 48.4 ms in 8 of 8 trials (docs/benchmarks.md).
 // `progress` (may be empty) is called once per iteration; `report`
 // may be null. The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are
 // remapped to the compacted vertex numbering. `resume` (may be null): continue from a checkpoint
