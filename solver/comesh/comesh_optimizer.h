@@ -181,9 +181,9 @@ struct ComeshReport {
 // poll per chunk of triangles; the two-loop recursion, the Hessian product and curing poll in
 // spans; a fresh factor's values are allocated and touched in polled spans. Measured from the
 // cancel to the return: at most 69 ms up to 165k vertices; at 311k (eleventh session, on a
-// machine where that row took 150 s) p50 34.5 ms, max 48.4 ms in 8 of 8 trials (docs/benchmarks.md).
-// `progress` (may be empty) is called once per iteration; `report`
-// may be null. The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are
+// machine where that row took 150-177 s) p50 30.5-34.5 ms, max 53.8 ms in 14 cancelled trials
+// (docs/benchmarks.md). `progress` (may be empty) is called once per iteration; `report` may be
+// null. The result passes ValidateMultimesh; Multimesh::boundary and cohesive_edges are
 // remapped to the compacted vertex numbering. `resume` (may be null): continue from a checkpoint
 // that a run on the same `mesh` with the same options reported (InvalidArgument if its multimesh is
 // not valid); the result and report equal that run's.
