@@ -77,10 +77,11 @@ struct SparseCholesky::Impl {
   // pass) did so again: the values are hundreds of MB there, so glibc maps them anew each time.
   // This gives the factor the previous factor's value array when it is large enough (its pages
   // are resident: CHOLMOD clears each supernode itself before using it), else a new one with
-  // 1/8 more room, whose pages it touches in polled spans of kTouchPoll values when `cancel` is
-  // given. cholmod_super_numeric then finds the factor numeric. 1 when done, 0 on a CHOLMOD error
-  // (common.status), -1 if cancelled (the factor is then numeric with meaningless values, which
-  // the next Factorize overwrites like any refactorization's).
+  // 1/8 more room (the exact size if that much is not available), whose pages it touches in polled
+  // spans of kTouchPoll values when `cancel` is given. cholmod_super_numeric then finds the factor
+  // numeric. 1 when done, 0 on a CHOLMOD error (common.status), -1 if cancelled (the factor is then
+  // numeric with meaningless values, which the next Factorize overwrites like any
+  // refactorization's).
   int AllocateSupernodalValues(const CancelToken* cancel);
   // Frees the factor, keeping a supernodal factor's value array as the spare for the next one.
   void FreeFactor();
@@ -192,13 +193,15 @@ int SparseCholesky::Impl::AllocateSupernodalValues(const CancelToken* cancel) {
   }
   FreeSpare();
   const size_t capacity = need + need / 8;
-  void* x = cholmod_malloc(capacity, sizeof(double), &common);
-  if (x == nullptr) return 0;
-  cholmod_free(need, sizeof(double), factor->x, &common);
-  factor->x = x;
-  x_capacity = capacity;
+  if (void* x = cholmod_malloc(capacity, sizeof(double), &common); x != nullptr) {
+    cholmod_free(need, sizeof(double), factor->x, &common);
+    factor->x = x;
+    x_capacity = capacity;
+  } else {
+    common.status = CHOLMOD_OK;  // no room for the slack: the exact array CHOLMOD allocated
+  }
   if (cancel == nullptr) return 1;
-  double* values = static_cast<double*>(x);
+  double* values = static_cast<double*>(factor->x);
   for (size_t begin = 0; begin < need; begin += kTouchPoll) {
     if (cancel->IsCancelled()) return -1;
     std::fill(values + begin, values + std::min(need, begin + kTouchPoll), 0.0);
