@@ -34,6 +34,15 @@ struct World {
   std::string archive;  // ExportSession of the template session
 };
 
+// A bound on the work of an OptimizeComesh (as the deadline is): at most 2 outer and 8 inner
+// iterations, so one input does not take the time of hundreds. Every path of the optimizer is
+// still reached (a topology pass, inner steps, convergence, limits) on the small mesh.
+void BoundComesh(v1::ComeshParameters* c) {
+  auto at_most = [](uint32_t n, uint32_t bound) { return n == 0 || n > bound ? bound : n; };
+  c->set_max_outer_iterations(at_most(c->max_outer_iterations(), 2));
+  c->set_max_inner_iterations(at_most(c->max_inner_iterations(), 8));
+}
+
 void Require(const grpc::Status& s, const char* what) {
   if (!s.ok()) {
     std::fprintf(stderr, "rpc_fuzz set-up: %s: %s\n", what, s.error_message().c_str());
@@ -58,6 +67,7 @@ World& GetWorld() {
     w->stub = v1::Inbetween::NewStub(w->server->InProcessChannel());
     grpc::ClientContext c1;
     v1::CreateSessionRequest create;
+    BoundComesh(create.mutable_parameters()->mutable_comesh());
     v1::CreateSessionResponse created;
     Require(w->stub->CreateSession(&c1, create, &created), "CreateSession");
     uint64_t version = created.session().version();
@@ -341,17 +351,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     case 11: {
       v1::OptimizeComeshRequest r;
       if (!Prepare(data, size, &r, session, version, use_version)) break;
-      // A bound on the work (as the deadline is): at most 2 outer and 8 inner iterations, so
-      // one input does not take the time of hundreds. Every path of the optimizer is still
-      // reached (a topology pass, inner steps, convergence, limits) on the small mesh.
-      if (auto* c = r.mutable_comesh();
-          c->max_outer_iterations() == 0 || c->max_outer_iterations() > 2) {
-        c->set_max_outer_iterations(2);
-      }
-      if (auto* c = r.mutable_comesh();
-          c->max_inner_iterations() == 0 || c->max_inner_iterations() > 8) {
-        c->set_max_inner_iterations(8);
-      }
+      // (Unset parameters mean the session's, which the template session bounds the same way.)
+      if (r.has_comesh()) BoundComesh(r.mutable_comesh());
       status = Drain<decltype(w.stub->OptimizeComesh(ctx.get(), r)), v1::OptimizeComeshResponse>(
           w.stub->OptimizeComesh(ctx.get(), r), ctx.get());
       break;
@@ -368,17 +369,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // Every mutation moves a session's version on, except OptimizeComesh's checkpoint (kept at the
   // same version for a later resume): after any other method, the same version means the same
   // session, as fresh as a new import.
+  bool unchanged = false;
   if (!session.empty() && method != 11) {
     auto c = Context();
     v1::GetSessionRequest get;
     get.set_session_id(session);
     v1::GetSessionResponse resp;
-    if (w.stub->GetSession(c.get(), get, &resp).ok() && resp.session().version() == version) {
-      session.clear();  // kept for the next input
-    }
+    unchanged = w.stub->GetSession(c.get(), get, &resp).ok() && resp.session().version() == version;
   }
-  if (!session.empty()) pooled.clear();
-  for (const std::string& id : {session, created}) {
+  std::string stale;  // the copy the call changed (or may have): deleted, a new one next time
+  if (!session.empty() && !unchanged) {
+    stale = session;
+    pooled.clear();
+  }
+  for (const std::string& id : {stale, created}) {
     if (id.empty()) continue;
     auto c = Context();
     v1::DeleteSessionRequest del;
