@@ -330,8 +330,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (!Prepare(data, size, &r, session, version, use_version)) break;
       auto stream = w.stub->EditTopology(ctx.get());
       v1::TopologyState state;
-      if (stream->Write(r)) stream->Read(&state);
-      stream->WritesDone();
+      // The one edit goes with the half-close (as the web gateway's EditTopologyOnce sends
+      // it). A separate WritesDone after the handler already answered an error leaked both
+      // calls' arenas (~35 kB under ASan) in gRPC's in-process transport (Debian's 1.51; the
+      // same calls over TCP stay flat): RSS grew with every such input (docs/hardening.md).
+      if (stream->Write(r, grpc::WriteOptions().set_last_message())) stream->Read(&state);
       while (stream->Read(&state)) {
       }
       status = stream->Finish();
