@@ -431,6 +431,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       }
       MapToBoundaryOptions map_options;
       map_options.tutte_when_convex = loops.size() == 1;
+      map_options.max_iterations = options.max_map_iterations;
       // Every triangle positive does not make a map injective: the boundary may fold over
       // itself (seen on a real icon's cusp). Such a map counts as not found.
       auto injective = [&](absl::StatusOr<Points> m) -> absl::StatusOr<Points> {

@@ -29,6 +29,10 @@ struct MultimeshOptions {
   // Bound on the vertices of the initial mesh (TriangulateOptions::max_vertices); above it the
   // build is RESOURCE_EXHAUSTED instead of refining (practically) forever.
   int max_mesh_vertices = 2'000'000;
+  // SLIM iterations allowed to each map into another drawing (MapToBoundaryOptions::
+  // max_iterations); when they run out the build is FAILED_PRECONDITION. mesh_fuzz lowers it so
+  // that an input whose pull never converges does not cost the time of thousands of others.
+  int max_map_iterations = 2000;
 };
 
 struct MultimeshReport {

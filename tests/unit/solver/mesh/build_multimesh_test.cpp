@@ -86,6 +86,25 @@ TEST(BuildMultimeshTest, BarArchExampleNonConvexBothWays) {
   }
 }
 
+TEST(BuildMultimeshTest, MapIterationBudgetIsHonoured) {
+  // A square into a deep U: the Tutte start folds, so the map needs the boundary pull; with one
+  // SLIM iteration allowed it cannot be found, and the build says so instead of running on.
+  Drawing square, u;
+  square.outlines = {{{Point(0, 0), Point(100, 0), Point(100, 100), Point(0, 100)}}};
+  u.outlines = {{{Point(0, 0), Point(100, 0), Point(100, 100), Point(80, 100), Point(80, 10),
+                  Point(20, 10), Point(20, 100), Point(0, 100)}}};
+  const std::vector<Drawing> drawings = {square, u};
+  MultimeshOptions options;
+  options.max_map_iterations = 1;
+  absl::StatusOr<Multimesh> starved = BuildMultimesh(drawings, options);
+  ASSERT_FALSE(starved.ok());
+  EXPECT_EQ(starved.status().code(), absl::StatusCode::kFailedPrecondition) << starved.status();
+  options.max_map_iterations = MultimeshOptions().max_map_iterations;
+  absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, options);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ExpectValid(drawings, *mesh);
+}
+
 TEST(BuildMultimeshTest, FineSizeBoundTransfersBoundarySteinerPoints) {
   const std::vector<Drawing> drawings = {Example("square_hexagon/square.svg"),
                                          Example("square_hexagon/hexagon.svg")};
