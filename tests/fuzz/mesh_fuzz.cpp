@@ -49,7 +49,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // ASan (20000 vertices took 40 s). 300 (3000 until the twelfth session) for throughput.
   options.max_mesh_vertices = 300;
   // A spike whose boundary pull never converges ran the whole 2,000-iteration budget (9.6 s
-  // here) before its FAILED_PRECONDITION; 200 iterations still reach every stage of the pull.
+  // here) before its FAILED_PRECONDITION; 200 still run three stages of the pull (60 iterations
+  // each) and end in the same refusal.
   options.max_map_iterations = 200;
   absl::StatusOr<Multimesh> m = BuildMultimesh({da, db}, options);
   if (!m.ok()) {
