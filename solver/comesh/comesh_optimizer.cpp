@@ -120,15 +120,9 @@ class Layout {
         if (on_boundary[v]) {
           if (!slide_boundary || boundary_nbrs[v].size() != 2) continue;
           const Point a = x[boundary_nbrs[v][0]], b = x[boundary_nbrs[v][1]];
-          const Point ab = b - a, av = x[v] - a;
-          const double len2 = ab.squaredNorm();
-          const double along = av.dot(ab);
-          if (!(len2 > 0.0) || std::abs(ab.x() * av.y() - ab.y() * av.x()) > 1e-9 * len2 ||
-              along <= 0.0 || along >= len2) {
-            continue;  // a corner (or degenerate): pinned
-          }
+          if (!StrictlyInsideSegment(a, b, x[v])) continue;  // a corner (or degenerate): pinned
           var.slider = true;
-          var.direction = ab / std::sqrt(len2);
+          var.direction = (b - a).normalized();
         }
         index_[s][v] = static_cast<int>(vars_.size());
         size_ += var.slider ? 1 : 2;

@@ -3,8 +3,10 @@
 #include "solver/comesh/comesh_topology.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -79,12 +81,32 @@ class Editor {
       odt_sum_ += odt;
       mips_sum_ += mips;
     }
+    boundary_nbrs_.assign(n, {-1, -1});
+    std::vector<char> fixed(n, 0);  // never slides: a non-manifold edge, cohesive, >2 boundary edges
     for (const auto& [edge, count] : uses) {
       if (count != 2) protected_[edge.first] = protected_[edge.second] = 1;
+      if (count > 2) fixed[edge.first] = fixed[edge.second] = 1;
+      if (count != 1) continue;
+      for (const auto& [v, u] : {edge, std::pair(edge.second, edge.first)}) {
+        std::array<int, 2>& nb = boundary_nbrs_[v];
+        if (nb[0] < 0) {
+          nb[0] = u;
+        } else if (nb[1] < 0) {
+          nb[1] = u;
+        } else {
+          fixed[v] = 1;
+        }
+      }
     }
     for (int v : mesh.boundary) protected_[v] = 1;
     for (const auto& c : mesh.cohesive_edges) {
-      for (int v : c) protected_[v] = 1;
+      for (int v : c) protected_[v] = fixed[v] = 1;
+    }
+    slidable_.assign(n, 0);
+    if (options.boundary_collapses) {
+      for (int v = 0; v < n; ++v) {
+        if (!fixed[v]) UpdateSlidable(v);
+      }
     }
     for (int s = 0; s < num_shapes; ++s) {
       double area = 0.0, length = 0.0;
@@ -155,6 +177,19 @@ class Editor {
         cancel);
   }
 
+  // Boundary collapse candidates: the boundary edges (a, b), a < b, with an endpoint that may be
+  // removed (slidable), each once, ascending.
+  std::vector<std::pair<int, int>> BoundaryEdgesAtSlidable() const {
+    std::vector<std::pair<int, int>> edges;
+    for (size_t v = 0; v < slidable_.size(); ++v) {
+      if (!slidable_[v] || removed_[v]) continue;
+      for (int u : boundary_nbrs_[v]) edges.push_back(std::minmax(static_cast<int>(v), u));
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    return edges;
+  }
+
   // Length of edge (a, b) relative to the mean edge length, max (or min) over shapes.
   double RelativeLength(int a, int b, bool max) const {
     double r = max ? 0.0 : std::numeric_limits<double>::infinity();
@@ -167,6 +202,10 @@ class Editor {
 
   // The two live triangles sharing edge (a, b), or false.
   bool EdgeTriangles(int a, int b, int* t1, int* t2) const {
+    return EdgeTriangleCount(a, b, t1, t2) == 2;
+  }
+  // The number of live triangles on edge (a, b); the first two into *t1, *t2.
+  int EdgeTriangleCount(int a, int b, int* t1, int* t2) const {
     int found = 0;
     for (int t : incident_[a]) {
       const Triangle& tri = triangles_[t];
@@ -176,7 +215,7 @@ class Editor {
         ++found;
       }
     }
-    return found == 2;
+    return found;
   }
 
   bool TryFlip(int a, int b) {
@@ -203,17 +242,23 @@ class Editor {
     return true;
   }
 
-  // Removes b (interior) by merging it into a.
+  // Removes b by merging it into a: b interior (edge ab interior), or b a slidable boundary
+  // vertex and ab one of its two boundary edges (a keeps its place; the boundary polyline of every
+  // shape is unchanged as a point set, since b lay on the straight segment of its neighbours).
   bool TryCollapse(int a, int b) {
-    if (removed_[a] || removed_[b] || protected_[b] || locked_[a] || locked_[b]) return false;
+    if (removed_[a] || removed_[b] || locked_[a] || locked_[b]) return false;
+    const bool along_boundary =
+        slidable_[b] && (boundary_nbrs_[b][0] == a || boundary_nbrs_[b][1] == a);
+    if (protected_[b] && !along_boundary) return false;
     int t1 = -1, t2 = -1;
-    if (!EdgeTriangles(a, b, &t1, &t2)) return false;
-    // Link condition: the common neighbours of a and b are exactly the two opposite vertices.
+    const int on_edge = EdgeTriangleCount(a, b, &t1, &t2);
+    if (on_edge != (along_boundary ? 1 : 2)) return false;
+    // Link condition: the common neighbours of a and b are exactly the opposite vertices.
     const std::vector<int> na = Neighbours(a), nb = Neighbours(b);
     std::vector<int> common;
     std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
-    if (common.size() != 2) return false;
-    // Affected triangles: the one-rings of a and b (the two on edge ab disappear).
+    if (static_cast<int>(common.size()) != on_edge) return false;
+    // Affected triangles: the one-rings of a and b (those on edge ab disappear).
     std::vector<int> affected = incident_[a];
     for (int t : incident_[b]) {
       if (t != t1 && t != t2) affected.push_back(t);
@@ -247,8 +292,8 @@ class Editor {
       if (ok) {
         double odt_new, mips_new;
         Terms(new_tris, &odt_new, &mips_new);
-        const double after =
-            Objective(t_ - 2, odt_sum_ - odt_old + odt_new, mips_sum_ - mips_old + mips_new);
+        const double after = Objective(t_ - on_edge, odt_sum_ - odt_old + odt_new,
+                                       mips_sum_ - mips_old + mips_new);
         if (after < best) {
           best = after;
           best_place = place;
@@ -265,7 +310,8 @@ class Editor {
       return false;
     }
     // Apply.
-    for (int t : {t1, t2}) Kill(t);
+    Kill(t1);
+    if (on_edge == 2) Kill(t2);
     const std::vector<int> moved = incident_[b];
     for (int t : moved) {
       Triangle tri = triangles_[t];
@@ -278,7 +324,16 @@ class Editor {
       for (int v : triangles_[t]) MarkDirty(v);
     }
     removed_[b] = 1;
-    t_ -= 2;
+    t_ -= on_edge;
+    if (along_boundary) {  // a and b's other boundary neighbour c become neighbours
+      const int c = boundary_nbrs_[b][0] == a ? boundary_nbrs_[b][1] : boundary_nbrs_[b][0];
+      for (auto [v, old_nbr, new_nbr] : {std::tuple(a, b, c), std::tuple(c, b, a)}) {
+        std::array<int, 2>& nbrs = boundary_nbrs_[v];
+        (nbrs[0] == old_nbr ? nbrs[0] : nbrs[1]) = new_nbr;
+        if (slidable_[v]) UpdateSlidable(v);
+      }
+      slidable_[b] = 0;
+    }
     odt_sum_ += best_odt;
     mips_sum_ += best_mips;
     locked_[a] = locked_[b] = 1;
@@ -353,14 +408,37 @@ class Editor {
       }
       out.shapes.push_back(std::move(y));
     }
-    for (int v : input.boundary) out.boundary.push_back(index[v]);
+    // Boundary collapses remove vertices from the boundary lists; cohesive vertices are never
+    // removed, so the cohesive edges (and the indices into them) keep their order.
+    auto kept = [&](const std::vector<int>& list) {
+      std::vector<int> out_list;
+      for (int v : list) {
+        if (!removed_[v]) out_list.push_back(index[v]);
+      }
+      return out_list;
+    };
+    out.boundary = kept(input.boundary);
+    for (const std::vector<int>& loop : input.boundary_loops) out.boundary_loops.push_back(kept(loop));
     for (const auto& c : input.cohesive_edges) {
       out.cohesive_edges.push_back({index[c[0]], index[c[1]], index[c[2]], index[c[3]]});
     }
+    out.cohesive_closed = input.cohesive_closed;
     return out;
   }
 
  private:
+  // slidable_[v]: v has two boundary neighbours and lies strictly inside the straight segment
+  // between them in every shape (what the optimizer lets slide), so removing it keeps every
+  // shape's domain.
+  void UpdateSlidable(int v) {
+    const auto [p, q] = boundary_nbrs_[v];
+    bool ok = p >= 0 && q >= 0;
+    for (size_t s = 0; ok && s < shapes_.size(); ++s) {
+      ok = StrictlyInsideSegment(shapes_[s][p], shapes_[s][q], shapes_[s][v]);
+    }
+    slidable_[v] = ok;
+  }
+
   double Objective(int t, double odt, double mips) const {
     const double w = objective_.map_weight();
     return (1.0 - w) * (t / t0_) * odt + w * mips;
@@ -454,6 +532,8 @@ class Editor {
   std::vector<Points> shapes_;
   std::vector<std::vector<int>> incident_;
   std::vector<char> removed_, locked_, protected_;
+  std::vector<std::array<int, 2>> boundary_nbrs_;  // the two boundary neighbours, or -1
+  std::vector<char> slidable_;                     // removable along the boundary (see above)
   std::vector<double> min_area2_, mean_edge_;
   double t0_;
   int t_;
@@ -508,6 +588,14 @@ bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& a
         }
       },
       cancel);
+}
+
+bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v) {
+  const Point ab = b - a, av = v - a;
+  const double len2 = ab.squaredNorm();
+  const double along = av.dot(ab);
+  return len2 > 0.0 && std::abs(ab.x() * av.y() - ab.y() * av.x()) <= 1e-9 * len2 &&
+         along > 0.0 && along < len2;
 }
 
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
@@ -572,6 +660,13 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
   };
   if (options.collapses) {
     if (!candidates_by(+1.0, options.collapse_ratio)) return cancelled_status;
+    if (options.boundary_collapses) {
+      for (const auto& [a, b] : editor.BoundaryEdgesAtSlidable()) {
+        const double key = editor.RelativeLength(a, b, /*max=*/true);
+        if (key < options.collapse_ratio) candidates.push_back({key, {a, b}});
+      }
+      std::sort(candidates.begin(), candidates.end());
+    }
     for (const auto& [r, edge] : candidates) {
       if (Cancelled(cancel)) return cancelled_status;
       rep.collapses += editor.TryCollapse(edge.first, edge.second) ||

@@ -8,13 +8,16 @@
 //     current triangle count T, E(T) = (1 - w) (T / T0) O + w M, with O, M the sums of the
 //     per-triangle ODT and MIPS terms normalized for the pass's starting count T0, so that
 //     removing or adding triangles is compared fairly.
-// Collapses only remove interior vertices: topological boundary vertices, Multimesh::boundary
-// vertices and cohesive-edge vertices are never removed (a boundary endpoint keeps its place;
-// two interior endpoints merge at the better of the midpoint and the kept vertex's position);
+// Collapses remove interior vertices and, along a boundary edge, boundary vertices that lie on a
+// straight stretch of the boundary in every shape (TopologyOptions::boundary_collapses); corners,
+// cohesive-edge vertices and vertices listed in Multimesh::boundary but inside the mesh are never
+// removed (a boundary endpoint keeps its place; two interior endpoints merge at the better of
+// the midpoint and the kept vertex's position);
 // the link condition keeps the mesh a manifold. A vertex touched by a collapse or split is not
 // used by another one in the same pass, so each pass changes the mesh locally; the optimizer
 // alternates passes with inner runs. The result is renumbered compactly (vertex order kept);
-// Multimesh::boundary and cohesive_edges are remapped.
+// Multimesh::boundary and boundary_loops (removed vertices dropped) and cohesive_edges are
+// remapped; cohesive_closed is kept.
 #pragma once
 
 #include <utility>
@@ -30,6 +33,11 @@ struct TopologyOptions {
   bool flips = true;
   bool collapses = true;
   bool splits = true;
+  // Collapses may also remove a boundary vertex that lies strictly inside the straight segment
+  // of its two boundary neighbours in every shape (a slider of the optimizer; never a corner, a
+  // cohesive-edge vertex or a vertex of a non-manifold edge), merging it into a neighbour along
+  // a boundary edge: every shape's domain and boundary polyline stay the same point set.
+  bool boundary_collapses = true;
   // An interior edge is a collapse candidate when its length is below collapse_ratio times the
   // mean edge length in EVERY shape, a split candidate when above split_ratio times it in SOME
   // shape; the objective decides (see above).
@@ -64,6 +72,10 @@ bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& a
 // multimesh is valid too and has objective_after <= objective_before. CANCELLED (and no mesh) if
 // `cancel` is set during the pass (polled before every candidate operation and every 4096 items
 // of the edge and candidate lists).
+// True if v lies strictly inside segment ab (collinear within 1e-9 |ab|^2 of cross product, and
+// strictly between a and b): the optimizer's slider test and the topology pass's boundary one.
+bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v);
+
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
                                           const TopologyOptions& options,
                                           TopologyReport* report = nullptr,

@@ -14,6 +14,7 @@
 #include "solver/comesh/comesh_objective.h"
 #include "solver/mesh/build_multimesh.h"
 #include "solver/mesh/validate.h"
+#include "tests/unit/solver/comesh/comesh_boundary_expect.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
 
 namespace inbetween::solver {
@@ -114,7 +115,7 @@ TEST(ComeshOptimizerTest, SquareToHexagonImprovesMapAndKeepsMeshSane) {
     ASSERT_TRUE(out.ok()) << out.status();
     EXPECT_LT(report.map_energy, report.map_energy_before - 0.01) << "laplacian " << laplacian;
     EXPECT_LT(report.mesh_energy, 1.5);
-    for (const Points& x : out->shapes) EXPECT_EQ(testing::CountNonPositive(m.triangles, x), 0);
+    for (const Points& x : out->shapes) EXPECT_EQ(testing::CountNonPositive(out->triangles, x), 0);
   }
 }
 
@@ -298,17 +299,43 @@ TEST(ComeshOptimizerTest, OuterLoopOnRealSquareToHexagonDropsVerticesAndStaysVal
   EXPECT_EQ(report.objective_trace.back(), report.objective_after);
   EXPECT_LT(report.map_energy, report.map_energy_before);
   EXPECT_LT(report.mesh_energy, report.mesh_energy_before);
-  // Boundary kept, in order, at the same positions.
-  ASSERT_EQ(out->boundary.size(), m->boundary.size());
-  for (int s = 0; s < m->num_shapes(); ++s) {
-    for (size_t b = 0; b < m->boundary.size(); ++b) {
-      const Point before = m->shapes[s][m->boundary[b]];
-      const Point after = out->shapes[s][out->boundary[b]];
-      // Sliders move along their straight side; corners stay.
-      EXPECT_LT((before - after).norm(), 0.5) << "shape " << s << " boundary " << b;
+  // The boundary is the same point set (sliders move along their straight side, boundary
+  // collapses drop some of them; corners stay), and its loops are kept.
+  ASSERT_EQ(out->boundary_loops.size(), 1u);
+  testing::ExpectBoundaryKept(*m, *out);
+  EXPECT_EQ(iterates, report.inner);
+}
+
+// A mouth closed in one drawing and open in the other (an opening): after the outer loop the
+// multimesh still has its two boundary loops, its cohesive edges and the list of shapes where
+// they are closed, all consistent (ValidateMultimesh checks loops and collocation).
+TEST(ComeshOptimizerTest, OuterLoopKeepsLoopsAndCohesiveEdgesOfAnOpening) {
+  Drawing closed = testing::RegularPolygon(48, 10.0, Point(0, 0));
+  Drawing open = closed;
+  closed.openings = {{{-5, 2}, {0, 2.5}, {5, 2}}};
+  open.outlines.push_back({{{-5, 2}, {0, 0}, {5, 2}, {0, 5}}});  // the open mouth
+  auto m = BuildMultimesh({closed, open}, {});
+  ASSERT_TRUE(m.ok()) << m.status();
+  ASSERT_EQ(m->boundary_loops.size(), 2u);
+  ASSERT_FALSE(m->cohesive_edges.empty());
+  ComeshReport report;
+  auto out = OptimizeComesh(*m, ComeshOptions{}, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_GT(report.collapses + report.flips, 0);  // the passes changed the mesh
+  EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
+  ASSERT_EQ(out->boundary_loops.size(), 2u);
+  testing::ExpectBoundaryKept(*m, *out);
+  EXPECT_EQ(out->cohesive_edges.size(), m->cohesive_edges.size());
+  EXPECT_EQ(out->cohesive_closed, m->cohesive_closed);
+  // Cohesive-edge vertices are pinned: the same places, in the same order.
+  for (int s = 0; s < out->num_shapes(); ++s) {
+    for (size_t c = 0; c < m->cohesive_edges.size(); ++c) {
+      for (int k = 0; k < 4; ++k) {
+        EXPECT_EQ(out->shapes[s][out->cohesive_edges[c][k]],
+                  m->shapes[s][m->cohesive_edges[c][k]]);
+      }
     }
   }
-  EXPECT_EQ(iterates, report.inner);
 }
 
 TEST(ComeshOptimizerTest, ResultDoesNotDependOnThreadCount) {

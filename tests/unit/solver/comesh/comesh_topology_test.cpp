@@ -12,6 +12,7 @@
 
 #include "solver/comesh/comesh_objective.h"
 #include "solver/mesh/validate.h"
+#include "tests/unit/solver/comesh/comesh_boundary_expect.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
 
 namespace inbetween::solver {
@@ -28,15 +29,7 @@ void ExpectValidEverywhere(const Multimesh& m) {
   for (const Points& x : m.shapes) EXPECT_EQ(CountInverted(m.triangles, x), 0);
 }
 
-// Boundary positions, in boundary order, must survive any pass unchanged in every shape.
-void ExpectSameBoundary(const Multimesh& before, const Multimesh& after) {
-  ASSERT_EQ(before.boundary.size(), after.boundary.size());
-  for (int s = 0; s < before.num_shapes(); ++s) {
-    for (size_t b = 0; b < before.boundary.size(); ++b) {
-      EXPECT_EQ(before.shapes[s][before.boundary[b]], after.shapes[s][after.boundary[b]]);
-    }
-  }
-}
+using testing::ExpectBoundaryKept;
 
 Multimesh Sheared(int k, double shear) {
   Multimesh m = testing::SquareGrid(k);
@@ -96,7 +89,7 @@ TEST(ComeshTopologyTest, FlipsLongDiagonalsOfAShearedGridInAllShapes) {
   EXPECT_EQ(out->num_vertices(), m.num_vertices());
   EXPECT_EQ(out->triangles.size(), m.triangles.size());
   ExpectValidEverywhere(*out);
-  ExpectSameBoundary(m, *out);
+  ExpectBoundaryKept(m, *out);
   EXPECT_LT(report.objective_after, report.objective_before);
   EXPECT_NEAR(Objective(*out), report.objective_after, 1e-9 * report.objective_after);
   EXPECT_NEAR(Objective(m), report.objective_before, 1e-9 * report.objective_before);
@@ -183,7 +176,7 @@ TEST(ComeshTopologyTest, CollapsesANeedlessVertexKeepingBoundaryAndValidity) {
   EXPECT_EQ(out->num_vertices(), m.num_vertices() - report.collapses + report.splits);
   EXPECT_EQ(out->triangles.size(), m.triangles.size() - 2 * report.collapses + 2 * report.splits);
   ExpectValidEverywhere(*out);
-  ExpectSameBoundary(m, *out);
+  ExpectBoundaryKept(m, *out);
   ASSERT_EQ(out->cohesive_edges.size(), 1u);
   for (int s = 0; s < m.num_shapes(); ++s) {
     EXPECT_EQ(out->shapes[s][out->cohesive_edges[0][0]], m.shapes[s][0]);
@@ -216,11 +209,91 @@ TEST(ComeshTopologyTest, EveryPassOnRandomlyDistortedMeshesStaysValid) {
       auto out = ImproveTopology(m, 0.1 + 0.15 * seed, TopologyOptions{}, &report);
       ASSERT_TRUE(out.ok()) << out.status();
       ExpectValidEverywhere(*out);
-      ExpectSameBoundary(m, *out);
+      ExpectBoundaryKept(m, *out);
       EXPECT_LE(report.objective_after, report.objective_before);
       m = *std::move(out);
     }
   }
+}
+
+// Boundary collapses: a boundary vertex crowded against its neighbour on a straight side of
+// both shapes is removed along the boundary; the square's corners (corners in both shapes) and
+// a cohesive-edge vertex never are; the boundary stays the same point set, the lists stay loops.
+TEST(ComeshTopologyTest, BoundaryCollapseRemovesACrowdedVertexOnAStraightSide) {
+  Multimesh m = testing::SquareGrid(6);
+  m.shapes.push_back(testing::Similar(m.shapes[0], 0.4, 1.7, Point(3, 1)));
+  // Vertex 2 = (2/6, 0) pushed along the bottom side almost onto vertex 3, in both shapes (an
+  // exact similarity keeps it on the side); vertex 5 = (5/6, 0) likewise onto the corner 6.
+  for (Points& x : m.shapes) {
+    x[2] = x[3] + 0.05 * (x[2] - x[3]);
+    x[5] = x[6] + 0.05 * (x[5] - x[6]);
+  }
+  m.boundary_loops = {m.boundary};
+  m.cohesive_edges.push_back({3, 4, 4, 3});  // 3 and 4 are never removed
+  ASSERT_TRUE(ValidateMultimesh(m).ok()) << ValidateMultimesh(m);
+  for (bool boundary_collapses : {false, true}) {
+    SCOPED_TRACE(boundary_collapses);
+    TopologyOptions options;
+    options.boundary_collapses = boundary_collapses;
+    TopologyReport report;
+    auto out = ImproveTopology(m, 0.5, options, &report);
+    ASSERT_TRUE(out.ok()) << out.status();
+    ExpectValidEverywhere(*out);
+    ExpectBoundaryKept(m, *out);
+    EXPECT_LE(report.objective_after, report.objective_before);
+    ASSERT_EQ(out->boundary_loops.size(), 1u);
+    EXPECT_EQ(out->boundary_loops[0], out->boundary);
+    auto on_boundary = [&](const Point& p) {
+      int found = 0;
+      for (int v : out->boundary) found += out->shapes[0][v] == p;
+      return found;
+    };
+    if (!boundary_collapses) {
+      EXPECT_EQ(out->boundary.size(), m.boundary.size());
+      continue;
+    }
+    // 2 (crowding 3) and 5 (crowding the corner) are gone; everything else on the boundary stays.
+    EXPECT_EQ(on_boundary(m.shapes[0][2]), 0);
+    EXPECT_EQ(on_boundary(m.shapes[0][5]), 0);
+    EXPECT_EQ(out->boundary.size(), m.boundary.size() - 2);
+    for (int v : {0, 3, 4, 6}) EXPECT_EQ(on_boundary(m.shapes[0][v]), 1) << v;
+    ASSERT_EQ(out->cohesive_edges.size(), 1u);
+    EXPECT_EQ(out->shapes[1][out->cohesive_edges[0][0]], m.shapes[1][3]);
+    EXPECT_EQ(out->shapes[1][out->cohesive_edges[0][1]], m.shapes[1][4]);
+  }
+}
+
+// A boundary vertex on a straight side of one shape but at a corner of the other is never removed:
+// the square grid's boundary on a hexagon (Tutte), crowded in many places; only vertices straight
+// in both shapes may go.
+TEST(ComeshTopologyTest, BoundaryCollapseKeepsCornersOfEveryShape) {
+  Multimesh m = testing::SquareGrid(12);
+  m.shapes.push_back(testing::TutteHexagon(m));
+  m.boundary_loops = {m.boundary};
+  // Every third boundary vertex that is on a straight side in both shapes is crowded onto its
+  // successor (a corner of one shape, sometimes) along that side.
+  const int nb = static_cast<int>(m.boundary.size());
+  for (int i = 0; i < nb; i += 3) {
+    const int p = m.boundary[(i + nb - 1) % nb], v = m.boundary[i], q = m.boundary[(i + 1) % nb];
+    bool straight = true;
+    for (const Points& x : m.shapes) straight &= StrictlyInsideSegment(x[p], x[q], x[v]);
+    if (!straight) continue;
+    for (Points& x : m.shapes) x[v] = x[q] + 0.1 * (x[v] - x[q]);
+  }
+  ASSERT_TRUE(ValidateMultimesh(m).ok()) << ValidateMultimesh(m);
+  const size_t boundary_before = m.boundary.size();
+  for (int pass = 0; pass < 4; ++pass) {
+    TopologyOptions options;
+    options.collapse_ratio = 3.0;  // every boundary edge is a candidate
+    TopologyReport report;
+    auto out = ImproveTopology(m, 0.5, options, &report);
+    ASSERT_TRUE(out.ok()) << out.status();
+    ExpectValidEverywhere(*out);
+    ExpectBoundaryKept(m, *out);
+    EXPECT_LE(report.objective_after, report.objective_before);
+    m = *std::move(out);
+  }
+  EXPECT_LT(m.boundary.size(), boundary_before);  // some straight-in-both vertices did go
 }
 
 }  // namespace
