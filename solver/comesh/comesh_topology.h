@@ -68,14 +68,14 @@ std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Tria
 bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& alive,
               const CancelToken* cancel, std::vector<std::pair<std::pair<int, int>, int>>* uses);
 
-// One topology pass. `mesh` must be valid (positive triangles in every shape). The returned
-// multimesh is valid too and has objective_after <= objective_before. CANCELLED (and no mesh) if
-// `cancel` is set during the pass (polled before every candidate operation and every 4096 items
-// of the edge and candidate lists).
 // True if v lies strictly inside segment ab (collinear within 1e-9 |ab|^2 of cross product, and
 // strictly between a and b): the optimizer's slider test and the topology pass's boundary one.
 bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v);
 
+// One topology pass. `mesh` must be valid (positive triangles in every shape). The returned
+// multimesh is valid too and has objective_after <= objective_before. CANCELLED (and no mesh) if
+// `cancel` is set during the pass (polled before every candidate operation and every 4096 items
+// of the edge and candidate lists).
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
                                           const TopologyOptions& options,
                                           TopologyReport* report = nullptr,
