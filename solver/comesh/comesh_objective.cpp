@@ -72,22 +72,10 @@ absl::StatusOr<ComeshObjective> ComeshObjective::Create(const std::vector<Triang
 
 void ComeshObjective::TriangleTerms(const Triangle& t, const std::vector<Points>& shapes,
                                     double* odt, double* mips) const {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  const int n = num_shapes();
   *odt = 0.0;
   *mips = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const Points& xi = shapes[i];
-    const double d = OdtTriangleEnergy(xi[t[0]], xi[t[1]], xi[t[2]]);
-    const Points& xj = shapes[(i + 1) % n];
-    const double c =
-        MipsTriangleEnergy({xi[t[0]], xi[t[1]], xi[t[2]]}, {xj[t[0]], xj[t[1]], xj[t[2]]});
-    if (!std::isfinite(d) || !std::isfinite(c)) {
-      *odt = *mips = kInf;
-      return;
-    }
-    *odt += d / odt_normalizer_[i];
-    *mips += c / areas_[i];
+  if (!AccumulateTriangle(t, shapes, odt, mips)) {
+    *odt = *mips = std::numeric_limits<double>::infinity();
   }
 }
 
@@ -95,6 +83,40 @@ double ComeshObjective::TriangleTerm(const Triangle& t, const std::vector<Points
   double odt, mips;
   TriangleTerms(t, shapes, &odt, &mips);
   return (1.0 - map_weight_) * odt + map_weight_ * mips;
+}
+
+bool ComeshObjective::AccumulateTriangle(const Triangle& tri, const std::vector<Points>& shapes,
+                                         double* mesh_sum, double* map_sum,
+                                         Point* corner_gradient) const {
+  const int n = num_shapes();
+  const double w = map_weight_;
+  Point* cg = corner_gradient;
+  std::array<Point, 3> g_odt, g_i, g_j;
+  if (cg != nullptr) {
+    for (int k = 0; k < 3 * n; ++k) cg[k].setZero();
+  }
+  for (int i = 0; i < n; ++i) {
+    const Points& xi = shapes[i];
+    const int j = (i + 1) % n;
+    const Points& xj = shapes[j];
+    const std::array<Point, 3> ci = {xi[tri[0]], xi[tri[1]], xi[tri[2]]};
+    const std::array<Point, 3> cj = {xj[tri[0]], xj[tri[1]], xj[tri[2]]};
+    const double d = OdtTriangleEnergy(ci[0], ci[1], ci[2], cg != nullptr ? &g_odt : nullptr);
+    const double c =
+        MipsTriangleEnergy(ci, cj, cg != nullptr ? &g_i : nullptr, cg != nullptr ? &g_j : nullptr);
+    if (!std::isfinite(d) || !std::isfinite(c)) return false;
+    *mesh_sum += d / odt_normalizer_[i];
+    *map_sum += c / areas_[i];
+    if (cg != nullptr) {
+      const double sd = (1.0 - w) / odt_normalizer_[i];
+      const double sc = w / areas_[i];
+      for (int k = 0; k < 3; ++k) {
+        cg[k * n + i] += sd * g_odt[k] + sc * g_i[k];
+        cg[k * n + j] += sc * g_j[k];
+      }
+    }
+  }
+  return true;
 }
 
 double ComeshObjective::Evaluate(const std::vector<Points>& shapes, std::vector<Points>* gradient,
@@ -112,36 +134,12 @@ double ComeshObjective::Evaluate(const std::vector<Points>& shapes, std::vector<
   ParallelChunks(num_triangles, kChunk, threads_, [&](int chunk, int begin, int end) {
     if (Cancelled(cancel)) return;  // the result is NaN below
     double mesh_sum = 0.0, map_sum = 0.0;
-    std::array<Point, 3> g_odt, g_i, g_j;
     for (int t = begin; t < end; ++t) {
       const Triangle& tri = triangles_[t];
       Point* cg = want_gradient ? &corner_gradient_[static_cast<size_t>(3) * t * n] : nullptr;
-      if (want_gradient) {
-        for (int k = 0; k < 3 * n; ++k) cg[k].setZero();
-      }
-      for (int i = 0; i < n; ++i) {
-        const Points& xi = shapes[i];
-        const int j = (i + 1) % n;
-        const Points& xj = shapes[j];
-        const std::array<Point, 3> ci = {xi[tri[0]], xi[tri[1]], xi[tri[2]]};
-        const std::array<Point, 3> cj = {xj[tri[0]], xj[tri[1]], xj[tri[2]]};
-        const double d = OdtTriangleEnergy(ci[0], ci[1], ci[2], want_gradient ? &g_odt : nullptr);
-        const double c = MipsTriangleEnergy(ci, cj, want_gradient ? &g_i : nullptr,
-                                            want_gradient ? &g_j : nullptr);
-        if (!std::isfinite(d) || !std::isfinite(c)) {
-          mesh_part[chunk] = map_part[chunk] = kInf;
-          return;
-        }
-        mesh_sum += d / odt_normalizer_[i];
-        map_sum += c / areas_[i];
-        if (want_gradient) {
-          const double sd = (1.0 - w) / odt_normalizer_[i];
-          const double sc = w / areas_[i];
-          for (int k = 0; k < 3; ++k) {
-            cg[k * n + i] += sd * g_odt[k] + sc * g_i[k];
-            cg[k * n + j] += sc * g_j[k];
-          }
-        }
+      if (!AccumulateTriangle(tri, shapes, &mesh_sum, &map_sum, cg)) {
+        mesh_part[chunk] = map_part[chunk] = kInf;
+        return;
       }
     }
     mesh_part[chunk] = mesh_sum;

@@ -60,6 +60,13 @@ class ComeshObjective {
   void TriangleTerms(const Triangle& t, const std::vector<Points>& shapes, double* odt,
                      double* mips) const;
 
+  // Adds triangle t's sum_i D_t(X_i) / N_i to *mesh_sum and sum_i C_t(X_i, X_i+1) / A_i to
+  // *map_sum (shape by shape, as Evaluate sums them) and, if `corner_gradient` is given (3 n
+  // entries), overwrites it with the gradient of t's part of E: entry k n + i is d/dX_i(t[k]).
+  // False (sums partly added) if t is not positive in some shape.
+  bool AccumulateTriangle(const Triangle& t, const std::vector<Points>& shapes, double* mesh_sum,
+                          double* map_sum, Point* corner_gradient = nullptr) const;
+
   int num_shapes() const { return static_cast<int>(areas_.size()); }
   int num_vertices() const { return num_vertices_; }
   double map_weight() const { return map_weight_; }

@@ -21,6 +21,7 @@
 #include "absl/strings/str_format.h"
 #include "solver/comesh/comesh_hessian.h"
 #include "solver/comesh/comesh_objective.h"
+#include "solver/comesh/comesh_relax.h"
 #include "solver/comesh/comesh_topology.h"
 #include "solver/comesh/mips_energy.h"
 #include "solver/core/cancellable_call.h"
@@ -214,13 +215,15 @@ AreaPolynomial AreaAlong(const Points& x, const Points& dx, const Triangle& t) {
 // nothing (its area polynomial is constant).
 double MaxNonInvertingStep(const std::vector<Triangle>& triangles,
                            const std::vector<Points>& shapes, const std::vector<Points>& disp,
-                           int threads) {
+                           int threads, std::pair<int, int>* argmin = nullptr) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   constexpr int kChunk = 4096;
   const int num_triangles = static_cast<int>(triangles.size());
   std::vector<double> part(NumChunks(num_triangles, kChunk), kInf);
+  std::vector<std::pair<int, int>> where(part.size(), {-1, -1});
   ParallelChunks(num_triangles, kChunk, threads, [&](int chunk, int begin, int end) {
     double best = kInf;
+    std::pair<int, int> best_at = {-1, -1};
     for (size_t s = 0; s < shapes.size(); ++s) {
       const Points& x = shapes[s];
       const Points& dx = disp[s];
@@ -240,13 +243,22 @@ double MaxNonInvertingStep(const std::vector<Triangle>& triangles,
             if (r2 > 0.0) root = std::min(root, r2);
           }
         }
-        best = std::min(best, root);
+        if (root < best) {
+          best = root;
+          best_at = {ti, static_cast<int>(s)};
+        }
       }
     }
     part[chunk] = best;
+    where[chunk] = best_at;
   });
   double best = kInf;
-  for (double b : part) best = std::min(best, b);
+  for (size_t c = 0; c < part.size(); ++c) {
+    if (part[c] < best) {
+      best = part[c];
+      if (argmin != nullptr) *argmin = where[c];
+    }
+  }
   return best;
 }
 
@@ -927,6 +939,8 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   auto apply = [&](const VectorXd& v) {
     return hessian ? hessian->Apply(v, cancel) : laplacian->Apply(v);
   };
+  std::optional<VertexRelaxer> relaxer;
+  if (options.relax_fraction > 0.0) relaxer.emplace(*objective);
   stats->phases.hessian += clock.Lap();
 
   VectorXd z = layout.Gather(shapes);
@@ -1063,7 +1077,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       return absl::OkStatus();
     }
 
-    const VectorXd g_new = layout.GatherGradient(trial_grad);
+    VectorXd g_new = layout.GatherGradient(trial_grad);
     if (Cancelled(cancel)) return cancelled_at(iter);
     // The pair's vectors reuse the storage of the pair last dropped from the history (or not
     // kept): two fresh vectors every iteration cost ~30 ms of page faults at 311k vertices.
@@ -1101,6 +1115,43 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       spare = std::move(p);
     }
     stats->phases.direction += clock.Lap();
+    if (relaxer) {
+      // The vertices holding at least relax_fraction of |g|^2 (and relax_over_mean times an
+      // even share), largest first, at most relax_max_vertices of them.
+      const double total = g_new.squaredNorm();
+      const std::vector<Layout::Var>& vars = layout.vars();
+      const double threshold =
+          total * std::max(options.relax_fraction, options.relax_over_mean / vars.size());
+      std::vector<std::pair<double, int>> picked;
+      for (int i = 0; i < static_cast<int>(vars.size()); ++i) {
+        const double part = vars[i].slider ? g_new[vars[i].offset] * g_new[vars[i].offset]
+                                           : g_new.segment<2>(vars[i].offset).squaredNorm();
+        if (part >= threshold) picked.emplace_back(part, i);
+      }
+      std::sort(picked.begin(), picked.end(), [](const auto& x, const auto& y) {
+        return x.first != y.first ? x.first > y.first : x.second < y.second;
+      });
+      picked.resize(std::min<size_t>(picked.size(), std::max(0, options.relax_max_vertices)));
+      std::vector<RelaxTarget> targets;
+      for (const auto& [part, i] : picked) {
+        targets.push_back({vars[i].shape, vars[i].vertex, vars[i].slider, vars[i].direction});
+      }
+      if (relaxer->Relax(targets, options.relax_steps, &trial, &trial_grad, &trial_energies) > 0) {
+        if (Cancelled(cancel)) return cancelled_at(iter);
+        for (const auto& [part, i] : picked) {
+          const Layout::Var& var = vars[i];
+          const Point& x = trial[var.shape][var.vertex];
+          if (var.slider) {
+            z_new[var.offset] = (x - var.base).dot(var.direction);
+          } else {
+            z_new.segment<2>(var.offset) = x;
+          }
+        }
+        g_new = layout.GatherGradient(trial_grad);
+        f_new = trial_energies.objective;
+      }
+      stats->phases.line_search += clock.Lap();
+    }
     history.push_back(f_new);
     const int window = std::max(1, options.decrease_window);
     // A step capped by the inversion bound is "blocked": slow progress there may be one blocking
@@ -1155,10 +1206,13 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   }
   if (options.max_iterations < 0 || options.history < 0 || !(options.max_step_fraction > 0.0) ||
       !(options.max_step_fraction < 1.0) || options.max_outer < 0 ||
-      !(options.cure_keep >= 0.0 && options.cure_keep < 1.0) || !(options.blend >= 0.0)) {
+      !(options.cure_keep >= 0.0 && options.cure_keep < 1.0) || !(options.blend >= 0.0) ||
+      std::isnan(options.relax_fraction) || !(options.relax_over_mean >= 0.0) ||
+      options.relax_max_vertices < 0 || options.relax_steps < 0) {
     return absl::InvalidArgumentError(
-        "comesh options: max_iterations, history and max_outer must be >= 0, max_step_fraction "
-        "in (0, 1), cure_keep in [0, 1), blend >= 0");
+        "comesh options: max_iterations, history, max_outer, relax_max_vertices and relax_steps "
+        "must be >= 0, max_step_fraction in (0, 1), cure_keep in [0, 1), blend and "
+        "relax_over_mean >= 0, relax_fraction a number");
   }
   const int threads = ResolveThreads(options.threads);
   const absl::Status not_started = absl::CancelledError("comesh optimization cancelled at start");

@@ -33,8 +33,10 @@ struct ComeshBenchArgs {
 
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
 // --cure-keep C, --step-fraction F, --scale-by-inverse, --history M, --tolerance R, --laplacian
-// (BCQN's H0), --refresh K, --outer-inner K, --repeat N, --verbose, --malloc-defaults and (when
-// `with_max_vertices`) --max-vertices N, --min-vertices N, --cache DIR and --cancel-trials N;
+// (BCQN's H0), --refresh K, --relax F (0: no local relaxation), --relax-over-mean M,
+// --relax-max K, --relax-steps S, --outer-inner K, --repeat N, --verbose, --malloc-defaults and
+// (when `with_max_vertices`) --max-vertices N, --min-vertices N, --cache DIR and
+// --cancel-trials N;
 // exits 2 with a usage line otherwise.
 // Unless --malloc-defaults, keeps freed memory in the process as the CLI does
 // (solver/core/retain_memory.h), so the optimizer is timed as the animator's tool runs it.
@@ -44,7 +46,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
                  "[--cure-keep C] [--step-fraction F] [--outer-inner K] [--scale-by-inverse] "
-                 "[--history M] [--tolerance R] [--laplacian] [--refresh K] [--repeat N] "
+                 "[--history M] [--tolerance R] [--laplacian] [--refresh K] [--relax F] "
+                 "[--relax-over-mean M] [--relax-max K] [--relax-steps S] [--repeat N] "
                  "[--verbose] [--malloc-defaults] [--json FILE]\n",
                  argv[0],
                  with_max_vertices
@@ -78,6 +81,14 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.blend = std::atof(next());
     } else if (a == "--scale-by-inverse") {
       args.options.scaling_by_inverse = true;
+    } else if (a == "--relax") {
+      args.options.relax_fraction = std::atof(next());
+    } else if (a == "--relax-over-mean") {
+      args.options.relax_over_mean = std::atof(next());
+    } else if (a == "--relax-max") {
+      args.options.relax_max_vertices = std::atoi(next());
+    } else if (a == "--relax-steps") {
+      args.options.relax_steps = std::atoi(next());
     } else if (a == "--history") {
       args.options.history = std::atoi(next());
     } else if (a == "--outer-inner") {
