@@ -1115,7 +1115,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       spare = std::move(p);
     }
     stats->phases.direction += clock.Lap();
-    if (relaxer) {
+    if (relaxer && step < 1.0) {
       // The vertices holding at least relax_fraction of |g|^2 (and relax_over_mean times an
       // even share), largest first, at most relax_max_vertices of them.
       const double total = g_new.squaredNorm();
