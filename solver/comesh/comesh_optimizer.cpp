@@ -215,15 +215,13 @@ AreaPolynomial AreaAlong(const Points& x, const Points& dx, const Triangle& t) {
 // nothing (its area polynomial is constant).
 double MaxNonInvertingStep(const std::vector<Triangle>& triangles,
                            const std::vector<Points>& shapes, const std::vector<Points>& disp,
-                           int threads, std::pair<int, int>* argmin = nullptr) {
+                           int threads) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   constexpr int kChunk = 4096;
   const int num_triangles = static_cast<int>(triangles.size());
   std::vector<double> part(NumChunks(num_triangles, kChunk), kInf);
-  std::vector<std::pair<int, int>> where(part.size(), {-1, -1});
   ParallelChunks(num_triangles, kChunk, threads, [&](int chunk, int begin, int end) {
     double best = kInf;
-    std::pair<int, int> best_at = {-1, -1};
     for (size_t s = 0; s < shapes.size(); ++s) {
       const Points& x = shapes[s];
       const Points& dx = disp[s];
@@ -243,22 +241,13 @@ double MaxNonInvertingStep(const std::vector<Triangle>& triangles,
             if (r2 > 0.0) root = std::min(root, r2);
           }
         }
-        if (root < best) {
-          best = root;
-          best_at = {ti, static_cast<int>(s)};
-        }
+        best = std::min(best, root);
       }
     }
     part[chunk] = best;
-    where[chunk] = best_at;
   });
   double best = kInf;
-  for (size_t c = 0; c < part.size(); ++c) {
-    if (part[c] < best) {
-      best = part[c];
-      if (argmin != nullptr) *argmin = where[c];
-    }
-  }
+  for (double b : part) best = std::min(best, b);
   return best;
 }
 
@@ -1115,7 +1104,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       spare = std::move(p);
     }
     stats->phases.direction += clock.Lap();
-    if (relaxer && step < 1.0) {
+    if (relaxer && step < 1.0 && g_new.squaredNorm() > 0.0) {
       // The vertices holding at least relax_fraction of |g|^2 (and relax_over_mean times an
       // even share), largest first, at most relax_max_vertices of them.
       const double total = g_new.squaredNorm();
@@ -1138,6 +1127,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       }
       if (relaxer->Relax(targets, options.relax_steps, &trial, &trial_grad, &trial_energies) > 0) {
         if (Cancelled(cancel)) return cancelled_at(iter);
+        // Only the picked vertices moved (a full Gather would re-round every slider's unknown).
         for (const auto& [part, i] : picked) {
           const Layout::Var& var = vars[i];
           const Point& x = trial[var.shape][var.vertex];
@@ -1150,7 +1140,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
         g_new = layout.GatherGradient(trial_grad);
         f_new = trial_energies.objective;
       }
-      stats->phases.line_search += clock.Lap();
+      stats->phases.relax += clock.Lap();
     }
     history.push_back(f_new);
     const int window = std::max(1, options.decrease_window);

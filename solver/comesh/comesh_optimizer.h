@@ -164,6 +164,7 @@ struct ComeshPhaseSeconds {
   double direction = 0.0;    // L-BFGS two-loop recursion with H0 solves, curvature pairs
   double step_bound = 0.0;   // curing and the largest non-inverting step
   double line_search = 0.0;  // objective + gradient evaluations of the line search
+  double relax = 0.0;        // local relaxation after short steps (comesh_relax.h)
   double topology = 0.0;     // topology passes
 };
 

@@ -132,8 +132,8 @@ inline void PrintPhases(const solver::ComeshReport& r) {
   const solver::ComeshPhaseSeconds& p = r.phase_seconds;
   std::printf(
       "  phases (s): hessian %.3f, direction %.3f, step bound %.3f, line search %.3f, "
-      "topology %.3f\n",
-      p.hessian, p.direction, p.step_bound, p.line_search, p.topology);
+      "relax %.3f, topology %.3f\n",
+      p.hessian, p.direction, p.step_bound, p.line_search, p.relax, p.topology);
 }
 
 // OptimizeComesh, timed: a run shorter than a second is repeated until `repeat` runs were made
@@ -180,6 +180,7 @@ inline nlohmann::json ComeshRow(const std::string& name, const solver::ComeshRep
             {"direction", r.phase_seconds.direction},
             {"step_bound", r.phase_seconds.step_bound},
             {"line_search", r.phase_seconds.line_search},
+            {"relax", r.phase_seconds.relax},
             {"topology", r.phase_seconds.topology}}}};
 }
 

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <thread>
 
 #include "solver/comesh/comesh_objective.h"
@@ -404,6 +405,54 @@ TEST(ComeshOptimizerTest, RejectsBadOuterOptions) {
   options.max_outer = -1;
   EXPECT_EQ(OptimizeComesh(m, options, nullptr, nullptr, nullptr).status().code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+TEST(ComeshOptimizerTest, RejectsBadRelaxOptions) {
+  const Multimesh m = SquareToHexagon(4);
+  for (int which = 0; which < 4; ++which) {
+    ComeshOptions options;
+    if (which == 0) options.relax_steps = -1;
+    if (which == 1) options.relax_max_vertices = -1;
+    if (which == 2) options.relax_over_mean = std::nan("");
+    if (which == 3) options.relax_fraction = std::nan("");
+    const absl::Status st = OptimizeComesh(m, options, nullptr, nullptr, nullptr).status();
+    EXPECT_EQ(st.code(), absl::StatusCode::kInvalidArgument) << which;
+    EXPECT_NE(st.message().find("relax"), std::string::npos) << st;
+  }
+}
+
+// The inner loop with the local relaxation made to pick many vertices after every short step:
+// no iterate inverts or raises the objective (evaluated afresh), and the objective and energies
+// the optimizer tracked through the relaxations are those of its result.
+TEST(ComeshOptimizerTest, RelaxationKeepsIteratesValidAndTrackedEnergiesExact) {
+  const Multimesh m = SquareToHexagon(12);
+  auto objective = ComeshObjective::Create(m.triangles, m.shapes, 0.5);
+  ASSERT_TRUE(objective.ok());
+  double previous = objective->Evaluate(m.shapes);
+  int inverted = 0, increases = 0;
+  ComeshOptions options;
+  options.max_outer = 0;
+  options.relax_fraction = 1e-9;
+  options.relax_over_mean = 0.0;
+  options.relax_max_vertices = 64;
+  options.on_iterate = [&](int, const std::vector<Points>& shapes) {
+    for (const Points& x : shapes) inverted += testing::CountNonPositive(m.triangles, x);
+    const double f = objective->Evaluate(shapes);
+    if (!(f <= previous)) ++increases;
+    previous = f;
+  };
+  ComeshReport report;
+  auto out = OptimizeComesh(m, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_GT(report.phase_seconds.relax, 0.0);  // it ran
+  EXPECT_EQ(inverted, 0);
+  EXPECT_EQ(increases, 0);
+  ComeshEnergies fresh;
+  const double f = objective->Evaluate(out->shapes, nullptr, &fresh);
+  EXPECT_NEAR(report.objective_after, f, 1e-11 * f);
+  EXPECT_NEAR(report.map_energy, fresh.map, 1e-11 * fresh.map);
+  EXPECT_NEAR(report.mesh_energy, fresh.mesh, 1e-11 * fresh.mesh);
+  EXPECT_LT(report.objective_after, report.objective_before);
 }
 
 // Resuming from a checkpoint in the middle gives the uninterrupted run, bit for bit: the same
