@@ -332,8 +332,7 @@ TEST(ComeshOptimizerTest, OuterLoopKeepsLoopsAndCohesiveEdgesOfAnOpening) {
   for (int s = 0; s < out->num_shapes(); ++s) {
     for (size_t c = 0; c < m->cohesive_edges.size(); ++c) {
       for (int k = 0; k < 4; ++k) {
-        EXPECT_EQ(out->shapes[s][out->cohesive_edges[c][k]],
-                  m->shapes[s][m->cohesive_edges[c][k]]);
+        EXPECT_EQ(out->shapes[s][out->cohesive_edges[c][k]], m->shapes[s][m->cohesive_edges[c][k]]);
       }
     }
   }
