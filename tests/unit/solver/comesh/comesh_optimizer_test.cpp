@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <thread>
@@ -37,28 +38,47 @@ Multimesh SquareToHexagon(int k) {
   return m;
 }
 
+// Over every accepted iterate of a run on the fixed topology of `m` (max_outer = 0): the
+// inverted triangles of every shape and the iterates whose objective, evaluated afresh, rose
+// above the one before. Run optimizes with on_iterate set to count them.
+struct IterateAudit {
+  int iterates = 0;
+  int inverted = 0;
+  int increases = 0;
+
+  absl::StatusOr<Multimesh> Run(const Multimesh& m, ComeshOptions options, ComeshReport* report) {
+    Install(m, &options);
+    return OptimizeComesh(m, options, nullptr, nullptr, report);
+  }
+
+ private:
+  void Install(const Multimesh& m, ComeshOptions* options) {
+    auto objective = std::make_shared<ComeshObjective>(
+        ComeshObjective::Create(m.triangles, m.shapes, options->map_weight).value());
+    auto previous = std::make_shared<double>(objective->Evaluate(m.shapes));
+    options->on_iterate = [this, objective, previous, triangles = m.triangles](
+                              int, const std::vector<Points>& shapes) {
+      ++iterates;
+      for (const Points& x : shapes) inverted += testing::CountNonPositive(triangles, x);
+      const double f = objective->Evaluate(shapes);
+      if (!(f <= *previous)) ++increases;
+      *previous = f;
+    };
+  }
+};
+
 TEST(ComeshOptimizerTest, DecreasesObjectiveWithoutInvertingAnyIterate) {
   const Multimesh m = SquareToHexagon(10);
-  auto objective = ComeshObjective::Create(m.triangles, m.shapes, 0.5);
-  ASSERT_TRUE(objective.ok());
-  double previous = objective->Evaluate(m.shapes);
-  int iterates = 0, inverted = 0, increases = 0;
   ComeshOptions options;
   options.max_outer = 0;  // the inner loop alone: topology (and thus the objective) fixed
-  options.on_iterate = [&](int, const std::vector<Points>& shapes) {
-    ++iterates;
-    for (const Points& x : shapes) inverted += testing::CountNonPositive(m.triangles, x);
-    const double f = objective->Evaluate(shapes);
-    if (!(f <= previous)) ++increases;
-    previous = f;
-  };
+  IterateAudit audit;
   ComeshReport report;
-  auto out = OptimizeComesh(m, options, nullptr, nullptr, &report);
+  auto out = audit.Run(m, options, &report);
   ASSERT_TRUE(out.ok()) << out.status();
-  EXPECT_GT(iterates, 5);
-  EXPECT_EQ(iterates, report.inner);
-  EXPECT_EQ(inverted, 0);
-  EXPECT_EQ(increases, 0);
+  EXPECT_GT(audit.iterates, 5);
+  EXPECT_EQ(audit.iterates, report.inner);
+  EXPECT_EQ(audit.inverted, 0);
+  EXPECT_EQ(audit.increases, 0);
   EXPECT_LT(report.objective_after, report.objective_before);
   EXPECT_LT(report.map_energy, report.map_energy_before);
   EXPECT_EQ(report.vertices_before, m.num_vertices());
@@ -375,14 +395,12 @@ TEST(ComeshOptimizerTest, BlendingAndCuringKeepEveryIterateValid) {
   options.blend = 1.0;
   options.cure = true;
   options.max_outer = 0;
-  int inverted = 0;
-  options.on_iterate = [&](int, const std::vector<Points>& shapes) {
-    for (const Points& x : shapes) inverted += testing::CountNonPositive(m.triangles, x);
-  };
+  IterateAudit audit;
   ComeshReport report;
-  auto out = OptimizeComesh(m, options, nullptr, nullptr, &report);
+  auto out = audit.Run(m, options, &report);
   ASSERT_TRUE(out.ok()) << out.status();
-  EXPECT_EQ(inverted, 0);
+  EXPECT_EQ(audit.inverted, 0);
+  EXPECT_EQ(audit.increases, 0);
   EXPECT_GT(report.inner, 5);
   EXPECT_LT(report.objective_after, report.objective_before);
 }
@@ -427,25 +445,18 @@ TEST(ComeshOptimizerTest, RelaxationKeepsIteratesValidAndTrackedEnergiesExact) {
   const Multimesh m = SquareToHexagon(12);
   auto objective = ComeshObjective::Create(m.triangles, m.shapes, 0.5);
   ASSERT_TRUE(objective.ok());
-  double previous = objective->Evaluate(m.shapes);
-  int inverted = 0, increases = 0;
   ComeshOptions options;
   options.max_outer = 0;
   options.relax_fraction = 1e-9;
   options.relax_over_mean = 0.0;
   options.relax_max_vertices = 64;
-  options.on_iterate = [&](int, const std::vector<Points>& shapes) {
-    for (const Points& x : shapes) inverted += testing::CountNonPositive(m.triangles, x);
-    const double f = objective->Evaluate(shapes);
-    if (!(f <= previous)) ++increases;
-    previous = f;
-  };
+  IterateAudit audit;
   ComeshReport report;
-  auto out = OptimizeComesh(m, options, nullptr, nullptr, &report);
+  auto out = audit.Run(m, options, &report);
   ASSERT_TRUE(out.ok()) << out.status();
   EXPECT_GT(report.phase_seconds.relax, 0.0);  // it ran
-  EXPECT_EQ(inverted, 0);
-  EXPECT_EQ(increases, 0);
+  EXPECT_EQ(audit.inverted, 0);
+  EXPECT_EQ(audit.increases, 0);
   ComeshEnergies fresh;
   const double f = objective->Evaluate(out->shapes, nullptr, &fresh);
   EXPECT_NEAR(report.objective_after, f, 1e-11 * f);
