@@ -150,19 +150,19 @@ bool VertexRelaxer::RelaxOne(const RelaxTarget& target, int steps,
 
 void VertexRelaxer::Tally(const std::vector<int>& triangles, const std::vector<Points>& shapes,
                           double sign, double* mesh_sum, double* map_sum,
-                          std::vector<Points>* gradient) const {
+                          std::vector<GradientChange>* changes) const {
   const int n = objective_.num_shapes();
   std::vector<Point> cg(3 * n);
   for (int t : triangles) {
     const Triangle& tri = objective_.triangles()[t];
     double mesh_part = 0.0, map_part = 0.0;
     objective_.AccumulateTriangle(tri, shapes, &mesh_part, &map_part,
-                                  gradient != nullptr ? cg.data() : nullptr);
+                                  changes != nullptr ? cg.data() : nullptr);
     *mesh_sum += sign * mesh_part;
     *map_sum += sign * map_part;
-    if (gradient == nullptr) continue;
+    if (changes == nullptr) continue;
     for (int k = 0; k < 3; ++k) {
-      for (int i = 0; i < n; ++i) (*gradient)[i][tri[k]] += sign * cg[k * n + i];
+      for (int i = 0; i < n; ++i) changes->push_back({i, tri[k], sign * cg[k * n + i]});
     }
   }
 }
@@ -183,10 +183,14 @@ int VertexRelaxer::Relax(std::span<const RelaxTarget> targets, int steps,
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   }
   double mesh_change = 0.0, map_change = 0.0;
-  if (track) Tally(touched, *shapes, -1.0, &mesh_change, &map_change, gradient);
+  std::vector<GradientChange> changes;
+  std::vector<GradientChange>* tally = gradient != nullptr ? &changes : nullptr;
+  if (track) Tally(touched, *shapes, -1.0, &mesh_change, &map_change, tally);
   int moved = 0;
   for (const RelaxTarget& target : targets) moved += RelaxOne(target, steps, shapes) ? 1 : 0;
-  if (track) Tally(touched, *shapes, 1.0, &mesh_change, &map_change, gradient);
+  if (!track || moved == 0) return moved;  // gradient and energies stay as they are
+  Tally(touched, *shapes, 1.0, &mesh_change, &map_change, tally);
+  for (const GradientChange& c : changes) (*gradient)[c.shape][c.vertex] += c.change;
   if (energies != nullptr) {
     const int n = objective_.num_shapes();
     const double w = objective_.map_weight();

@@ -38,9 +38,9 @@ class VertexRelaxer {
 
   // Relaxes every target in order with up to `steps` Newton steps each and returns how many
   // moved. *shapes must be valid (every triangle positive). If `gradient` (Evaluate's layout,
-  // dE/dX per shape and vertex) and `energies` are given they are updated by the change of the
-  // terms of the triangles around the targets, so they stay those of *shapes (up to rounding)
-  // without a full evaluation.
+  // dE/dX per shape and vertex) and `energies` are given and something moved, they are updated by
+  // the change of the terms of the triangles around the targets, so they stay those of *shapes
+  // (up to rounding) without a full evaluation; if nothing moved they are left untouched.
   int Relax(std::span<const RelaxTarget> targets, int steps, std::vector<Points>* shapes,
             std::vector<Points>* gradient = nullptr, ComeshEnergies* energies = nullptr) const;
 
@@ -51,10 +51,16 @@ class VertexRelaxer {
                       Point* grad) const;
 
  private:
+  struct GradientChange {
+    int shape;
+    int vertex;
+    Point change;
+  };
   bool RelaxOne(const RelaxTarget& target, int steps, std::vector<Points>* shapes) const;
-  // Adds sign times the terms of `triangles` at `shapes` to the sums and the gradient.
+  // Adds sign times the terms of `triangles` at `shapes` to the sums and, if `changes` is given,
+  // appends their gradient contributions (times sign) to it, in triangle order.
   void Tally(const std::vector<int>& triangles, const std::vector<Points>& shapes, double sign,
-             double* mesh_sum, double* map_sum, std::vector<Points>* gradient) const;
+             double* mesh_sum, double* map_sum, std::vector<GradientChange>* changes) const;
 
   const ComeshObjective& objective_;
   std::vector<int> begin_;  // vertex -> ring triangles, CSR

@@ -146,8 +146,17 @@ TEST(VertexRelaxerTest, NoTargetsOrNoStepsChangeNothing) {
   std::vector<Points> shapes = m.shapes;
   EXPECT_EQ(relaxer.Relax({}, 3, &shapes), 0);
   const RelaxTarget target{1, 20, false, Point::Zero()};
-  EXPECT_EQ(relaxer.Relax({&target, 1}, 0, &shapes), 0);
+  std::vector<Points> gradient;
+  ComeshEnergies energies;
+  objective.Evaluate(shapes, &gradient, &energies);
+  const std::vector<Points> gradient_before = gradient;
+  const ComeshEnergies energies_before = energies;
+  EXPECT_EQ(relaxer.Relax({&target, 1}, 0, &shapes, &gradient, &energies), 0);
   EXPECT_EQ(shapes, m.shapes);
+  EXPECT_EQ(gradient, gradient_before);  // untouched, not changed and changed back
+  EXPECT_EQ(energies.objective, energies_before.objective);
+  EXPECT_EQ(energies.mesh, energies_before.mesh);
+  EXPECT_EQ(energies.map, energies_before.map);
 }
 
 }  // namespace
