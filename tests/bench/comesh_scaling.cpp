@@ -225,7 +225,7 @@ int main(int argc, char** argv) {
   if (ours.size() >= 2) {
     std::printf(
         "growth, time ~ vertices^k over these %zu rows (least squares in log-log): "
-        "ours k = %.2f, paper k = %.2f\n",
+        "ours k = %.3f, paper k = %.3f\n",
         ours.size(), GrowthExponent(ours), GrowthExponent(papers));
   }
   inbetween::bench::WriteRows(args.json_path, rows);
