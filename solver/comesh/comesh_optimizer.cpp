@@ -422,7 +422,7 @@ class HessianPreconditioner {
   static absl::StatusOr<HessianPreconditioner> Create(
       const std::vector<Triangle>& triangles, const Layout& layout,
       const ComeshObjective& objective, const std::vector<Points>& shapes, int background_analysis,
-      const CancelToken* cancel, SharedFactors* factors) {
+      bool float_substitutions, const CancelToken* cancel, SharedFactors* factors) {
     HessianPreconditioner h;
     h.background_analysis_ = background_analysis;
     h.triangles_ = &triangles;
@@ -541,6 +541,7 @@ class HessianPreconditioner {
       if (solver == nullptr) {
         solver = std::make_shared<SparseCholesky>(SparseCholesky::Method::kAuto);
       }
+      solver->set_float_substitutions(float_substitutions);
       block.solver = solver;
     }
     h.threads_ = layout.size() >= kParallelUnknowns ? objective.threads() : 1;
@@ -909,7 +910,8 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   if (options.hessian_preconditioner && mesh->num_shapes() <= options.hessian_max_shapes) {
     absl::StatusOr<HessianPreconditioner> h =
         HessianPreconditioner::Create(mesh->triangles, layout, *objective, shapes,
-                                      options.background_analysis_unknowns, cancel, factors);
+                                      options.background_analysis_unknowns,
+                                      options.float_substitutions, cancel, factors);
     if (absl::IsCancelled(h.status())) return cancelled_at(0);
     if (!h.ok()) return h.status();
     hessian.emplace(*std::move(h));

@@ -102,13 +102,19 @@ struct SparseCholesky::Impl {
   // (simplicial) or supernodes and return false, y half solved, once it is set; true when done.
   template <int kColumns>
   bool Substitute(double* y, int columns, const CancelToken* cancel) const;
-  template <int kColumns>
-  bool SubstituteSupernodal(double* y, int columns, double* below, const CancelToken* cancel) const;
+  template <int kColumns, typename T>
+  bool SubstituteSupernodal(const T* values, double* y, int columns, double* below,
+                            const CancelToken* cancel) const;
+  bool float_substitutions = false;
+  std::vector<float> l_xf;  // float_substitutions: a supernodal factor's values as float
   // Solves in place for `columns` interleaved right-hand sides in the permuted order. `below`:
   // max_below x columns values of scratch (supernodal factors only).
   template <int kColumns>
   bool SolvePermuted(double* y, int columns, double* below, const CancelToken* cancel) const {
-    if (super != nullptr) return SubstituteSupernodal<kColumns>(y, columns, below, cancel);
+    if (super != nullptr) {
+      if (!l_xf.empty()) return SubstituteSupernodal<kColumns>(l_xf.data(), y, columns, below, cancel);
+      return SubstituteSupernodal<kColumns>(l_x, y, columns, below, cancel);
+    }
     return Substitute<kColumns>(y, columns, cancel);
   }
 
@@ -235,7 +241,9 @@ void SparseCholesky::Impl::Extract() {
     for (int k = 0; k < nsuper; ++k) {
       max_below = std::max(max_below, (s_pi[k + 1] - s_pi[k]) - (super[k + 1] - super[k]));
     }
+    l_xf.clear();
   } else {
+    l_xf.clear();
     l_p = static_cast<const int*>(factor->p);
     l_nz = static_cast<const int*>(factor->nz);
     l_i = static_cast<const int*>(factor->i);
@@ -248,8 +256,8 @@ void SparseCholesky::Impl::Extract() {
 // place, and the rows below it through a dense scratch (gathered or scattered once per supernode,
 // so the inner loops run over contiguous memory); no BLAS, so solves on several threads never
 // contend. `below`: scratch of max_below x columns values.
-template <int kColumns>
-bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* below,
+template <int kColumns, typename T>
+bool SparseCholesky::Impl::SubstituteSupernodal(const T* l_x, double* y, int columns, double* below,
                                                 const CancelToken* cancel) const {
   const int c = kColumns > 0 ? kColumns : columns;
   // Columns of a supernode handled side by side (kGroup at a time); every entry of y and of
@@ -271,13 +279,13 @@ bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
     const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
     if (poll(s, nsrow, nscol)) return false;
     const int* rows = s_i + s_pi[s] + nscol;
-    const double* block = l_x + s_px[s];
+    const T* block = l_x + s_px[s];
     double* ys = y + static_cast<size_t>(k1) * c;
     std::fill(below, below + static_cast<size_t>(nbelow) * c, 0.0);
     for (int j0 = 0; j0 < nscol; j0 += kGroup) {
       const int group = std::min(kGroup, nscol - j0);
       for (int j = j0; j < j0 + group; ++j) {
-        const double* col = block + static_cast<size_t>(j) * nsrow;
+        const T* col = block + static_cast<size_t>(j) * nsrow;
         double* yj = ys + static_cast<size_t>(j) * c;
         const double inv = 1.0 / col[j];
         for (int q = 0; q < c; ++q) yj[q] *= inv;
@@ -286,7 +294,7 @@ bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
         }
       }
       // below += lower_j * y_j for the group's columns in column order, one pass over `below`.
-      const double* lower = block + static_cast<size_t>(j0) * nsrow + nscol;
+      const T* lower = block + static_cast<size_t>(j0) * nsrow + nscol;
       const double* yg = ys + static_cast<size_t>(j0) * c;
       if (group == kGroup) {
         for (int r = 0; r < nbelow; ++r) {
@@ -316,7 +324,7 @@ bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
     const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
     if (poll(s, nsrow, nscol)) return false;
     const int* rows = s_i + s_pi[s] + nscol;
-    const double* block = l_x + s_px[s];
+    const T* block = l_x + s_px[s];
     double* ys = y + static_cast<size_t>(k1) * c;
     for (int r = 0; r < nbelow; ++r) {
       const double* yr = y + static_cast<size_t>(rows[r]) * c;
@@ -324,7 +332,7 @@ bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
     }
     for (int j1 = nscol; j1 > 0; j1 -= kGroup) {
       const int group = std::min(kGroup, j1), j0 = j1 - group;
-      const double* lower = block + static_cast<size_t>(j0) * nsrow + nscol;
+      const T* lower = block + static_cast<size_t>(j0) * nsrow + nscol;
       const size_t stride = static_cast<size_t>(nsrow);
       for (int q = 0; q < c; ++q) {  // right-hand sides are independent
         // Each column's dot product with `below` (one sum per column, in row order), the
@@ -346,7 +354,7 @@ bool SparseCholesky::Impl::SubstituteSupernodal(double* y, int columns, double* 
           }
         }
         for (int j = j1 - 1; j >= j0; --j) {
-          const double* col = block + static_cast<size_t>(j) * nsrow;
+          const T* col = block + static_cast<size_t>(j) * nsrow;
           double sum = sums[j - j0];
           for (int i = j + 1; i < nscol; ++i) sum += col[i] * ys[static_cast<size_t>(i) * c + q];
           double& yj = ys[static_cast<size_t>(j) * c + q];
@@ -723,6 +731,20 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a,
     }
   }
   m.Extract();
+  if (m.float_substitutions && m.super != nullptr) {
+    // Polled every kConvertPoll values (~1-2 ms): tens of millions of values at 311k vertices.
+    constexpr size_t kConvertPoll = size_t{1} << 20;
+    const size_t count = static_cast<size_t>(m.s_px[m.nsuper]);
+    m.l_xf.resize(count);
+    for (size_t begin = 0; begin < count; begin += kConvertPoll) {
+      if (Cancelled(cancel)) {
+        m.l_xf.clear();
+        return absl::CancelledError("SparseCholesky: numeric factorization cancelled");
+      }
+      const size_t end = std::min(count, begin + kConvertPoll);
+      for (size_t k = begin; k < end; ++k) m.l_xf[k] = static_cast<float>(m.l_x[k]);
+    }
+  }
   m.factorized = true;
   return absl::OkStatus();
 }
@@ -882,6 +904,7 @@ absl::Status SparseCholesky::SolveInPlace(Eigen::MatrixXd* b, int threads,
 
 int SparseCholesky::rows() const { return impl_->n; }
 bool SparseCholesky::factorized() const { return impl_->factorized; }
+void SparseCholesky::set_float_substitutions(bool on) { impl_->float_substitutions = on; }
 bool SparseCholesky::supernodal() const {
   return impl_->factor != nullptr && impl_->factor->is_super;
 }

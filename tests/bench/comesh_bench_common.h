@@ -32,6 +32,7 @@ struct ComeshBenchArgs {
 };
 
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
+// --double-substitutions (ComeshOptions::float_substitutions off),
 // --cure-keep C, --step-fraction F, --scale-by-inverse, --history M, --tolerance R, --laplacian
 // (BCQN's H0), --refresh K, --relax F (0: no local relaxation), --relax-over-mean M,
 // --relax-max K, --relax-steps S, --outer-inner K, --repeat N, --verbose, --malloc-defaults and
@@ -45,7 +46,7 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
-                 "[--cure-keep C] [--step-fraction F] [--outer-inner K] [--scale-by-inverse] "
+                 "[--cure-keep C] [--double-substitutions] [--step-fraction F] [--outer-inner K] [--scale-by-inverse] "
                  "[--history M] [--tolerance R] [--laplacian] [--refresh K] [--relax F] "
                  "[--relax-over-mean M] [--relax-max K] [--relax-steps S] [--repeat N] "
                  "[--verbose] [--malloc-defaults] [--json FILE]\n",
@@ -97,6 +98,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.hessian_preconditioner = false;
     } else if (a == "--refresh") {
       args.options.hessian_refresh = std::atoi(next());
+    } else if (a == "--double-substitutions") {
+      args.options.float_substitutions = false;
     } else if (a == "--no-cure") {
       args.options.cure = false;
     } else if (a == "--cure-keep") {

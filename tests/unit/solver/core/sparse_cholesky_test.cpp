@@ -220,6 +220,60 @@ TEST(SparseCholeskyTest, AutoGoesSupernodalOnLargeMatricesWithTheSameSolution) {
   EXPECT_FALSE(indefinite.factorized());
 }
 
+// Float substitutions: a supernodal factor's solves read its values rounded to float, so the
+// solution is that of a slightly different matrix (close, not bit-equal); simplicial factors ignore
+// the switch; a refactorization refreshes the float copy; it is deterministic.
+TEST(SparseCholeskyTest, FloatSubstitutionsSolveCloselyOnSupernodalFactorsOnly) {
+  const Eigen::SparseMatrix<double> a = GridMatrix(100, 1e-2, 1.0, 3);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::MatrixXd b(a.rows(), 2);
+  for (Eigen::Index k = 0; k < b.size(); ++k) b.data()[k] = u(rng);
+  SparseCholesky exact(SparseCholesky::Method::kAuto), rounded(SparseCholesky::Method::kAuto);
+  rounded.set_float_substitutions(true);
+  ASSERT_TRUE(exact.Compute(a).ok());
+  ASSERT_TRUE(rounded.Compute(a).ok());
+  ASSERT_TRUE(rounded.supernodal());
+  Eigen::MatrixXd x = b, y = b, y_again = b;
+  ASSERT_TRUE(exact.SolveInPlace(&x).ok());
+  ASSERT_TRUE(rounded.SolveInPlace(&y).ok());
+  ASSERT_TRUE(rounded.SolveInPlace(&y_again, 2).ok());
+  EXPECT_EQ(y, y_again);
+  const double scale = x.cwiseAbs().maxCoeff();
+  EXPECT_GT((x - y).cwiseAbs().maxCoeff(), 1e-12 * scale);  // it did read floats
+  EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 1e-4 * scale);
+  EXPECT_LT((a * y - b).norm(), 1e-4 * b.norm());
+
+  // New values on the same pattern: the float copy follows.
+  const Eigen::SparseMatrix<double> scaled = 4.0 * a;
+  ASSERT_TRUE(rounded.Factorize(scaled).ok());
+  y = b;
+  ASSERT_TRUE(rounded.SolveInPlace(&y).ok());
+  EXPECT_LT((y - 0.25 * x).cwiseAbs().maxCoeff(), 1e-4 * 0.25 * scale);
+
+  // A cancelled factorization leaves nothing to solve with; without the token it works again.
+  CancelToken cancelled;
+  cancelled.Cancel();
+  EXPECT_EQ(rounded.Factorize(a, &cancelled).code(), absl::StatusCode::kCancelled);
+  EXPECT_FALSE(rounded.factorized());
+  ASSERT_TRUE(rounded.Factorize(a).ok());
+  y = b;
+  ASSERT_TRUE(rounded.SolveInPlace(&y).ok());
+  EXPECT_EQ(y, y_again);
+
+  // A simplicial factor ignores the switch: the same bits as without it.
+  const Eigen::SparseMatrix<double> small = GridMatrix(20, 0.1);
+  SparseCholesky plain, switched;
+  switched.set_float_substitutions(true);
+  ASSERT_TRUE(plain.Compute(small).ok());
+  ASSERT_TRUE(switched.Compute(small).ok());
+  ASSERT_FALSE(switched.supernodal());
+  Eigen::MatrixXd p = Eigen::MatrixXd::Ones(small.rows(), 1), q = p;
+  ASSERT_TRUE(plain.SolveInPlace(&p).ok());
+  ASSERT_TRUE(switched.SolveInPlace(&q).ok());
+  EXPECT_EQ(p, q);
+}
+
 // CHOLMOD's OpenMP regions run on the calling thread (the GOMP_parallel definition in
 // sparse_cholesky.cpp): a supernodal factorization starts no thread. Without that definition
 // libgomp starts a pool of 3 workers at the first region with its team of 4 (they stay alive).
