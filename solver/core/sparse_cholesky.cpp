@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -106,13 +107,19 @@ struct SparseCholesky::Impl {
   bool SubstituteSupernodal(const T* values, double* y, int columns, double* below,
                             const CancelToken* cancel) const;
   bool float_substitutions = false;
-  std::vector<float> l_xf;  // float_substitutions: a supernodal factor's values as float
+  // With float_substitutions, a supernodal factor's values rounded to float, stored in place over
+  // the first half of factor->x (so no memory is added; the doubles are gone until the next
+  // Factorize, which overwrites every value anyway); null otherwise.
+  const float* l_xf = nullptr;
+  // Rounds the values to float in place (above), polling `cancel` every kConvertPoll values;
+  // false if it was set (the values are then meaningless, as after a cancelled factorization).
+  bool ConvertValuesToFloat(const CancelToken* cancel);
   // Solves in place for `columns` interleaved right-hand sides in the permuted order. `below`:
   // max_below x columns values of scratch (supernodal factors only).
   template <int kColumns>
   bool SolvePermuted(double* y, int columns, double* below, const CancelToken* cancel) const {
     if (super != nullptr) {
-      if (!l_xf.empty()) return SubstituteSupernodal<kColumns>(l_xf.data(), y, columns, below, cancel);
+      if (l_xf != nullptr) return SubstituteSupernodal<kColumns>(l_xf, y, columns, below, cancel);
       return SubstituteSupernodal<kColumns>(l_x, y, columns, below, cancel);
     }
     return Substitute<kColumns>(y, columns, cancel);
@@ -227,7 +234,25 @@ void SparseCholesky::Impl::FreeFactor() {
   cholmod_free_factor(&factor, &common);
 }
 
+bool SparseCholesky::Impl::ConvertValuesToFloat(const CancelToken* cancel) {
+  // Span by span: the span's doubles are read into a float buffer, then copied to bytes
+  // [4 begin, 4 end) of the array, which lie below the unread doubles (from byte 8 end on).
+  constexpr size_t kConvertPoll = size_t{1} << 20;
+  const size_t count = static_cast<size_t>(s_px[nsuper]);
+  char* bytes = static_cast<char*>(factor->x);
+  std::vector<float> span(std::min(count, kConvertPoll));
+  for (size_t begin = 0; begin < count; begin += kConvertPoll) {
+    if (Cancelled(cancel)) return false;
+    const size_t end = std::min(count, begin + kConvertPoll);
+    for (size_t k = begin; k < end; ++k) span[k - begin] = static_cast<float>(l_x[k]);
+    std::memcpy(bytes + begin * sizeof(float), span.data(), (end - begin) * sizeof(float));
+  }
+  l_xf = reinterpret_cast<const float*>(bytes);
+  return true;
+}
+
 void SparseCholesky::Impl::Extract() {
+  l_xf = nullptr;
   perm = static_cast<const int*>(factor->Perm);
   l_x = static_cast<const double*>(factor->x);
   if (factor->is_super) {
@@ -241,9 +266,7 @@ void SparseCholesky::Impl::Extract() {
     for (int k = 0; k < nsuper; ++k) {
       max_below = std::max(max_below, (s_pi[k + 1] - s_pi[k]) - (super[k + 1] - super[k]));
     }
-    l_xf.clear();
   } else {
-    l_xf.clear();
     l_p = static_cast<const int*>(factor->p);
     l_nz = static_cast<const int*>(factor->nz);
     l_i = static_cast<const int*>(factor->i);
@@ -731,19 +754,8 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a,
     }
   }
   m.Extract();
-  if (m.float_substitutions && m.super != nullptr) {
-    // Polled every kConvertPoll values (~1-2 ms): tens of millions of values at 311k vertices.
-    constexpr size_t kConvertPoll = size_t{1} << 20;
-    const size_t count = static_cast<size_t>(m.s_px[m.nsuper]);
-    m.l_xf.resize(count);
-    for (size_t begin = 0; begin < count; begin += kConvertPoll) {
-      if (Cancelled(cancel)) {
-        m.l_xf.clear();
-        return absl::CancelledError("SparseCholesky: numeric factorization cancelled");
-      }
-      const size_t end = std::min(count, begin + kConvertPoll);
-      for (size_t k = begin; k < end; ++k) m.l_xf[k] = static_cast<float>(m.l_x[k]);
-    }
+  if (m.float_substitutions && m.super != nullptr && !m.ConvertValuesToFloat(cancel)) {
+    return absl::CancelledError("SparseCholesky: numeric factorization cancelled");
   }
   m.factorized = true;
   return absl::OkStatus();

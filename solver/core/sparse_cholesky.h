@@ -91,11 +91,11 @@ class SparseCholesky {
   static constexpr int kSolveCancelStride = 256;
 
   // Single-precision substitutions (for preconditioners, where L to 1e-16 buys nothing): each
-  // factorization of a supernodal factor also keeps its values rounded to float, and the solves
-  // read those (products and sums still in double). The substitutions read L once per sweep and
-  // are bound by memory traffic, so halving L's bytes made the comesh direction solve ~27% faster
-  // per iteration at 165k vertices (docs/benchmarks.md). Simplicial factors are unaffected.
-  // Costs one float copy of L's values per factorization. Takes effect at the next Factorize.
+  // factorization of a supernodal factor ends by rounding its values to float, in place (no
+  // memory added; polled like the factorization), and the solves read those (products and sums
+  // still in double). The substitutions read L once per sweep and are bound by memory traffic,
+  // so halving L's bytes made the comesh direction ~27% faster per iteration at 165k vertices
+  // (docs/benchmarks.md). Simplicial factors are unaffected. Takes effect at the next Factorize.
   void set_float_substitutions(bool on);
 
   int rows() const;
