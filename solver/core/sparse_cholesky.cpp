@@ -278,10 +278,11 @@ void SparseCholesky::Impl::Extract() {
 // The supernodal twin of Substitute (L L^T, no D): per supernode, the dense diagonal block in
 // place, and the rows below it through a dense scratch (gathered or scattered once per supernode,
 // so the inner loops run over contiguous memory); no BLAS, so solves on several threads never
-// contend. `below`: scratch of max_below x columns values.
+// contend. `below`: scratch of max_below x columns values. `values`: the factor's values, l_x or
+// their float rounding (l_xf); products and sums are in double either way.
 template <int kColumns, typename T>
-bool SparseCholesky::Impl::SubstituteSupernodal(const T* l_x, double* y, int columns, double* below,
-                                                const CancelToken* cancel) const {
+bool SparseCholesky::Impl::SubstituteSupernodal(const T* values, double* y, int columns,
+                                                double* below, const CancelToken* cancel) const {
   const int c = kColumns > 0 ? kColumns : columns;
   // Columns of a supernode handled side by side (kGroup at a time); every entry of y and of
   // `below` still sees its operations in the same order as one column at a time, so the result
@@ -302,7 +303,7 @@ bool SparseCholesky::Impl::SubstituteSupernodal(const T* l_x, double* y, int col
     const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
     if (poll(s, nsrow, nscol)) return false;
     const int* rows = s_i + s_pi[s] + nscol;
-    const T* block = l_x + s_px[s];
+    const T* block = values + s_px[s];
     double* ys = y + static_cast<size_t>(k1) * c;
     std::fill(below, below + static_cast<size_t>(nbelow) * c, 0.0);
     for (int j0 = 0; j0 < nscol; j0 += kGroup) {
@@ -347,7 +348,7 @@ bool SparseCholesky::Impl::SubstituteSupernodal(const T* l_x, double* y, int col
     const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
     if (poll(s, nsrow, nscol)) return false;
     const int* rows = s_i + s_pi[s] + nscol;
-    const T* block = l_x + s_px[s];
+    const T* block = values + s_px[s];
     double* ys = y + static_cast<size_t>(k1) * c;
     for (int r = 0; r < nbelow; ++r) {
       const double* yr = y + static_cast<size_t>(rows[r]) * c;

@@ -46,8 +46,9 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
-                 "[--cure-keep C] [--double-substitutions] [--step-fraction F] [--outer-inner K] [--scale-by-inverse] "
-                 "[--history M] [--tolerance R] [--laplacian] [--refresh K] [--relax F] "
+                 "[--cure-keep C] [--double-substitutions] [--step-fraction F] [--outer-inner K] "
+                 "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
+                 "[--relax F] "
                  "[--relax-over-mean M] [--relax-max K] [--relax-steps S] [--repeat N] "
                  "[--verbose] [--malloc-defaults] [--json FILE]\n",
                  argv[0],
