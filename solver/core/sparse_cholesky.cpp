@@ -234,6 +234,12 @@ void SparseCholesky::Impl::FreeFactor() {
   cholmod_free_factor(&factor, &common);
 }
 
+namespace {
+absl::Status NumericCancelled() {
+  return absl::CancelledError("SparseCholesky: numeric factorization cancelled");
+}
+}  // namespace
+
 bool SparseCholesky::Impl::ConvertValuesToFloat(const CancelToken* cancel) {
   // Span by span: the span's doubles are read into a float buffer, then copied to bytes
   // [4 begin, 4 end) of the array, which lie below the unread doubles (from byte 8 end on).
@@ -684,7 +690,7 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a,
   }
   m.factorized = false;
   auto cancelled = [] {
-    return absl::CancelledError("SparseCholesky: numeric factorization cancelled");
+    return NumericCancelled();
   };
   // (No early return for a token already set: the first poll, at the first row block or the
   // first supernode, answers then; the tests rely on that to reach both polls.)
@@ -756,7 +762,7 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a,
   }
   m.Extract();
   if (m.float_substitutions && m.super != nullptr && !m.ConvertValuesToFloat(cancel)) {
-    return absl::CancelledError("SparseCholesky: numeric factorization cancelled");
+    return NumericCancelled();
   }
   m.factorized = true;
   return absl::OkStatus();

@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
         const double got = mesh->num_vertices();
         if (!closest || std::abs(got - paper.before) <
                             std::abs(closest->num_vertices() - paper.before)) {
-          closest = *mesh;
+          closest = *std::move(mesh);  // `mesh` is rebuilt or replaced by `closest` below
         }
         if (std::abs(got - paper.before) <= 0.03 * paper.before) break;
         request *= paper.before / got;
