@@ -1284,8 +1284,10 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     if (progress) {
       progress(
           "comesh", 1.0,
-          absl::StrFormat("outer %d: %d flips, %d collapses, %d splits, vertices %d", rep.outer,
-                          topo.flips, topo.collapses, topo.splits, current.num_vertices()));
+          absl::StrFormat("outer %d: %d flips, %d collapses (%d corner swaps), %d splits, "
+                          "vertices %d",
+                          rep.outer, topo.flips, topo.collapses, topo.corner_swaps, topo.splits,
+                          current.num_vertices()));
     }
     if (options.on_checkpoint) {
       options.on_checkpoint(ComeshCheckpoint{.mesh = current,

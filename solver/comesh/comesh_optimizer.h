@@ -63,7 +63,9 @@
 // triangles, reduced in a fixed order, so the result is bit-identical for ANY thread count
 // (options.threads only changes speed). threads <= 0 uses std::thread::hardware_concurrency().
 //
-// TODO(issue 5): sliding across polyline corners / along curved outlines and pinned
+// The boundary correspondence moves past a corner only by the topology pass's corner swaps
+// (TopologyOptions::corner_swaps), a discrete step accepted when the objective does not rise.
+// TODO(issue 5): continuous sliding across polyline corners / along curved outlines and pinned
 //   correspondence marks once the multimesh carries them; boundary edge splits.
 #pragma once
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -82,7 +83,8 @@ class Editor {
       mips_sum_ += mips;
     }
     boundary_nbrs_.assign(n, {-1, -1});
-    std::vector<char> fixed(n, 0);  // never slides: a non-manifold edge, cohesive, >2 boundary edges
+    fixed_.assign(n, 0);  // never slides: a non-manifold edge, cohesive, >2 boundary edges
+    std::vector<char>& fixed = fixed_;
     for (const auto& [edge, count] : uses) {
       if (count != 2) protected_[edge.first] = protected_[edge.second] = 1;
       if (count > 2) fixed[edge.first] = fixed[edge.second] = 1;
@@ -102,10 +104,11 @@ class Editor {
     for (const auto& c : mesh.cohesive_edges) {
       for (int v : c) protected_[v] = fixed[v] = 1;
     }
-    slidable_.assign(n, 0);
-    if (options.boundary_collapses) {
+    all_straight_ = num_shapes >= 64 ? ~uint64_t{0} : (uint64_t{1} << num_shapes) - 1;
+    straight_.assign(n, 0);
+    if (options.boundary_collapses && num_shapes <= 64) {
       for (int v = 0; v < n; ++v) {
-        if (!fixed[v]) UpdateSlidable(v);
+        if (!fixed[v]) UpdateStraight(v);
       }
     }
     for (int s = 0; s < num_shapes; ++s) {
@@ -122,6 +125,7 @@ class Editor {
 
   double Objective() const { return Objective(t_, odt_sum_, mips_sum_); }
   int num_triangles() const { return t_; }
+  int corner_swaps() const { return corner_swaps_; }
   bool cancelled() const { return cancelled_; }
 
   // Interior edges (each once) as (a, b) with a < b, into *edges; false if `cancel` was set
@@ -178,16 +182,35 @@ class Editor {
   }
 
   // Boundary collapse candidates: the boundary edges (a, b), a < b, with an endpoint that may be
-  // removed (slidable), each once, ascending.
-  std::vector<std::pair<int, int>> BoundaryEdgesAtSlidable() const {
+  // removed (straight in every shape), each once, ascending; with corner swaps, also those whose
+  // two endpoints are each straight where the other is a corner (MergeableAlong).
+  std::vector<std::pair<int, int>> BoundaryCollapseEdges() const {
     std::vector<std::pair<int, int>> edges;
-    for (size_t v = 0; v < slidable_.size(); ++v) {
-      if (!slidable_[v] || removed_[v]) continue;
-      for (int u : boundary_nbrs_[v]) edges.push_back(std::minmax(static_cast<int>(v), u));
+    for (size_t v = 0; v < straight_.size(); ++v) {
+      if (straight_[v] == 0 || removed_[v]) continue;
+      for (int u : boundary_nbrs_[v]) {
+        if (straight_[v] == all_straight_ || MergeableAlong(static_cast<int>(v), u) ||
+            MergeableAlong(u, static_cast<int>(v))) {
+          edges.push_back(std::minmax(static_cast<int>(v), u));
+        }
+      }
     }
     std::sort(edges.begin(), edges.end());
     edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
     return edges;
+  }
+  // True if a or b is straight in every shape (a plain boundary collapse, not a corner swap).
+  bool Removable(int a, int b) const {
+    return straight_[a] == all_straight_ || straight_[b] == all_straight_;
+  }
+  // True if b may merge into its boundary neighbour a: b is not fixed and lies strictly inside
+  // the straight segment of its own two boundary neighbours in every shape or (with corner
+  // swaps) in every shape where a does not.
+  bool MergeableAlong(int a, int b) const {
+    return a >= 0 && b >= 0 && !fixed_[b] && straight_[b] != 0 &&
+           (boundary_nbrs_[b][0] == a || boundary_nbrs_[b][1] == a) &&
+           (straight_[b] == all_straight_ ||
+            (options_.corner_swaps && (straight_[a] | straight_[b]) == all_straight_));
   }
 
   // Length of edge (a, b) relative to the mean edge length, max (or min) over shapes.
@@ -242,13 +265,16 @@ class Editor {
     return true;
   }
 
-  // Removes b by merging it into a: b interior (edge ab interior), or b a slidable boundary
-  // vertex and ab one of its two boundary edges (a keeps its place; the boundary polyline of every
-  // shape is unchanged as a point set, since b lay on the straight segment of its neighbours).
+  // Removes b by merging it into a: b interior (edge ab interior), or ab a boundary edge with
+  // MergeableAlong(a, b). Along the boundary the merged vertex takes, in each shape, a's place
+  // where b is straight there and b's place where b is a corner (a is straight there then): the
+  // boundary polyline of every shape is unchanged as a point set, since the vertex dropped from
+  // it lay on the straight segment of its neighbours. A corner of one shape can so move past a
+  // corner of another along the boundary (square -> hexagon: a square corner onto a hexagon
+  // corner), which sliding alone never does: the optimizer's sliders stop at corners.
   bool TryCollapse(int a, int b) {
     if (removed_[a] || removed_[b] || locked_[a] || locked_[b]) return false;
-    const bool along_boundary =
-        slidable_[b] && (boundary_nbrs_[b][0] == a || boundary_nbrs_[b][1] == a);
+    const bool along_boundary = MergeableAlong(a, b);
     if (protected_[b] && !along_boundary) return false;
     int t1 = -1, t2 = -1;
     const int on_edge = EdgeTriangleCount(a, b, &t1, &t2);
@@ -278,8 +304,12 @@ class Editor {
     const double before = Objective();
     // Candidate places for the merged vertex: a's own, or (a free) the midpoint, in every shape.
     const int num_shapes = static_cast<int>(shapes_.size());
-    std::vector<Point> saved(num_shapes);
-    for (int s = 0; s < num_shapes; ++s) saved[s] = shapes_[s][a];
+    std::vector<Point> original(num_shapes), saved(num_shapes);
+    for (int s = 0; s < num_shapes; ++s) {
+      original[s] = saved[s] = shapes_[s][a];
+      // Along the boundary, a shape where b is a corner keeps b's place (see above).
+      if (along_boundary && !(straight_[b] >> s & 1)) saved[s] = shapes_[s][b];
+    }
     double best = std::numeric_limits<double>::infinity();
     int best_place = -1;
     double best_odt = 0.0, best_mips = 0.0;
@@ -306,7 +336,7 @@ class Editor {
       shapes_[s][a] = best_place == 1 ? Point(0.5 * (saved[s] + shapes_[s][b])) : saved[s];
     }
     if (best_place < 0 || !(best <= before)) {
-      for (int s = 0; s < num_shapes; ++s) shapes_[s][a] = saved[s];
+      for (int s = 0; s < num_shapes; ++s) shapes_[s][a] = original[s];
       return false;
     }
     // Apply.
@@ -325,14 +355,19 @@ class Editor {
     }
     removed_[b] = 1;
     t_ -= on_edge;
+    corner_swaps_ += along_boundary && straight_[b] != all_straight_;
     if (along_boundary) {  // a and b's other boundary neighbour c become neighbours
       const int c = boundary_nbrs_[b][0] == a ? boundary_nbrs_[b][1] : boundary_nbrs_[b][0];
       for (auto [v, old_nbr, new_nbr] : {std::tuple(a, b, c), std::tuple(c, b, a)}) {
         std::array<int, 2>& nbrs = boundary_nbrs_[v];
         (nbrs[0] == old_nbr ? nbrs[0] : nbrs[1]) = new_nbr;
-        if (slidable_[v]) UpdateSlidable(v);
+        // As b lay on the straight line of its neighbours (or a took its place), only a
+        // vertex straight everywhere can change (the tolerance of StrictlyInsideSegment grows
+        // with the segment); a corner swap makes a a corner where b was one.
+        if (straight_[v] == all_straight_) UpdateStraight(v);
       }
-      slidable_[b] = 0;
+      straight_[a] &= straight_[b];
+      straight_[b] = 0;
     }
     odt_sum_ += best_odt;
     mips_sum_ += best_mips;
@@ -427,16 +462,18 @@ class Editor {
   }
 
  private:
-  // slidable_[v]: v has two boundary neighbours and lies strictly inside the straight segment
-  // between them in every shape (what the optimizer lets slide), so removing it keeps every
-  // shape's domain.
-  void UpdateSlidable(int v) {
+  // Bit s of straight_[v]: v has two boundary neighbours and lies strictly inside the straight
+  // segment between them in shape s (where the optimizer lets it slide), so removing it from that
+  // shape's boundary polyline keeps the shape's domain.
+  void UpdateStraight(int v) {
     const auto [p, q] = boundary_nbrs_[v];
-    bool ok = p >= 0 && q >= 0;
-    for (size_t s = 0; ok && s < shapes_.size(); ++s) {
-      ok = StrictlyInsideSegment(shapes_[s][p], shapes_[s][q], shapes_[s][v]);
+    uint64_t bits = 0;
+    for (size_t s = 0; p >= 0 && q >= 0 && s < shapes_.size(); ++s) {
+      if (StrictlyInsideSegment(shapes_[s][p], shapes_[s][q], shapes_[s][v])) {
+        bits |= uint64_t{1} << s;
+      }
     }
-    slidable_[v] = ok;
+    straight_[v] = bits;
   }
 
   double Objective(int t, double odt, double mips) const {
@@ -533,7 +570,10 @@ class Editor {
   std::vector<std::vector<int>> incident_;
   std::vector<char> removed_, locked_, protected_;
   std::vector<std::array<int, 2>> boundary_nbrs_;  // the two boundary neighbours, or -1
-  std::vector<char> slidable_;                     // removable along the boundary (see above)
+  std::vector<char> fixed_;  // never merged along the boundary (see the constructor)
+  std::vector<uint64_t> straight_;  // per vertex, the shapes where it is a slider (UpdateStraight)
+  uint64_t all_straight_ = 0;       // every shape's bit
+  int corner_swaps_ = 0;
   std::vector<double> min_area2_, mean_edge_;
   double t0_;
   int t_;
@@ -661,9 +701,12 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
   if (options.collapses) {
     if (!candidates_by(+1.0, options.collapse_ratio)) return cancelled_status;
     if (options.boundary_collapses) {
-      for (const auto& [a, b] : editor.BoundaryEdgesAtSlidable()) {
+      for (const auto& [a, b] : editor.BoundaryCollapseEdges()) {
+        // A corner swap is tried whatever its length: sliding cannot do its work.
         const double key = editor.RelativeLength(a, b, /*max=*/true);
-        if (key < options.collapse_ratio) candidates.push_back({key, {a, b}});
+        if (key < options.collapse_ratio || !editor.Removable(a, b)) {
+          candidates.push_back({key, {a, b}});
+        }
       }
       std::sort(candidates.begin(), candidates.end());
     }
@@ -684,6 +727,7 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
     return cancelled_status;
   }
   rep.objective_after = editor.Objective();
+  rep.corner_swaps = editor.corner_swaps();
   if (report != nullptr) *report = rep;
   return editor.Compact(mesh);
 }

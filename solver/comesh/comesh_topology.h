@@ -9,10 +9,12 @@
 //     per-triangle ODT and MIPS terms normalized for the pass's starting count T0, so that
 //     removing or adding triangles is compared fairly.
 // Collapses remove interior vertices and, along a boundary edge, boundary vertices that lie on a
-// straight stretch of the boundary in every shape (TopologyOptions::boundary_collapses); corners,
-// cohesive-edge vertices and vertices listed in Multimesh::boundary but inside the mesh are never
-// removed (a boundary endpoint keeps its place; two interior endpoints merge at the better of
-// the midpoint and the kept vertex's position);
+// straight stretch of the boundary in every shape (TopologyOptions::boundary_collapses), or merge
+// a corner of some shapes with a boundary neighbour that is a corner of the others (corner
+// swaps); no shape loses a corner point, and cohesive-edge vertices and vertices listed in
+// Multimesh::boundary but inside the mesh are never removed (a boundary endpoint keeps its place,
+// shape by shape; two interior endpoints merge at the better of the midpoint and the kept
+// vertex's position);
 // the link condition keeps the mesh a manifold. A vertex touched by a collapse or split is not
 // used by another one in the same pass, so each pass changes the mesh locally; the optimizer
 // alternates passes with inner runs. The result is renumbered compactly (vertex order kept);
@@ -38,6 +40,13 @@ struct TopologyOptions {
   // cohesive-edge vertex or a vertex of a non-manifold edge), merging it into a neighbour along
   // a boundary edge: every shape's domain and boundary polyline stay the same point set.
   bool boundary_collapses = true;
+  // With boundary_collapses, a boundary edge (a, b) whose endpoints are each a corner only where
+  // the other is straight may collapse too (a "corner swap"): the merged vertex keeps, in each
+  // shape, the place of the endpoint that is a corner there. So a corner of one shape moves onto
+  // a corner of another (square -> hexagon: 90 degrees onto 120 instead of onto 180), which the
+  // optimizer's sliders, stopped at every corner, cannot do. Tried whatever the edge's length;
+  // the objective decides as for every collapse.
+  bool corner_swaps = true;
   // An interior edge is a collapse candidate when its length is below collapse_ratio times the
   // mean edge length in EVERY shape, a split candidate when above split_ratio times it in SOME
   // shape; the objective decides (see above).
@@ -53,6 +62,7 @@ struct TopologyOptions {
 struct TopologyReport {
   int flips = 0;
   int collapses = 0;
+  int corner_swaps = 0;  // of the collapses, those that were corner swaps
   int splits = 0;
   double objective_before = 0.0;  // E of the input (for its own triangle count)
   double objective_after = 0.0;   // E of the output (for its own triangle count)

@@ -32,6 +32,7 @@ struct ComeshBenchArgs {
 };
 
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
+// --no-corner-swaps (TopologyOptions::corner_swaps off),
 // --double-substitutions (ComeshOptions::float_substitutions off),
 // --cure-keep C, --step-fraction F, --scale-by-inverse, --history M, --tolerance R, --laplacian
 // (BCQN's H0), --refresh K, --relax F (0: no local relaxation), --relax-over-mean M,
@@ -46,6 +47,7 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
+                 "[--no-corner-swaps] "
                  "[--cure-keep C] [--double-substitutions] [--step-fraction F] [--outer-inner K] "
                  "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
                  "[--relax F] "
@@ -101,6 +103,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.hessian_refresh = std::atoi(next());
     } else if (a == "--double-substitutions") {
       args.options.float_substitutions = false;
+    } else if (a == "--no-corner-swaps") {
+      args.options.topology.corner_swaps = false;
     } else if (a == "--no-cure") {
       args.options.cure = false;
     } else if (a == "--cure-keep") {

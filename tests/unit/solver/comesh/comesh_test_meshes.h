@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "solver/core/types.h"
@@ -47,30 +48,12 @@ inline Multimesh SquareGrid(int k) {
   return m;
 }
 
-// Places the boundary (in m.boundary order) on the regular hexagon of circumradius r around
-// `center`, by arc length, then every interior vertex at the average of its neighbours (Tutte:
-// injective because the hexagon is convex). Same orientation as the input boundary.
-inline Points TutteHexagon(const Multimesh& m, double r = 0.6, Point center = Point(0.5, 0.5)) {
+// Every interior vertex of m (not in m.boundary) at the average of its neighbours, the boundary
+// vertices where `out` has them (Tutte: injective when the boundary is a convex polygon).
+inline Points TutteInterior(const Multimesh& m, Points out) {
   const int n = m.num_vertices();
-  const Points& src = m.shapes[0];
-  const int nb = static_cast<int>(m.boundary.size());
-  std::vector<double> arc(nb + 1, 0.0);
-  for (int b = 0; b < nb; ++b) {
-    arc[b + 1] = arc[b] + (src[m.boundary[(b + 1) % nb]] - src[m.boundary[b]]).norm();
-  }
-  Points out = src;
   std::vector<int> index(n, -1);
-  for (int b = 0; b < nb; ++b) {
-    const double u = 6.0 * arc[b] / arc[nb];  // hexagon side parameter in [0, 6)
-    const int side = std::min(5, static_cast<int>(u));
-    const double f = u - side;
-    const double a0 = -3.0 * std::numbers::pi / 4.0 + side * std::numbers::pi / 3.0;
-    const Point p0 = center + r * Point(std::cos(a0), std::sin(a0));
-    const Point p1 = center + r * Point(std::cos(a0 + std::numbers::pi / 3.0),
-                                        std::sin(a0 + std::numbers::pi / 3.0));
-    out[m.boundary[b]] = (1.0 - f) * p0 + f * p1;
-    index[m.boundary[b]] = -2;
-  }
+  for (int v : m.boundary) index[v] = -2;
   int free = 0;
   for (int v = 0; v < n; ++v) {
     if (index[v] == -1) index[v] = free++;
@@ -99,6 +82,30 @@ inline Points TutteHexagon(const Multimesh& m, double r = 0.6, Point center = Po
     if (index[v] >= 0) out[v] = sol.row(index[v]).transpose();
   }
   return out;
+}
+
+// Places the boundary (in m.boundary order) on the regular hexagon of circumradius r around
+// `center`, by arc length, then the interior by TutteInterior. Same orientation as the input
+// boundary.
+inline Points TutteHexagon(const Multimesh& m, double r = 0.6, Point center = Point(0.5, 0.5)) {
+  const Points& src = m.shapes[0];
+  const int nb = static_cast<int>(m.boundary.size());
+  std::vector<double> arc(nb + 1, 0.0);
+  for (int b = 0; b < nb; ++b) {
+    arc[b + 1] = arc[b] + (src[m.boundary[(b + 1) % nb]] - src[m.boundary[b]]).norm();
+  }
+  Points out = src;
+  for (int b = 0; b < nb; ++b) {
+    const double u = 6.0 * arc[b] / arc[nb];  // hexagon side parameter in [0, 6)
+    const int side = std::min(5, static_cast<int>(u));
+    const double f = u - side;
+    const double a0 = -3.0 * std::numbers::pi / 4.0 + side * std::numbers::pi / 3.0;
+    const Point p0 = center + r * Point(std::cos(a0), std::sin(a0));
+    const Point p1 = center + r * Point(std::cos(a0 + std::numbers::pi / 3.0),
+                                        std::sin(a0 + std::numbers::pi / 3.0));
+    out[m.boundary[b]] = (1.0 - f) * p0 + f * p1;
+  }
+  return TutteInterior(m, std::move(out));
 }
 
 // x + amplitude * sin(pi x) sin(pi y) * (cos(2 pi y), sin(2 pi x)) on the unit square: fixes

@@ -219,9 +219,11 @@ TEST(ComeshTopologyTest, EveryPassOnRandomlyDistortedMeshesStaysValid) {
 
 // One pass (w = 0.5) with what every pass must give: a valid multimesh in every shape, the same
 // boundary point set, an objective not raised. nullopt (and a failure) if the pass failed.
-std::optional<Multimesh> CheckedPass(const Multimesh& m, const TopologyOptions& options) {
+std::optional<Multimesh> CheckedPass(const Multimesh& m, const TopologyOptions& options,
+                                     TopologyReport* report_out = nullptr) {
   TopologyReport report;
   absl::StatusOr<Multimesh> out = ImproveTopology(m, 0.5, options, &report);
+  if (report_out != nullptr) *report_out = report;
   EXPECT_TRUE(out.ok()) << out.status();
   if (!out.ok()) return std::nullopt;
   ExpectValidEverywhere(*out);
@@ -300,6 +302,77 @@ TEST(ComeshTopologyTest, BoundaryCollapseKeepsCornersOfEveryShape) {
     m = *std::move(out);
   }
   EXPECT_LT(m.boundary.size(), boundary_before);  // some straight-in-both vertices did go
+}
+
+// Corner swaps: shape 1 is the same square with its boundary turned back by one vertex, so the
+// corner of shape 1 is the boundary neighbour before each corner of shape 0, and each of the two
+// crowds the other's corner (in shape 0 the shape-1 corner vertex is pushed along the side to a
+// tenth of its distance from the square's corner, likewise in shape 1). A swap merges the two
+// into a corner of both shapes, dropping the crowded triangles; the boundary stays the same
+// point set in both shapes and the map energy falls. Not with corner_swaps off, and never at a
+// cohesive-edge vertex.
+TEST(ComeshTopologyTest, CornerSwapsMergeNeighbouringCornersOfTwoShapes) {
+  const int k = 8;
+  Multimesh m = testing::SquareGrid(k);
+  const int nb = static_cast<int>(m.boundary.size());
+  Points turned = m.shapes[0];
+  for (int b = 0; b < nb; ++b) turned[m.boundary[b]] = m.shapes[0][m.boundary[(b + 1) % nb]];
+  m.shapes.push_back(testing::TutteInterior(m, std::move(turned)));
+  for (int i = 0; i < nb; i += k) {
+    const int corner0 = m.boundary[i], corner1 = m.boundary[(i + nb - 1) % nb];
+    Points& x0 = m.shapes[0];
+    Points& x1 = m.shapes[1];
+    x0[corner1] = x0[corner0] + 0.1 * (x0[corner1] - x0[corner0]);
+    x1[corner0] = x1[corner1] + 0.1 * (x1[corner0] - x1[corner1]);
+  }
+  m.boundary_loops = {m.boundary};
+  // The pair at the corner (1, 0) of shape 0 (boundary[k]) is a cohesive edge.
+  m.cohesive_edges.push_back({m.boundary[k - 1], m.boundary[k], m.boundary[k], m.boundary[k - 1]});
+  ASSERT_TRUE(ValidateMultimesh(m).ok()) << ValidateMultimesh(m);
+  auto corners_of_both = [](const Multimesh& mesh) {
+    int count = 0;
+    const std::vector<int>& loop = mesh.boundary;
+    const size_t n = loop.size();
+    for (size_t i = 0; i < n; ++i) {
+      bool corner = true;
+      for (const Points& x : mesh.shapes) {
+        corner &= !StrictlyInsideSegment(x[loop[(i + n - 1) % n]], x[loop[(i + 1) % n]], x[loop[i]]);
+      }
+      count += corner;
+    }
+    return count;
+  };
+  auto map_energy = [](const Multimesh& mesh) {
+    auto o = ComeshObjective::Create(mesh.triangles, mesh.shapes, 0.5);
+    EXPECT_TRUE(o.ok()) << o.status();
+    ComeshEnergies e;
+    if (o.ok()) o->Evaluate(mesh.shapes, nullptr, &e);
+    return e.map;
+  };
+  ASSERT_EQ(corners_of_both(m), 0);
+  for (bool swaps : {false, true}) {
+    SCOPED_TRACE(swaps);
+    TopologyOptions options;
+    options.corner_swaps = swaps;
+    TopologyReport report;
+    const std::optional<Multimesh> out = CheckedPass(m, options, &report);
+    ASSERT_TRUE(out.has_value());
+    if (!swaps) {
+      EXPECT_EQ(report.corner_swaps, 0);
+      EXPECT_EQ(corners_of_both(*out), 0);
+      continue;
+    }
+    // Three of the four corner pairs merge; the cohesive one stays apart.
+    EXPECT_EQ(report.corner_swaps, 3);
+    EXPECT_EQ(corners_of_both(*out), 3);
+    EXPECT_EQ(out->boundary.size(), m.boundary.size() - 3);
+    EXPECT_LT(map_energy(*out), map_energy(m));
+    ASSERT_EQ(out->cohesive_edges.size(), 1u);
+    for (int s = 0; s < 2; ++s) {
+      EXPECT_EQ(out->shapes[s][out->cohesive_edges[0][0]], m.shapes[s][m.boundary[k - 1]]);
+      EXPECT_EQ(out->shapes[s][out->cohesive_edges[0][1]], m.shapes[s][m.boundary[k]]);
+    }
+  }
 }
 
 }  // namespace
