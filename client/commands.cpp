@@ -218,7 +218,8 @@ json MultimeshToJson(const v1::Multimesh& mesh) {
   return {{"triangles", std::move(triangles)},
           {"shapes", std::move(shapes)},
           {"cohesive_edges", std::move(cohesive)},
-          {"boundary", std::vector<uint32_t>(mesh.boundary().begin(), mesh.boundary().end())}};
+          {"boundary", std::vector<uint32_t>(mesh.boundary().begin(), mesh.boundary().end())},
+          {"pinned", std::vector<uint32_t>(mesh.pinned().begin(), mesh.pinned().end())}};
 }
 
 // The multimesh's shapes as a frame set, so the SVG exporter can draw each shape's mesh.

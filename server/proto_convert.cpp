@@ -38,6 +38,7 @@ inbetween::v1::Multimesh ToProto(const solver::Multimesh& mesh) {
     pair->set_c(e[2]);
     pair->set_d(e[3]);
   }
+  for (int v : mesh.pinned) out.add_pinned(v);
   return out;
 }
 
@@ -85,6 +86,14 @@ absl::StatusOr<solver::Multimesh> MultimeshFromProto(const inbetween::v1::Multim
     }
     out.cohesive_edges.push_back({static_cast<int>(e.a()), static_cast<int>(e.b()),
                                   static_cast<int>(e.c()), static_cast<int>(e.d())});
+  }
+  for (int i = 0; i < mesh.pinned_size(); ++i) {
+    if (absl::Status s = check_index(mesh.pinned(i), "pinned", i); !s.ok()) return s;
+    if (i > 0 && !(mesh.pinned(i - 1) < mesh.pinned(i))) {
+      return absl::InvalidArgumentError(absl::StrCat(field, ".pinned[", i, "] (", mesh.pinned(i),
+                                                     ") is not above the one before it"));
+    }
+    out.pinned.push_back(static_cast<int>(mesh.pinned(i)));
   }
   return out;
 }

@@ -112,6 +112,7 @@ class Layout {
     for (const auto& c : mesh.cohesive_edges) {
       for (int v : c) pinned[v] = 1;
     }
+    for (int v : mesh.pinned) pinned[v] = 1;  // correspondence marks
     index_.assign(num_shapes_, std::vector<int>(n, -1));
     for (int s = 0; s < num_shapes_; ++s) {
       const Points& x = mesh.shapes[s];

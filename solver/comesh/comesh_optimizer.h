@@ -56,8 +56,9 @@
 // Unknowns, per shape: interior vertices move in 2D. With slide_boundary, a boundary vertex that
 // lies strictly inside the straight segment between its two boundary neighbours in that shape
 // slides along that line (one unknown), so the domain of every shape is preserved exactly.
-// Fixed: boundary corners, every vertex of a cohesive edge, vertices listed in
-// Multimesh::boundary that are not on the topological boundary, and unused vertices.
+// Fixed: boundary corners, every vertex of a cohesive edge, correspondence marks
+// (Multimesh::pinned), vertices listed in Multimesh::boundary that are not on the topological
+// boundary, and unused vertices.
 //
 // Threads: the objective, gradient and step bound are computed over fixed-size chunks of
 // triangles, reduced in a fixed order, so the result is bit-identical for ANY thread count
@@ -65,8 +66,8 @@
 //
 // The boundary correspondence moves past a corner only by the topology pass's corner swaps
 // (TopologyOptions::corner_swaps), a discrete step accepted when the objective does not rise.
-// TODO(issue 5): continuous sliding across polyline corners / along curved outlines and pinned
-//   correspondence marks once the multimesh carries them; boundary edge splits.
+// TODO(issue 5): continuous sliding across polyline corners / along curved outlines; boundary
+//   edge splits.
 #pragma once
 
 #include <functional>

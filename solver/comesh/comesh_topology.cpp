@@ -104,6 +104,7 @@ class Editor {
     for (const auto& c : mesh.cohesive_edges) {
       for (int v : c) protected_[v] = fixed[v] = 1;
     }
+    for (int v : mesh.pinned) protected_[v] = fixed[v] = 1;  // correspondence marks
     all_straight_ = num_shapes >= 64 ? ~uint64_t{0} : (uint64_t{1} << num_shapes) - 1;
     straight_.assign(n, 0);
     if (options.boundary_collapses && num_shapes <= 64) {
@@ -458,6 +459,7 @@ class Editor {
       out.cohesive_edges.push_back({index[c[0]], index[c[1]], index[c[2]], index[c[3]]});
     }
     out.cohesive_closed = input.cohesive_closed;
+    out.pinned = kept(input.pinned);  // never removed (fixed), still ascending
     return out;
   }
 

@@ -11,8 +11,9 @@
 // Collapses remove interior vertices and, along a boundary edge, boundary vertices that lie on a
 // straight stretch of the boundary in every shape (TopologyOptions::boundary_collapses), or merge
 // a corner of some shapes with a boundary neighbour that is a corner of the others (corner
-// swaps); no shape loses a corner point, and cohesive-edge vertices and vertices listed in
-// Multimesh::boundary but inside the mesh are never removed (a boundary endpoint keeps its place,
+// swaps); no shape loses a corner point, and cohesive-edge vertices, correspondence marks
+// (Multimesh::pinned) and vertices listed in Multimesh::boundary but inside the mesh are never
+// removed (a boundary endpoint keeps its place,
 // shape by shape; two interior endpoints merge at the better of the midpoint and the kept
 // vertex's position);
 // the link condition keeps the mesh a manifold. A vertex touched by a collapse or split is not

@@ -621,6 +621,25 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
                               flat.begin() + out.loop_start[g + 1]);
     }
   }
+  // Each mark's breakpoint (the nearest one: add_break kept an earlier breakpoint within kSameT
+  // instead of a second one) starts an interval; its first vertex is the mark's.
+  for (int g = 0; g < num_groups; ++g) {
+    const std::vector<double>& b = breaks[g];
+    for (const auto& [at0, unused] : marks_on[g]) {
+      const double t = Wrap01((at0 - marks_on[g][0].first) / curve(0, g).length());
+      int nearest = 0;
+      double best = 2.0;
+      for (size_t i = 0; i < b.size(); ++i) {
+        const double gap = std::abs(b[i] - t);
+        const double dist = std::min(gap, 1.0 - gap);
+        if (dist < best) best = dist, nearest = static_cast<int>(i);
+      }
+      out.mark_vertices.push_back(first_vertex[interval_start[g] + nearest]);
+    }
+  }
+  std::sort(out.mark_vertices.begin(), out.mark_vertices.end());
+  out.mark_vertices.erase(std::unique(out.mark_vertices.begin(), out.mark_vertices.end()),
+                          out.mark_vertices.end());
   return out;
 }
 

@@ -38,6 +38,9 @@ struct BoundaryCorrespondence {
   // edge_twin[d][e]: the edge collocated with e and walked the other way in drawing d (the two
   // sides of a cut or opening of drawing d), or -1.
   std::vector<std::vector<int>> edge_twin;
+  // The global vertex of each correspondence mark (ascending, each once; marks that fell onto
+  // the same breakpoint share it).
+  std::vector<int> mark_vertices;
   int num_loops() const { return static_cast<int>(loop_start.size()) - 1; }
   int num_vertices() const { return loop_start.back(); }
 };

@@ -511,6 +511,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     }
   }
   if (mesh.cohesive_edges.empty()) mesh.cohesive_closed.clear();
+  for (int e : bc->mark_vertices) mesh.pinned.push_back(cut.entries[e][0].vertex);
 
   // Vertices along a Hilbert curve of the first shape: every later stage loops over triangles
   // and gathers their corners (vertex_order.h).

@@ -19,6 +19,10 @@ struct Multimesh {
   // cohesive_closed[s]: indices into cohesive_edges whose two sides are collocated in shape s
   // (the cut or opening is closed there). Empty when there are no cohesive edges.
   std::vector<std::vector<int>> cohesive_closed;
+  // Vertices whose correspondence is pinned (a correspondence mark's boundary vertex), ascending:
+  // comesh optimization moves them in no shape and no topology pass removes them. Empty when
+  // the drawings had no marks.
+  std::vector<int> pinned;
 
   int num_vertices() const { return shapes.empty() ? 0 : static_cast<int>(shapes[0].size()); }
   int num_shapes() const { return static_cast<int>(shapes.size()); }

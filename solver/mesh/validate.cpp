@@ -128,6 +128,17 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
           absl::StrCat("multimesh boundary vertex ", v, " out of range [0, ", n, ")"));
     }
   }
+  for (size_t i = 0; i < mesh.pinned.size(); ++i) {
+    const int v = mesh.pinned[i];
+    if (v < 0 || v >= n) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("multimesh pinned vertex ", v, " out of range [0, ", n, ")"));
+    }
+    if (i > 0 && !(mesh.pinned[i - 1] < v)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("multimesh pinned vertices are not ascending and distinct at ", v));
+    }
+  }
   // Shared topology: one consistently oriented manifold, so each directed edge belongs to one
   // triangle (a repeated or overlapping triangle or a non-manifold edge uses one twice).
   std::vector<std::array<int, 3>> directed;  // {from, to, triangle}, sorted

@@ -82,6 +82,8 @@ void RenumberSpatially(Multimesh* mesh) {
   for (std::array<int, 4>& c : mesh->cohesive_edges) {
     for (int& v : c) v = to[v];
   }
+  for (int& v : mesh->pinned) v = to[v];
+  std::sort(mesh->pinned.begin(), mesh->pinned.end());
 }
 
 }  // namespace inbetween::solver

@@ -33,7 +33,7 @@ class DrawingMarksTest : public ServerTest {
     return session;
   }
 
-  grpc::Status Build(const v1::Session& session) {
+  grpc::Status Build(const v1::Session& session, v1::Multimesh* built = nullptr) {
     grpc::ClientContext context;
     v1::BuildMultimeshRequest request;
     request.set_session_id(session.id());
@@ -41,6 +41,7 @@ class DrawingMarksTest : public ServerTest {
     auto reader = stub_->BuildMultimesh(&context, request);
     v1::BuildMultimeshResponse message;
     while (reader->Read(&message)) {
+      if (built != nullptr && message.has_result()) *built = message.result().multimesh();
     }
     return reader->Finish();
   }
@@ -66,8 +67,12 @@ TEST_F(DrawingMarksTest, SvgMarksAreKeptAndPinTheMultimesh) {
   EXPECT_EQ(stored.correspondences_size(), 0);
   // The marks pin the arm's cut tip to the armpit and the limbs' corners to one another; with
   // them the four poses build.
-  const grpc::Status status = Build(stored);
+  v1::Multimesh built;
+  const grpc::Status status = Build(stored, &built);
   EXPECT_TRUE(status.ok()) << status.error_message();
+  // Each mark's vertex is listed as pinned (comesh optimization keeps it in place), ascending.
+  EXPECT_EQ(built.pinned_size(), kWalkMarks);
+  for (int i = 1; i < built.pinned_size(); ++i) EXPECT_LT(built.pinned(i - 1), built.pinned(i));
 }
 
 TEST_F(DrawingMarksTest, MarksSurviveExportAndImport) {

@@ -26,6 +26,7 @@ SessionState WithCheckpoint() {
   c.mesh.shapes[1][2] = solver::Point(0.1 + 0.2, 1.0 / 3.0);  // not exactly decimal
   c.mesh.cohesive_edges = {{0, 1, 3, 2}};
   c.mesh.cohesive_closed = {{0}, {}};
+  c.mesh.pinned = {1, 3};
   c.outer = 2;
   c.inner = 41;
   c.energy_evaluations = 97;
@@ -56,6 +57,7 @@ TEST(SessionSnapshotTest, ComeshCheckpointRoundTripsBitForBit) {
   EXPECT_EQ(a.mesh.cohesive_edges, b.mesh.cohesive_edges);
   EXPECT_EQ(a.mesh.boundary_loops, b.mesh.boundary_loops);
   EXPECT_EQ(a.mesh.cohesive_closed, b.mesh.cohesive_closed);
+  EXPECT_EQ(a.mesh.pinned, b.mesh.pinned);
   EXPECT_EQ(a.outer, b.outer);
   EXPECT_EQ(a.inner, b.inner);
   EXPECT_EQ(a.energy_evaluations, b.energy_evaluations);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -547,6 +548,54 @@ TEST(ComeshOptimizerTest, RejectsAnInvalidCheckpoint) {
   auto out = OptimizeComesh(*m, ComeshOptions{}, nullptr, nullptr, nullptr, &bad);
   EXPECT_EQ(out.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_NE(out.status().message().find("checkpoint"), std::string::npos);
+}
+
+// Correspondence marks stay pinned (issue "Comesh optimization"): square -> hexagon built with a
+// mark at the middle of the square's bottom and top sides, matched to the middle of the
+// hexagon's bottom and top sides. Both lie on straight stretches in both shapes, where every
+// other boundary vertex slides; the marks' vertices stay where they were, in both shapes,
+// through inner runs and topology passes (corner swaps included), and are listed as pinned in
+// the result. The same multimesh with its pins dropped moves them.
+TEST(ComeshOptimizerTest, CorrespondenceMarksStayPinned) {
+  MultimeshOptions build;
+  build.boundary_vertices = 48;
+  build.max_edge_relative = 0.08;
+  const double h = 0.6 * std::sin(std::numbers::pi / 3.0);
+  build.marks = {{Point(0.5, 0.0), Point(0.5, 0.5 - h)}, {Point(0.5, 1.0), Point(0.5, 0.5 + h)}};
+  absl::StatusOr<Multimesh> built =
+      BuildMultimesh({testing::UnitSquare(), testing::RegularPolygon(6, 0.6, Point(0.5, 0.5))},
+                     build);
+  ASSERT_TRUE(built.ok()) << built.status();
+  ASSERT_EQ(built->pinned.size(), 2u);
+  std::vector<std::vector<Point>> at(2);
+  for (int v : built->pinned) {
+    for (int s = 0; s < 2; ++s) at[s].push_back(built->shapes[s][v]);
+  }
+  ComeshOptions options;
+  options.max_outer = 3;
+  ComeshReport report;
+  absl::StatusOr<Multimesh> out = OptimizeComesh(*built, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_GT(report.outer, 0);
+  EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
+  testing::ExpectBoundaryKept(*built, *out);
+  ASSERT_EQ(out->pinned.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    for (int s = 0; s < 2; ++s) EXPECT_EQ(out->shapes[s][out->pinned[i]], at[s][i]) << i << s;
+  }
+  Multimesh unpinned = *built;
+  unpinned.pinned.clear();
+  absl::StatusOr<Multimesh> free = OptimizeComesh(unpinned, options, nullptr, nullptr, nullptr);
+  ASSERT_TRUE(free.ok()) << free.status();
+  int moved = 0;
+  for (size_t i = 0; i < 2; ++i) {
+    for (int s = 0; s < 2; ++s) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Point& p : free->shapes[s]) nearest = std::min(nearest, (p - at[s][i]).norm());
+      moved += nearest > 1e-9;
+    }
+  }
+  EXPECT_GT(moved, 0) << "without pins the marks' vertices would have stayed anyway";
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <utility>
@@ -211,18 +212,25 @@ TEST(BuildMultimeshTopologyTest, MarksPinCorrespondingPoints) {
   absl::StatusOr<Multimesh> m = BuildMultimesh({a, b}, options);
   ASSERT_TRUE(m.ok()) << m.status();
   ExpectValid(*m);
-  int pinned = 0;
+  std::vector<int> pinned;
   for (int v : m->boundary) {
     if ((m->shapes[0][v] - Point(10, 0)).norm() < 1e-6) {
       EXPECT_NEAR((m->shapes[1][v] - Point(0, 10)).norm(), 0, 1e-6);
-      ++pinned;
+      pinned.push_back(v);
     }
     if ((m->shapes[0][v] - Point(-10, 0)).norm() < 1e-6) {
       EXPECT_NEAR((m->shapes[1][v] - Point(0, -10)).norm(), 0, 1e-6);
-      ++pinned;
+      pinned.push_back(v);
     }
   }
-  EXPECT_EQ(pinned, 2);
+  EXPECT_EQ(pinned.size(), 2u);
+  // The multimesh lists them as pinned (for comesh optimization), ascending.
+  std::sort(pinned.begin(), pinned.end());
+  EXPECT_EQ(m->pinned, pinned);
+  // Without marks nothing is pinned.
+  absl::StatusOr<Multimesh> free = BuildMultimesh({a, b}, {});
+  ASSERT_TRUE(free.ok()) << free.status();
+  EXPECT_TRUE(free->pinned.empty());
 }
 
 }  // namespace

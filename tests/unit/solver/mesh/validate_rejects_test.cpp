@@ -167,6 +167,20 @@ TEST(ValidateRejectsTest, BoundaryIndexOutOfRange) {
   ExpectRejected(ValidateMultimesh(m), "multimesh boundary vertex -2 out of range");
 }
 
+TEST(ValidateRejectsTest, PinnedVerticesOutOfRangeOrUnordered) {
+  const int n = SquareHexagon().num_vertices();
+  Multimesh m = SquareHexagon();
+  m.pinned = {1, 4};
+  EXPECT_TRUE(ValidateMultimesh(m).ok()) << ValidateMultimesh(m);
+  m.pinned = {1, n};
+  ExpectRejected(ValidateMultimesh(m),
+                 absl::StrCat("multimesh pinned vertex ", n, " out of range [0, ", n, ")"));
+  m.pinned = {4, 1};
+  ExpectRejected(ValidateMultimesh(m), "multimesh pinned vertices are not ascending and distinct at 1");
+  m.pinned = {4, 4};
+  ExpectRejected(ValidateMultimesh(m), "not ascending and distinct at 4");
+}
+
 // The same triangle twice (or any two triangles on one directed edge) covers part of every shape
 // twice: not one shared manifold topology, though every triangle is positive.
 TEST(ValidateRejectsTest, DuplicateTriangle) {
