@@ -66,8 +66,7 @@
 //
 // The boundary correspondence moves past a corner only by the topology pass's corner swaps
 // (TopologyOptions::corner_swaps), a discrete step accepted when the objective does not rise.
-// TODO(issue 5): continuous sliding across polyline corners / along curved outlines; boundary
-//   edge splits.
+// TODO(issue 5): continuous sliding across polyline corners / along curved outlines.
 #pragma once
 
 #include <functional>

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -378,15 +379,28 @@ class Editor {
     return true;
   }
 
-  // Inserts a new vertex at the midpoint of interior edge (a, b) in every shape.
+  // Inserts a new vertex at the midpoint of edge (a, b) in every shape: an interior edge, or a
+  // boundary edge between two vertices that are not fixed (not cohesive, not a mark), whose
+  // midpoint then lies on the boundary's straight segment in every shape (a slider).
   bool TrySplit(int a, int b) {
     if (locked_[a] || locked_[b]) return false;
     int t1 = -1, t2 = -1;
-    if (!EdgeTriangles(a, b, &t1, &t2)) return false;
+    const int on_edge = EdgeTriangleCount(a, b, &t1, &t2);
+    const bool boundary = on_edge == 1;
+    if (boundary) {
+      const bool neighbours = boundary_nbrs_[a][0] == b || boundary_nbrs_[a][1] == b;
+      if (!options_.boundary_splits || fixed_[a] || fixed_[b] || !neighbours) return false;
+    } else if (on_edge != 2) {
+      return false;
+    }
     const int m = static_cast<int>(removed_.size());
     for (Points& x : shapes_) x.push_back(0.5 * (x[a] + x[b]));
     std::vector<Triangle> new_tris;
-    for (int t : {t1, t2}) {
+    std::vector<int> split = {t1};
+    if (!boundary) split.push_back(t2);
+    std::vector<Triangle> old_tris;
+    for (int t : split) old_tris.push_back(triangles_[t]);
+    for (int t : split) {
       const Triangle& tri = triangles_[t];
       for (int end : {a, b}) {
         Triangle half = tri;
@@ -399,28 +413,55 @@ class Editor {
     bool ok = true;
     for (const Triangle& tri : new_tris) ok = ok && Positive(tri);
     double odt_old, mips_old, odt_new = 0.0, mips_new = 0.0;
-    Terms({triangles_[t1], triangles_[t2]}, &odt_old, &mips_old);
+    Terms(old_tris, &odt_old, &mips_old);
     if (ok) Terms(new_tris, &odt_new, &mips_new);
     const double before = Objective();
-    const double after =
-        Objective(t_ + 2, odt_sum_ - odt_old + odt_new, mips_sum_ - mips_old + mips_new);
+    const double after = Objective(t_ + on_edge, odt_sum_ - odt_old + odt_new,
+                                   mips_sum_ - mips_old + mips_new);
     if (!ok || !(after < before - 1e-12 * std::abs(before))) {
       for (Points& x : shapes_) x.pop_back();
       return false;
     }
+    // Every per-vertex array grows by m.
     removed_.push_back(0);
-    protected_.push_back(0);
+    protected_.push_back(boundary ? 1 : 0);
     locked_.push_back(1);
     incident_.emplace_back();
+    fixed_.push_back(0);
+    boundary_nbrs_.push_back(boundary ? std::array<int, 2>{a, b} : std::array<int, 2>{-1, -1});
+    straight_.push_back(0);
+    if (boundary) {
+      for (auto [v, other] : {std::pair(a, b), std::pair(b, a)}) {
+        std::array<int, 2>& nbrs = boundary_nbrs_[v];
+        (nbrs[0] == other ? nbrs[0] : nbrs[1]) = m;
+      }
+      if (options_.boundary_collapses && shapes_.size() <= 64) UpdateStraight(m);
+      boundary_splits_.push_back({a, b, m});
+    }
     Replace(t1, new_tris[0]);
-    Replace(t2, new_tris[2]);
     Add(new_tris[1]);
-    Add(new_tris[3]);
-    t_ += 2;
+    if (!boundary) {
+      Replace(t2, new_tris[2]);
+      Add(new_tris[3]);
+    }
+    t_ += on_edge;
     odt_sum_ += odt_new - odt_old;
     mips_sum_ += mips_new - mips_old;
     locked_[a] = locked_[b] = 1;
     return true;
+  }
+
+  // Boundary edges (a, b), a < b, whose endpoints are not fixed, each once, ascending.
+  std::vector<std::pair<int, int>> SplittableBoundaryEdges() const {
+    std::vector<std::pair<int, int>> edges;
+    for (size_t v = 0; v < boundary_nbrs_.size(); ++v) {
+      if (removed_[v] || fixed_[v]) continue;
+      for (int u : boundary_nbrs_[v]) {
+        if (u > static_cast<int>(v) && !fixed_[u]) edges.push_back({static_cast<int>(v), u});
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    return edges;
   }
 
   Multimesh Compact(const Multimesh& input) const {
@@ -453,8 +494,32 @@ class Editor {
       }
       return out_list;
     };
-    out.boundary = kept(input.boundary);
-    for (const std::vector<int>& loop : input.boundary_loops) out.boundary_loops.push_back(kept(loop));
+    // Boundary splits insert their vertex between the edge's two ends (next to each other in
+    // the kept list, cyclically).
+    std::map<std::pair<int, int>, int> inserted;
+    for (const auto& [a, b, m] : boundary_splits_) {
+      inserted[std::minmax(index[a], index[b])] = index[m];
+    }
+    auto with_splits = [&](const std::vector<int>& loop) {
+      if (inserted.empty()) return loop;
+      std::vector<int> out_loop;
+      for (size_t i = 0; i < loop.size(); ++i) {
+        out_loop.push_back(loop[i]);
+        const auto it = inserted.find(std::minmax(loop[i], loop[(i + 1) % loop.size()]));
+        if (it != inserted.end()) out_loop.push_back(it->second);
+      }
+      return out_loop;
+    };
+    for (const std::vector<int>& loop : input.boundary_loops) {
+      out.boundary_loops.push_back(with_splits(kept(loop)));
+    }
+    if (input.boundary_loops.empty()) {
+      out.boundary = with_splits(kept(input.boundary));
+    } else {
+      for (const std::vector<int>& loop : out.boundary_loops) {
+        out.boundary.insert(out.boundary.end(), loop.begin(), loop.end());
+      }
+    }
     for (const auto& c : input.cohesive_edges) {
       out.cohesive_edges.push_back({index[c[0]], index[c[1]], index[c[2]], index[c[3]]});
     }
@@ -576,6 +641,7 @@ class Editor {
   std::vector<uint64_t> straight_;  // per vertex, the shapes where it is a slider (UpdateStraight)
   uint64_t all_straight_ = 0;       // every shape's bit
   int corner_swaps_ = 0;
+  std::vector<std::array<int, 3>> boundary_splits_;  // (a, b, m): m split boundary edge (a, b)
   std::vector<double> min_area2_, mean_edge_;
   double t0_;
   int t_;
@@ -720,6 +786,13 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
   }
   if (options.splits) {
     if (!candidates_by(-1.0, options.split_ratio)) return cancelled_status;
+    if (options.boundary_splits) {
+      for (const auto& [a, b] : editor.SplittableBoundaryEdges()) {
+        const double key = -editor.RelativeLength(a, b, /*max=*/true);
+        if (key < -options.split_ratio) candidates.push_back({key, {a, b}});
+      }
+      std::sort(candidates.begin(), candidates.end());
+    }
     for (const auto& [r, edge] : candidates) {
       if (Cancelled(cancel)) return cancelled_status;
       rep.splits += editor.TrySplit(edge.first, edge.second);

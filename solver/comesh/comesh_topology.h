@@ -1,6 +1,7 @@
 // Comesh optimization, outer loop: one pass of topology operations applied identically to every
 // shape of a multimesh (DESIGN "Comesh optimization", S-Tables 1-4 "Outer"): edge flips, collapses
-// of short interior edges, splits of long interior edges. Each operation is accepted only if
+// of short interior edges, splits of long edges (interior, and boundary edges along the
+// boundary). Each operation is accepted only if
 //   - every new triangle is positive in EVERY shape, with area at least min_area_ratio times
 //     that shape's mean triangle area (no slivers), and
 //   - the comesh objective (comesh_objective.h) does not increase: flips and splits must lower
@@ -48,6 +49,9 @@ struct TopologyOptions {
   // optimizer's sliders, stopped at every corner, cannot do. Tried whatever the edge's length;
   // the objective decides as for every collapse.
   bool corner_swaps = true;
+  // Splits may also take a boundary edge (its midpoint on the boundary's straight segment in
+  // every shape, a new slider), except next to a cohesive-edge vertex or a correspondence mark.
+  bool boundary_splits = true;
   // An interior edge is a collapse candidate when its length is below collapse_ratio times the
   // mean edge length in EVERY shape, a split candidate when above split_ratio times it in SOME
   // shape; the objective decides (see above).

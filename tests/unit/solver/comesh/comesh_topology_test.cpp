@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <optional>
@@ -372,6 +373,53 @@ TEST(ComeshTopologyTest, CornerSwapsMergeNeighbouringCornersOfTwoShapes) {
       EXPECT_EQ(out->shapes[s][out->cohesive_edges[0][0]], m.shapes[s][m.boundary[k - 1]]);
       EXPECT_EQ(out->shapes[s][out->cohesive_edges[0][1]], m.shapes[s][m.boundary[k]]);
     }
+  }
+}
+
+// Boundary splits: on the bottom side of an 8 x 8 grid (both shapes, the second a similarity of
+// the first), vertices 1 and 2 are pushed along the side towards 0 and 3, leaving the boundary
+// edge (1, 2) 2.8 times the grid spacing long. A pass (collapses off) splits it: a new boundary
+// vertex inside it on the side, the loops and `boundary` list it between 1 and 2, the mesh stays
+// valid and the boundary the same point set. With boundary_splits off nothing lands there.
+TEST(ComeshTopologyTest, BoundarySplitsCutALongBoundaryEdge) {
+  Multimesh m = testing::SquareGrid(8);
+  Points& x = m.shapes[0];
+  x[1] = x[0] + 0.1 * (x[1] - x[0]);
+  x[2] = x[3] + 0.1 * (x[2] - x[3]);
+  m.shapes.push_back(testing::Similar(m.shapes[0], 0.4, 1.7, Point(3, 1)));
+  m.boundary_loops = {m.boundary};
+  ASSERT_TRUE(ValidateMultimesh(m).ok()) << ValidateMultimesh(m);
+  const double x1 = m.shapes[0][1].x(), x2 = m.shapes[0][2].x();
+  for (bool splits : {false, true}) {
+    SCOPED_TRACE(splits);
+    TopologyOptions options;
+    options.collapses = false;
+    options.boundary_splits = splits;
+    TopologyReport report;
+    const std::optional<Multimesh> out = CheckedPass(m, options, &report);
+    ASSERT_TRUE(out.has_value());
+    ASSERT_EQ(out->boundary_loops.size(), 1u);
+    EXPECT_EQ(out->boundary_loops[0], out->boundary);
+    std::vector<int> inside;  // boundary vertices strictly between the old 1 and 2
+    for (int v : out->boundary) {
+      const Point& p = out->shapes[0][v];
+      if (p.y() == 0.0 && p.x() > x1 + 1e-9 && p.x() < x2 - 1e-9) inside.push_back(v);
+    }
+    if (!splits) {
+      EXPECT_TRUE(inside.empty());
+      EXPECT_EQ(out->boundary.size(), m.boundary.size());
+      continue;
+    }
+    ASSERT_EQ(inside.size(), 1u);
+    EXPECT_GE(report.splits, 1);
+    EXPECT_EQ(out->boundary.size(), m.boundary.size() + 1);
+    EXPECT_NEAR(out->shapes[0][inside[0]].x(), 0.5 * (x1 + x2), 1e-12);
+    // Listed between 1 and 2 (numbering kept for the old vertices, new ones appended).
+    const std::vector<int>& loop = out->boundary;
+    const auto at = std::find(loop.begin(), loop.end(), inside[0]) - loop.begin();
+    ASSERT_GT(at, 0);
+    EXPECT_EQ(loop[at - 1], 1);
+    EXPECT_EQ(loop[(at + 1) % loop.size()], 2);
   }
 }
 
