@@ -32,7 +32,7 @@ struct ComeshBenchArgs {
 };
 
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
-// --no-corner-swaps (TopologyOptions::corner_swaps off),
+// --no-corner-swaps, --no-boundary-splits (TopologyOptions::corner_swaps, boundary_splits off),
 // --double-substitutions (ComeshOptions::float_substitutions off),
 // --cure-keep C, --step-fraction F, --scale-by-inverse, --history M, --tolerance R, --laplacian
 // (BCQN's H0), --refresh K, --relax F (0: no local relaxation), --relax-over-mean M,
@@ -47,7 +47,7 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
-                 "[--no-corner-swaps] "
+                 "[--no-corner-swaps] [--no-boundary-splits] "
                  "[--cure-keep C] [--double-substitutions] [--step-fraction F] [--outer-inner K] "
                  "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
                  "[--relax F] "
@@ -105,6 +105,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.float_substitutions = false;
     } else if (a == "--no-corner-swaps") {
       args.options.topology.corner_swaps = false;
+    } else if (a == "--no-boundary-splits") {
+      args.options.topology.boundary_splits = false;
     } else if (a == "--no-cure") {
       args.options.cure = false;
     } else if (a == "--cure-keep") {
