@@ -637,7 +637,9 @@ class Editor {
   std::vector<std::vector<int>> incident_;
   std::vector<char> removed_, locked_, protected_;
   std::vector<std::array<int, 2>> boundary_nbrs_;  // the two boundary neighbours, or -1
-  std::vector<char> fixed_;  // never merged along the boundary (see the constructor)
+  // Never removed along the boundary, and no boundary edge at it is split: non-manifold,
+  // cohesive-edge and mark vertices, and those with more than two boundary edges (constructor).
+  std::vector<char> fixed_;
   std::vector<uint64_t> straight_;  // per vertex, the shapes where it is a slider (UpdateStraight)
   uint64_t all_straight_ = 0;       // every shape's bit
   int corner_swaps_ = 0;
