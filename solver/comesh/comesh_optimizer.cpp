@@ -15,12 +15,14 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "solver/comesh/comesh_hessian.h"
 #include "solver/comesh/comesh_objective.h"
+#include "solver/comesh/comesh_outline.h"
 #include "solver/comesh/comesh_relax.h"
 #include "solver/comesh/comesh_topology.h"
 #include "solver/comesh/mips_energy.h"
@@ -80,12 +82,15 @@ absl::Status ValidateInput(const Multimesh& mesh) {
 
 // Per shape, which vertices move and how: interior vertices move freely in 2D; with sliding on,
 // a boundary vertex that lies strictly between its two boundary neighbours on a straight line
-// (in that shape) moves along that line; every other vertex is fixed.
+// (in that shape) moves along that line; with `outlines` (one per shape, may be null), any other
+// boundary vertex that lies on its shape's reference outline away from a hard point moves by arc
+// length along that outline (comesh_outline.h); every other vertex is fixed.
 class Layout {
  public:
   // With a `cancel` token (may be null) the edge list polls it (~0.1 s at 311k vertices); if it
   // was set, cancelled() is true and the layout is empty.
-  Layout(const Multimesh& mesh, bool slide_boundary, const CancelToken* cancel = nullptr) {
+  Layout(const Multimesh& mesh, bool slide_boundary, const std::vector<ShapeOutline>* outlines,
+         const CancelToken* cancel = nullptr) {
     const int n = mesh.num_vertices();
     num_vertices_ = n;
     num_shapes_ = mesh.num_shapes();
@@ -116,21 +121,38 @@ class Layout {
     index_.assign(num_shapes_, std::vector<int>(n, -1));
     for (int s = 0; s < num_shapes_; ++s) {
       const Points& x = mesh.shapes[s];
+      const ShapeOutline* outline = outlines != nullptr ? &(*outlines)[s] : nullptr;
+      const double tolerance = outline != nullptr ? outline->tolerance() : 0.0;
       for (int v = 0; v < n; ++v) {
         if (!used[v] || pinned[v]) continue;
         Var var{s, v, size_, false, Point::Zero(), x[v]};
         if (on_boundary[v]) {
           if (!slide_boundary || boundary_nbrs[v].size() != 2) continue;
           const Point a = x[boundary_nbrs[v][0]], b = x[boundary_nbrs[v][1]];
-          if (!StrictlyInsideSegment(a, b, x[v])) continue;  // a corner (or degenerate): pinned
-          var.slider = true;
-          var.direction = (b - a).normalized();
+          if (StrictlyInsideSegment(a, b, x[v])) {
+            var.slider = true;
+            var.direction = (b - a).normalized();
+          } else {
+            // A corner of its own polyline: it slides along the reference outline unless it is
+            // off the outline (a split's midpoint on a chord) or at one of its hard points.
+            if (outline == nullptr) continue;
+            const std::optional<ShapeOutline::Location> at = outline->Locate(x[v], tolerance);
+            if (!at || outline->AtHardPoint(at->loop, at->u, tolerance)) continue;
+            var.slider = true;
+            var.outline = at->loop;
+            var.u0 = at->u;
+            std::tie(var.lo, var.hi) = outline->Stretch(at->loop, at->u);
+            var.direction = outline->Tangent(at->loop, at->u);
+            ++num_outline_;
+          }
         }
         index_[s][v] = static_cast<int>(vars_.size());
         size_ += var.slider ? 1 : 2;
         vars_.push_back(var);
+        tangent_.push_back(var.direction);
       }
     }
+    outlines_ = num_outline_ > 0 ? outlines : nullptr;
   }
 
   struct Var {
@@ -138,14 +160,19 @@ class Layout {
     int vertex;
     int offset;       // into z
     bool slider;      // one unknown (position = base + z * direction) instead of two
-    Point direction;  // unit, sliders only
+    Point direction;  // unit, sliders only; for outline sliders the tangent where the run began
     Point base;       // position at the start, sliders only
+    // Outline sliders: the loop of the shape's outline, the arc length where the run began (the
+    // unknown is the arc length itself) and the stretch between hard points it stays in.
+    int outline = -1;
+    double u0 = 0.0, lo = 0.0, hi = 0.0;
   };
 
   bool cancelled() const { return cancelled_; }
   int size() const { return size_; }
   int num_shapes() const { return num_shapes_; }
   int num_vertices() const { return num_vertices_; }
+  int num_outline_sliders() const { return num_outline_; }
   const std::vector<Var>& vars() const { return vars_; }
   int index(int shape, int v) const { return index_[shape][v]; }
 
@@ -153,7 +180,9 @@ class Layout {
     VectorXd z(size_);
     for (const Var& var : vars_) {
       const Point& p = shapes[var.shape][var.vertex];
-      if (var.slider) {
+      if (var.outline >= 0) {
+        z[var.offset] = var.u0;
+      } else if (var.slider) {
         z[var.offset] = (p - var.base).dot(var.direction);
       } else {
         z.segment<2>(var.offset) = p;
@@ -161,12 +190,15 @@ class Layout {
     }
     return z;
   }
+  // The gradient in the unknowns; a slider's is the 2D gradient along its current tangent (see
+  // Track).
   VectorXd GatherGradient(const std::vector<Points>& gradient) const {
     VectorXd g(size_);
-    for (const Var& var : vars_) {
+    for (size_t i = 0; i < vars_.size(); ++i) {
+      const Var& var = vars_[i];
       const Point& p = gradient[var.shape][var.vertex];
       if (var.slider) {
-        g[var.offset] = p.dot(var.direction);
+        g[var.offset] = p.dot(tangent_[i]);
       } else {
         g.segment<2>(var.offset) = p;
       }
@@ -175,18 +207,35 @@ class Layout {
   }
   void Scatter(const VectorXd& z, std::vector<Points>* shapes) const {
     for (const Var& var : vars_) {
-      (*shapes)[var.shape][var.vertex] = var.slider
-                                             ? Point(var.base + z[var.offset] * var.direction)
-                                             : Point(z.segment<2>(var.offset));
+      Point& p = (*shapes)[var.shape][var.vertex];
+      if (var.outline >= 0) {
+        p = (*outlines_)[var.shape].At(var.outline, std::clamp(z[var.offset], var.lo, var.hi));
+      } else {
+        p = var.slider ? Point(var.base + z[var.offset] * var.direction)
+                       : Point(z.segment<2>(var.offset));
+      }
     }
   }
-  // Every vertex's displacement in every shape for the step z -> z + d (zero where fixed).
+  // Every vertex's displacement in every shape for the step z -> z + d (zero where fixed), to
+  // first order: a slider moves along its current tangent.
   void Displacements(const VectorXd& d, std::vector<Points>* out) const {
     out->resize(num_shapes_);
     for (Points& shape : *out) shape.assign(num_vertices_, Point::Zero());
-    for (const Var& var : vars_) {
+    for (size_t i = 0; i < vars_.size(); ++i) {
+      const Var& var = vars_[i];
       (*out)[var.shape][var.vertex] =
-          var.slider ? Point(d[var.offset] * var.direction) : Point(d.segment<2>(var.offset));
+          var.slider ? Point(d[var.offset] * tangent_[i]) : Point(d.segment<2>(var.offset));
+    }
+  }
+  // Moves the outline sliders' current tangents to the arc lengths in z (after an accepted step;
+  // a straight slider's tangent is its direction throughout).
+  void Track(const VectorXd& z) {
+    if (num_outline_ == 0) return;
+    for (size_t i = 0; i < vars_.size(); ++i) {
+      const Var& var = vars_[i];
+      if (var.outline < 0) continue;
+      tangent_[i] = (*outlines_)[var.shape].Tangent(var.outline,
+                                                    std::clamp(z[var.offset], var.lo, var.hi));
     }
   }
 
@@ -194,8 +243,11 @@ class Layout {
   int num_shapes_ = 0;
   int num_vertices_ = 0;
   int size_ = 0;
+  int num_outline_ = 0;
   bool cancelled_ = false;
   std::vector<Var> vars_;
+  std::vector<Point> tangent_;  // per var: a slider's current unit tangent
+  const std::vector<ShapeOutline>* outlines_ = nullptr;
   std::vector<std::vector<int>> index_;  // [shape][vertex] -> var or -1
 };
 
@@ -878,8 +930,9 @@ struct InnerStats {
 // The inner loop on a fixed topology: optimizes mesh->shapes in place. `iteration_base` numbers
 // iterations globally for callbacks.
 absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int threads,
-                       const CancelToken* cancel, const ProgressFn& progress, int iteration_base,
-                       InnerStats* stats, SharedFactors* factors) {
+                       const std::vector<ShapeOutline>* outlines, const CancelToken* cancel,
+                       const ProgressFn& progress, int iteration_base, InnerStats* stats,
+                       SharedFactors* factors) {
   Stopwatch clock;
   auto cancelled_at = [&](int iter) {
     return absl::CancelledError(
@@ -890,7 +943,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       ComeshObjective::Create(mesh->triangles, mesh->shapes, options.map_weight, threads);
   if (!objective.ok()) return objective.status();
   if (Cancelled(cancel)) return cancelled_at(0);
-  const Layout layout(*mesh, options.slide_boundary, cancel);
+  Layout layout(*mesh, options.slide_boundary, outlines, cancel);
   if (layout.cancelled() || Cancelled(cancel)) return cancelled_at(0);
   std::vector<Points>& shapes = mesh->shapes;
   std::vector<Points> grad_shapes;
@@ -1069,6 +1122,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       return absl::OkStatus();
     }
 
+    layout.Track(z_new);
     VectorXd g_new = layout.GatherGradient(trial_grad);
     if (Cancelled(cancel)) return cancelled_at(iter);
     // The pair's vectors reuse the storage of the pair last dropped from the history (or not
@@ -1116,6 +1170,7 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
           total * std::max(options.relax_fraction, options.relax_over_mean / vars.size());
       std::vector<std::pair<double, int>> picked;
       for (int i = 0; i < static_cast<int>(vars.size()); ++i) {
+        if (vars[i].outline >= 0) continue;  // moves along its outline only with the others
         const double part = vars[i].slider ? g_new[vars[i].offset] * g_new[vars[i].offset]
                                            : g_new.segment<2>(vars[i].offset).squaredNorm();
         if (part >= threshold) picked.emplace_back(part, i);
@@ -1201,11 +1256,12 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       !(options.max_step_fraction < 1.0) || options.max_outer < 0 ||
       !(options.cure_keep >= 0.0 && options.cure_keep < 1.0) || !(options.blend >= 0.0) ||
       std::isnan(options.relax_fraction) || !(options.relax_over_mean >= 0.0) ||
-      options.relax_max_vertices < 0 || options.relax_steps < 0) {
+      options.relax_max_vertices < 0 || options.relax_steps < 0 ||
+      !(options.outline_corner_degrees >= 0.0 && options.outline_corner_degrees <= 180.0)) {
     return absl::InvalidArgumentError(
         "comesh options: max_iterations, history, max_outer, relax_max_vertices and relax_steps "
         "must be >= 0, max_step_fraction in (0, 1), cure_keep in [0, 1), blend and "
-        "relax_over_mean >= 0, relax_fraction a number");
+        "relax_over_mean >= 0, relax_fraction a number, outline_corner_degrees in [0, 180]");
   }
   const int threads = ResolveThreads(options.threads);
   const absl::Status not_started = absl::CancelledError("comesh optimization cancelled at start");
@@ -1237,12 +1293,26 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     rep.splits = resume->splits;
     rep.objective_trace = resume->objective_trace;
   }
+  // The reference outlines are the input's (also when resuming), so every inner run slides the
+  // boundary along the drawn outlines, not along the chords of earlier runs.
+  std::vector<ShapeOutline> outlines;
+  if (options.slide_boundary && options.slide_outline) {
+    std::vector<char> fixed(mesh.num_vertices(), 0);
+    for (const auto& c : mesh.cohesive_edges) {
+      for (int v : c) fixed[v] = 1;
+    }
+    for (int v : mesh.pinned) fixed[v] = 1;
+    for (int s = 0; s < mesh.num_shapes(); ++s) {
+      outlines.emplace_back(mesh, s, options.outline_corner_degrees, fixed);
+    }
+  }
   SharedFactors factors;
   auto inner = [&](int max_iterations) {
     ComeshOptions run = options;
     run.max_iterations = max_iterations;
     absl::Status st =
-        InnerLoop(&current, run, threads, cancel, progress, stats.iterations, &stats, &factors);
+        InnerLoop(&current, run, threads, outlines.empty() ? nullptr : &outlines, cancel, progress,
+                  stats.iterations, &stats, &factors);
     if (st.ok()) rep.objective_trace.push_back(stats.objective);
     return st;
   };
@@ -1264,7 +1334,8 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     TopologyReport topo;
     Stopwatch topology_clock;
     absl::StatusOr<Multimesh> improved =
-        ImproveTopology(current, options.map_weight, options.topology, &topo, cancel);
+        ImproveTopology(current, options.map_weight, options.topology, &topo, cancel,
+                        outlines.empty() ? nullptr : &outlines);
     stats.phases.topology += topology_clock.Lap();
     if (absl::IsCancelled(improved.status())) {
       return absl::CancelledError(absl::StrCat("comesh optimization cancelled at outer ", outer));

@@ -55,7 +55,17 @@
 //
 // Unknowns, per shape: interior vertices move in 2D. With slide_boundary, a boundary vertex that
 // lies strictly inside the straight segment between its two boundary neighbours in that shape
-// slides along that line (one unknown), so the domain of every shape is preserved exactly.
+// slides along that line (one unknown), so the domain of every shape is preserved exactly. With
+// slide_outline too, every other boundary vertex (a corner of its own polyline: on a curved
+// outline, nearly all of them) slides along its shape's outline as it was in the input mesh (the
+// polyline of its boundary loops, frozen for the whole run, comesh_outline.h): its unknown is the
+// arc length, its position the point of the polyline there, its gradient taken along the tangent
+// where it is (updated after every step); it passes the polyline's soft corners (turns up to
+// outline_corner_degrees) and stops at the hard ones, at cohesive vertices and at marks. Every
+// boundary vertex thus stays on its input outline; the outline of a shape changes only by chords
+// across soft corners that a vertex has left. The line search's inversion bound follows the
+// tangent (first order across a soft corner); the trial's own evaluation, infinite for any
+// non-positive triangle, keeps every accepted iterate valid.
 // Fixed: boundary corners, every vertex of a cohesive edge, correspondence marks
 // (Multimesh::pinned), vertices listed in Multimesh::boundary that are not on the topological
 // boundary, and unused vertices.
@@ -64,9 +74,8 @@
 // triangles, reduced in a fixed order, so the result is bit-identical for ANY thread count
 // (options.threads only changes speed). threads <= 0 uses std::thread::hardware_concurrency().
 //
-// The boundary correspondence moves past a corner only by the topology pass's corner swaps
+// The boundary correspondence moves past a hard corner only by the topology pass's corner swaps
 // (TopologyOptions::corner_swaps), a discrete step accepted when the objective does not rise.
-// TODO(issue 5): continuous sliding across polyline corners / along curved outlines.
 #pragma once
 
 #include <functional>
@@ -114,6 +123,12 @@ struct ComeshOptions {
   bool cure = true;                 // BCQN curing of the direction
   double cure_keep = 0.5;           // curing keeps at least this fraction of each linearised area
   bool slide_boundary = true;       // boundary vertices on straight runs slide (see above)
+  // With slide_boundary: the other boundary vertices (the corners of their own polyline, as on
+  // every curved outline) slide by arc length along their shape's input outline, across its soft
+  // corners, stopping at turns above outline_corner_degrees and at cohesive vertices and marks
+  // (comesh_outline.h; see "Unknowns" above).
+  bool slide_outline = true;
+  double outline_corner_degrees = 25.0;
   // Local relaxation (comesh_relax.h): after each accepted step shorter than the unit step (one
   // that backtracked or met the inversion bound), every vertex (of one shape) whose gradient holds
   // at least relax_fraction of |g|^2 and relax_over_mean times an even share of it, at most

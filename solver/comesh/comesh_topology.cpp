@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -53,8 +54,9 @@ class Editor {
   // With `cancel` set during construction (polled every 4096 triangles: the set-up takes ~0.2 s
   // at 311k vertices), stops early and cancelled() is true; the editor is then unusable.
   Editor(const Multimesh& mesh, const ComeshObjective& objective, const TopologyOptions& options,
-         const CancelToken* cancel)
+         const std::vector<ShapeOutline>* outlines, const CancelToken* cancel)
       : objective_(objective),
+        outlines_(outlines),
         options_(options),
         triangles_(mesh.triangles),
         alive_(mesh.triangles.size(), 1),
@@ -394,7 +396,18 @@ class Editor {
       return false;
     }
     const int m = static_cast<int>(removed_.size());
-    for (Points& x : shapes_) x.push_back(0.5 * (x[a] + x[b]));
+    std::vector<Point> at;  // the new vertex in each shape
+    for (size_t s = 0; s < shapes_.size(); ++s) {
+      const Points& x = shapes_[s];
+      std::optional<Point> p = 0.5 * (x[a] + x[b]);
+      if (boundary && outlines_ != nullptr) {
+        const ShapeOutline& outline = (*outlines_)[s];
+        p = outline.SplitPoint(x[a], x[b], outline.tolerance());
+        if (!p) return false;
+      }
+      at.push_back(*p);
+    }
+    for (size_t s = 0; s < shapes_.size(); ++s) shapes_[s].push_back(at[s]);
     std::vector<Triangle> new_tris;
     std::vector<int> split = {t1};
     if (!boundary) split.push_back(t2);
@@ -630,6 +643,7 @@ class Editor {
   }
 
   const ComeshObjective& objective_;
+  const std::vector<ShapeOutline>* outlines_ = nullptr;  // may be null
   const TopologyOptions& options_;
   std::vector<Triangle> triangles_;
   std::vector<char> alive_;
@@ -710,7 +724,8 @@ bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v) {
 
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
                                           const TopologyOptions& options, TopologyReport* report,
-                                          const CancelToken* cancel) {
+                                          const CancelToken* cancel,
+                                          const std::vector<ShapeOutline>* outlines) {
   // Polled before every candidate operation (a relaxed atomic load; a pass on 35k vertices takes
   // ~0.1 s, more than the 100 ms a cancel may take).
   const absl::Status cancelled_status = absl::CancelledError("comesh topology pass cancelled");
@@ -718,7 +733,7 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
       ComeshObjective::Create(mesh.triangles, mesh.shapes, map_weight);
   if (!objective.ok()) return objective.status();
   if (Cancelled(cancel)) return cancelled_status;
-  Editor editor(mesh, *objective, options, cancel);
+  Editor editor(mesh, *objective, options, outlines, cancel);
   if (editor.cancelled() || Cancelled(cancel)) return cancelled_status;
   TopologyReport rep;
   rep.objective_before = editor.Objective();

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "solver/comesh/comesh_outline.h"
 #include "solver/core/cancel.h"
 #include "solver/mesh/multimesh.h"
 
@@ -90,10 +91,15 @@ bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v);
 // One topology pass. `mesh` must be valid (positive triangles in every shape). The returned
 // multimesh is valid too and has objective_after <= objective_before. CANCELLED (and no mesh) if
 // `cancel` is set during the pass (polled before every candidate operation and every 4096 items
-// of the edge and candidate lists).
+// of the edge and candidate lists). With `outlines` (one per shape; the optimizer's reference
+// outlines, comesh_outline.h), a boundary split puts its new vertex on the outline in every shape
+// (ShapeOutline::SplitPoint: the chord's midpoint on a straight stretch, the arc's middle across
+// soft corners) and is not made where some shape has no such point; without, at the chord's
+// midpoint.
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,
                                           const TopologyOptions& options,
                                           TopologyReport* report = nullptr,
-                                          const CancelToken* cancel = nullptr);
+                                          const CancelToken* cancel = nullptr,
+                                          const std::vector<ShapeOutline>* outlines = nullptr);
 
 }  // namespace inbetween::solver

@@ -72,6 +72,11 @@ TEST(ComeshOptimizerTest, DecreasesObjectiveWithoutInvertingAnyIterate) {
   const Multimesh m = SquareToHexagon(10);
   ComeshOptions options;
   options.max_outer = 0;  // the inner loop alone: topology (and thus the objective) fixed
+  // The hexagon's boundary is the square's, placed by arc length: four of its corners fall
+  // between vertices, whose turns (up to 60 degrees) are then split between two vertices, some
+  // below outline_corner_degrees. Straight-run sliding alone keeps the domains exactly, which
+  // this test checks (outline sliding: CurvedOutlinesSlideAlongTheirPolylines).
+  options.slide_outline = false;
   IterateAudit audit;
   ComeshReport report;
   auto out = audit.Run(m, options, &report);
@@ -367,7 +372,8 @@ TEST(ComeshOptimizerTest, OuterLoopKeepsLoopsAndCohesiveEdgesOfAnOpening) {
   EXPECT_GT(report.collapses + report.flips, 0);  // the passes changed the mesh
   EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
   ASSERT_EQ(out->boundary_loops.size(), 2u);
-  testing::ExpectBoundaryKept(*m, *out);
+  // The 48-gon's points (turns of 7.5 degrees) slide along it; the mouth's corners stay.
+  testing::ExpectBoundaryKept(*m, *out, ComeshOptions{}.outline_corner_degrees);
   EXPECT_EQ(out->cohesive_edges.size(), m->cohesive_edges.size());
   EXPECT_EQ(out->cohesive_closed, m->cohesive_closed);
   // Cohesive-edge vertices are pinned: the same places, in the same order.
@@ -571,6 +577,69 @@ TEST(ComeshOptimizerTest, RejectsAnInvalidCheckpoint) {
   EXPECT_NE(out.status().message().find("checkpoint"), std::string::npos);
 }
 
+// Curved outlines: every boundary vertex of a circle -> half-disk multimesh is a corner of its
+// own polyline, so only outline sliding (ComeshOptions::slide_outline) lets the boundary
+// correspondence move. With it the map energy falls far lower; every boundary vertex stays on
+// its shape's input outline; the half-disk's two drawn corners (90 degrees) keep a vertex exactly
+// where they were. Without it the boundary is the input's point set, corners in place.
+TEST(ComeshOptimizerTest, CurvedOutlinesSlideAlongTheirPolylines) {
+  Drawing circle, half;
+  Points round, arch;
+  for (int k = 0; k < 96; ++k) {
+    const double t = 2.0 * std::numbers::pi * k / 96.0;
+    round.push_back(Point(0.5 + 0.5 * std::cos(t), 0.5 + 0.5 * std::sin(t)));
+  }
+  for (int k = 0; k <= 32; ++k) {
+    const double t = std::numbers::pi * k / 32.0;
+    arch.push_back(Point(0.5 + 0.5 * std::cos(t), 0.3 + 0.5 * std::sin(t)));
+  }
+  circle.outlines.push_back({round});
+  half.outlines.push_back({arch});
+  MultimeshOptions build;
+  build.boundary_vertices = 48;
+  absl::StatusOr<Multimesh> m = BuildMultimesh({circle, half}, build);
+  ASSERT_TRUE(m.ok()) << m.status();
+  ComeshOptions options;
+  ComeshReport on, off;
+  absl::StatusOr<Multimesh> slid = OptimizeComesh(*m, options, nullptr, nullptr, &on);
+  ASSERT_TRUE(slid.ok()) << slid.status();
+  options.slide_outline = false;
+  absl::StatusOr<Multimesh> kept = OptimizeComesh(*m, options, nullptr, nullptr, &off);
+  ASSERT_TRUE(kept.ok()) << kept.status();
+  EXPECT_LT(on.map_energy, off.map_energy - 0.1) << on.map_energy << " vs " << off.map_energy;
+  EXPECT_LT(on.objective_after, off.objective_after);
+  testing::ExpectBoundaryKept(*m, *kept);
+  EXPECT_TRUE(ValidateMultimesh(*slid).ok()) << ValidateMultimesh(*slid);
+  const std::vector<int>& loop = m->boundary_loops.at(0);
+  const size_t n = loop.size();
+  int corners = 0;
+  for (int s = 0; s < 2; ++s) {
+    const Points& x = m->shapes[s];
+    const Points& y = slid->shapes[s];
+    EXPECT_EQ(CountInverted(slid->triangles, y), 0) << "shape " << s;
+    for (int v : slid->boundary) {
+      double d = std::numeric_limits<double>::infinity();
+      for (size_t k = 0; k < n; ++k) {
+        d = std::min(d, testing::DistanceToSegment(y[v], x[loop[k]], x[loop[(k + 1) % n]]));
+      }
+      EXPECT_LE(d, 1e-9) << "shape " << s << " vertex " << v << " left its outline";
+    }
+    for (size_t k = 0; k < n; ++k) {
+      const Point in = x[loop[k]] - x[loop[(k + n - 1) % n]];
+      const Point out = x[loop[(k + 1) % n]] - x[loop[k]];
+      if (in.dot(out) >= std::cos(options.outline_corner_degrees * std::numbers::pi / 180.0) *
+                             in.norm() * out.norm()) {
+        continue;
+      }
+      ++corners;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int v : slid->boundary) nearest = std::min(nearest, (y[v] - x[loop[k]]).norm());
+      EXPECT_EQ(nearest, 0.0) << "corner " << k << " of shape " << s;
+    }
+  }
+  EXPECT_EQ(corners, 2);  // the half-disk's
+}
+
 // Correspondence marks stay pinned (issue "Comesh optimization"): square -> hexagon built with a
 // mark at the middle of the square's bottom and top sides, matched to the middle of the
 // hexagon's bottom and top sides. Both lie on straight stretches in both shapes, where every
@@ -621,3 +690,4 @@ TEST(ComeshOptimizerTest, CorrespondenceMarksStayPinned) {
 
 }  // namespace
 }  // namespace inbetween::solver
+
