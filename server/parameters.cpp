@@ -44,6 +44,13 @@ absl::Status ValidateComesh(const inbetween::v1::ComeshParameters& comesh,
           field, ".outer_tolerance = ", comesh.outer_tolerance(), " is not in [0, 1)"));
     }
   }
+  if (comesh.has_outline_corner_degrees()) {
+    if (auto s = CheckRange(comesh.outline_corner_degrees(), 0, 180, false, field,
+                            "outline_corner_degrees");
+        !s.ok()) {
+      return s;
+    }
+  }
   if (comesh.tolerance() != 0) {
     if (!(std::isfinite(comesh.tolerance()) && comesh.tolerance() > 0 && comesh.tolerance() < 1)) {
       return absl::InvalidArgumentError(
@@ -175,6 +182,9 @@ solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& com
   }
   if (comesh.tolerance() != 0) options.relative_decrease_tolerance = comesh.tolerance();
   if (comesh.has_outer_tolerance()) options.outer_tolerance = comesh.outer_tolerance();
+  if (comesh.has_outline_corner_degrees()) {
+    options.outline_corner_degrees = comesh.outline_corner_degrees();
+  }
   return options;
 }
 

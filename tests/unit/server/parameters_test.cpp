@@ -61,6 +61,21 @@ TEST(ParametersTest, OutOfRangeNamesTheField) {
               HasSubstr("meshing.boundary_vertices"));
 }
 
+TEST(ParametersTest, OutlineCornerDegreesIsCheckedAndReachesTheOptimizer) {
+  v1::ComeshParameters c;
+  EXPECT_DOUBLE_EQ(ToComeshOptions(c).outline_corner_degrees,
+                   solver::ComeshOptions{}.outline_corner_degrees);
+  c.set_outline_corner_degrees(0.0);  // presence counts: 0 keeps only straight stretches sliding
+  ASSERT_TRUE(ValidateComesh(c, "comesh").ok());
+  EXPECT_DOUBLE_EQ(ToComeshOptions(c).outline_corner_degrees, 0.0);
+  c.set_outline_corner_degrees(181.0);
+  const absl::Status s = ValidateComesh(c, "comesh");
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(s.message()), HasSubstr("comesh.outline_corner_degrees = 181"));
+  c.set_outline_corner_degrees(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(ValidateComesh(c, "comesh").code(), absl::StatusCode::kInvalidArgument);
+}
+
 TEST(ParametersTest, TimingCurvesMapOntoTheSolver) {
   v1::InbetweenParameters p;
   absl::StatusOr<solver::TimingOptions> t = ToTimingOptions(p, 3, "parameters");
