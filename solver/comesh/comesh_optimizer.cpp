@@ -128,22 +128,26 @@ class Layout {
         Var var{s, v, size_, false, Point::Zero(), x[v]};
         if (on_boundary[v]) {
           if (!slide_boundary || boundary_nbrs[v].size() != 2) continue;
-          const Point a = x[boundary_nbrs[v][0]], b = x[boundary_nbrs[v][1]];
-          if (StrictlyInsideSegment(a, b, x[v])) {
-            var.slider = true;
-            var.direction = (b - a).normalized();
-          } else {
-            // A corner of its own polyline: it slides along the reference outline unless it is
-            // off the outline (a split's midpoint on a chord) or at one of its hard points.
-            if (outline == nullptr) continue;
-            const std::optional<ShapeOutline::Location> at = outline->Locate(x[v], tolerance);
-            if (!at || outline->AtHardPoint(at->loop, at->u, tolerance)) continue;
+          // On the reference outline: it slides along it, or stays at a hard point. (A straight
+          // slider there could follow its line off the outline once a neighbour has moved along
+          // a curve.)
+          const std::optional<ShapeOutline::Location> at =
+              outline != nullptr ? outline->Locate(x[v], tolerance) : std::nullopt;
+          if (at) {
+            if (outline->AtHardPoint(at->loop, at->u, tolerance)) continue;
             var.slider = true;
             var.outline = at->loop;
             var.u0 = at->u;
             std::tie(var.lo, var.hi) = outline->Stretch(at->loop, at->u);
             var.direction = outline->Tangent(at->loop, at->u);
             ++num_outline_;
+          } else {
+            // Otherwise (no outlines, or a vertex off them): along the straight segment of its
+            // neighbours if it lies strictly inside it, else fixed.
+            const Point a = x[boundary_nbrs[v][0]], b = x[boundary_nbrs[v][1]];
+            if (!StrictlyInsideSegment(a, b, x[v])) continue;
+            var.slider = true;
+            var.direction = (b - a).normalized();
           }
         }
         index_[s][v] = static_cast<int>(vars_.size());

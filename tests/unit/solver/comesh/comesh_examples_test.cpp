@@ -10,6 +10,7 @@
 #include "solver/comesh/comesh_optimizer.h"
 #include "solver/mesh/build_multimesh.h"
 #include "solver/mesh/validate.h"
+#include "tests/unit/solver/comesh/comesh_boundary_expect.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
 #include "tests/unit/solver/mesh/example_projects.h"
 
@@ -46,6 +47,8 @@ TEST_P(ComeshExamplesTest, NoAcceptedIterateInvertsAnyShape) {
   EXPECT_GT(iterates, 0);
   EXPECT_LE(report.objective_after, report.objective_before);
   EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
+  // Boundary vertices slid along their drawings' outlines only, past no sharp corner.
+  testing::ExpectBoundaryKept(mesh_, *out, options.outline_corner_degrees);
 }
 
 TEST_P(ComeshExamplesTest, EveryTopologyPassLeavesAValidMultimesh) {
@@ -68,6 +71,7 @@ TEST_P(ComeshExamplesTest, EveryTopologyPassLeavesAValidMultimesh) {
   EXPECT_EQ(passes, report.outer);
   EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
   for (const Points& x : out->shapes) EXPECT_EQ(testing::CountNonPositive(out->triangles, x), 0);
+  testing::ExpectBoundaryKept(mesh_, *out, options.outline_corner_degrees);
 }
 
 INSTANTIATE_TEST_SUITE_P(Examples, ComeshExamplesTest,
