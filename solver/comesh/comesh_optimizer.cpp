@@ -177,6 +177,7 @@ class Layout {
   int num_shapes() const { return num_shapes_; }
   int num_vertices() const { return num_vertices_; }
   int num_outline_sliders() const { return num_outline_; }
+  const Point& tangent(int i) const { return tangent_[i]; }
   const std::vector<Var>& vars() const { return vars_; }
   int index(int shape, int v) const { return index_[shape][v]; }
 
@@ -1174,7 +1175,6 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
           total * std::max(options.relax_fraction, options.relax_over_mean / vars.size());
       std::vector<std::pair<double, int>> picked;
       for (int i = 0; i < static_cast<int>(vars.size()); ++i) {
-        if (vars[i].outline >= 0) continue;  // moves along its outline only with the others
         const double part = vars[i].slider ? g_new[vars[i].offset] * g_new[vars[i].offset]
                                            : g_new.segment<2>(vars[i].offset).squaredNorm();
         if (part >= threshold) picked.emplace_back(part, i);
@@ -1184,21 +1184,36 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       });
       picked.resize(std::min<size_t>(picked.size(), std::max(0, options.relax_max_vertices)));
       std::vector<RelaxTarget> targets;
+      std::vector<Point> before;  // the picked vertices' positions
       for (const auto& [part, i] : picked) {
-        targets.push_back({vars[i].shape, vars[i].vertex, vars[i].slider, vars[i].direction});
+        const Layout::Var& var = vars[i];
+        RelaxTarget target{var.shape, var.vertex, var.slider, layout.tangent(i)};
+        if (var.outline >= 0) {
+          // Along the straight piece of the outline it is on (nowhere if at a bend).
+          const double u = std::clamp(z_new[var.offset], var.lo, var.hi);
+          const auto [back, forward] = outlines->at(var.shape).StraightExtent(var.outline, u);
+          target.lo = -std::min(back, u - var.lo);
+          target.hi = std::min(forward, var.hi - u);
+        }
+        targets.push_back(target);
+        before.push_back(trial[var.shape][var.vertex]);
       }
       if (relaxer->Relax(targets, options.relax_steps, &trial, &trial_grad, &trial_energies) > 0) {
         if (Cancelled(cancel)) return cancelled_at(iter);
         // Only the picked vertices moved (a full Gather would re-round every slider's unknown).
-        for (const auto& [part, i] : picked) {
+        for (size_t k = 0; k < picked.size(); ++k) {
+          const int i = picked[k].second;
           const Layout::Var& var = vars[i];
           const Point& x = trial[var.shape][var.vertex];
-          if (var.slider) {
+          if (var.outline >= 0) {
+            z_new[var.offset] += (x - before[k]).dot(layout.tangent(i));
+          } else if (var.slider) {
             z_new[var.offset] = (x - var.base).dot(var.direction);
           } else {
             z_new.segment<2>(var.offset) = x;
           }
         }
+        layout.Track(z_new);
         g_new = layout.GatherGradient(trial_grad);
         f_new = trial_energies.objective;
       }
