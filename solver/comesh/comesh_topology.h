@@ -50,8 +50,9 @@ struct TopologyOptions {
   // optimizer's sliders, stopped at every corner, cannot do. Tried whatever the edge's length;
   // the objective decides as for every collapse.
   bool corner_swaps = true;
-  // Splits may also take a boundary edge (its midpoint on the boundary's straight segment in
-  // every shape, a new slider), except next to a cohesive-edge vertex or a correspondence mark.
+  // Splits may also take a boundary edge (a new slider at its midpoint, or with the optimizer's
+  // outlines at the middle of its arc of the outline, see ImproveTopology), except next to a
+  // cohesive-edge vertex or a correspondence mark.
   bool boundary_splits = true;
   // An interior edge is a collapse candidate when its length is below collapse_ratio times the
   // mean edge length in EVERY shape, a split candidate when above split_ratio times it in SOME
