@@ -124,24 +124,25 @@ Point ShapeOutline::At(int l, double u) const {
   return a + t * (b - a);
 }
 
+Point ShapeOutline::Direction(const Loop& loop, int j) const {
+  const int m = static_cast<int>(loop.points.size());
+  j = (j % m + m) % m;
+  const Point d = loop.points[(j + 1) % m] - loop.points[j];
+  const double n = d.norm();
+  return n > 0.0 ? Point(d / n) : Point(Point::Zero());
+}
+
 Point ShapeOutline::Tangent(int l, double u) const {
   const Loop& loop = loops_[l];
-  const int m = static_cast<int>(loop.points.size());
   const double w = Wrap(loop, u);
   const int k = SegmentAt(loop, w);
-  auto segment = [&](int j) {
-    j = (j % m + m) % m;
-    const Point d = loop.points[(j + 1) % m] - loop.points[j];
-    const double n = d.norm();
-    return n > 0.0 ? Point(d / n) : Point(Point::Zero());
-  };
   const double eps = 1e-12 * loop.arc.back();
-  const Point here = segment(k);
+  const Point here = Direction(loop, k);
   Point t = here;
   if (w - loop.arc[k] <= eps) {
-    t = segment(k - 1) + here;
+    t = Direction(loop, k - 1) + here;
   } else if (loop.arc[k + 1] - w <= eps) {
-    t = here + segment(k + 1);
+    t = here + Direction(loop, k + 1);
   }
   const double n = t.norm();
   return n > 1e-12 ? Point(t / n) : here;
@@ -151,12 +152,7 @@ std::pair<double, double> ShapeOutline::StraightExtent(int l, double u) const {
   const Loop& loop = loops_[l];
   const int m = static_cast<int>(loop.points.size());
   const double w = Wrap(loop, u), eps = 1e-12 * loop.arc.back();
-  auto direction = [&](int j) {
-    j = (j % m + m) % m;
-    const Point d = loop.points[(j + 1) % m] - loop.points[j];
-    const double n = d.norm();
-    return n > 0.0 ? Point(d / n) : Point(Point::Zero());
-  };
+  auto direction = [&](int j) { return Direction(loop, j); };
   auto length = [&](int j) {
     j = (j % m + m) % m;
     return loop.arc[j + 1] - loop.arc[j];

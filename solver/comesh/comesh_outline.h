@@ -78,6 +78,8 @@ class ShapeOutline {
   // Segment k of the loop containing wrapped arc length u (in [0, length)).
   int SegmentAt(const Loop& loop, double u) const;
   double Wrap(const Loop& loop, double u) const;
+  // Unit direction of segment j (taken modulo the loop's size); zero for a degenerate segment.
+  Point Direction(const Loop& loop, int j) const;
   int64_t CellKey(int64_t ix, int64_t iy) const { return (ix << 32) ^ (iy & 0xffffffff); }
 
   std::vector<Loop> loops_;
