@@ -377,6 +377,14 @@ TEST_F(TopologyServiceTest, OptimizeStreamsIterationsStoresTheResultAndInbetween
     EXPECT_THAT(bad.status.error_message(), HasSubstr("comesh.max_outer_iterations"));
   }
   request.mutable_comesh()->set_max_outer_iterations(2);
+  request.mutable_comesh()->set_outline_corner_degrees(-1.0);
+  {
+    grpc::ClientContext context;
+    OptimizeRun bad = RunOptimize(*stub_, request, &context);
+    EXPECT_EQ(bad.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(bad.status.error_message(), HasSubstr("comesh.outline_corner_degrees = -1"));
+  }
+  request.mutable_comesh()->clear_outline_corner_degrees();
   request.mutable_comesh()->set_max_inner_iterations(30);
   grpc::ClientContext context;
   OptimizeRun run = RunOptimize(*stub_, request, &context);
