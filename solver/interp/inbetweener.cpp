@@ -290,7 +290,10 @@ absl::Status Inbetweener::Impl::Setup(const Multimesh& mesh) {
       return absl::InvalidArgumentError(absl::StrCat("vertex ", v, " is in no triangle"));
     }
   }
-  if (options.lambda > 0.0) {
+  // Cohesive pairs tie pieces together only where the cohesive term is in the matrix (zhu17 with
+  // lambda > 0); alexa's matrix has no such term, so each piece needs its own pinned vertex (a
+  // drawing split in two, like examples/split, would otherwise leave one piece singular).
+  if (options.lambda > 0.0 && options.method == InterpMethod::kZhu17) {
     for (const auto& e : mesh.cohesive_edges) {
       unite(e[0], e[2]);
       unite(e[1], e[3]);
