@@ -496,8 +496,7 @@ TEST(ComeshOptimizerTest, RelaxationKeepsIteratesValidAndTrackedEnergiesExact) {
 
 // Resuming from a checkpoint in the middle gives the uninterrupted run, bit for bit: the same
 // multimesh, the same report (seconds aside), the same iterates numbered on.
-TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun) {
-  auto m = BuiltSquareToHexagon(160);
+void ExpectResumedRunEqualsUninterrupted(const absl::StatusOr<Multimesh>& m) {
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
   // Short runs between passes and no outer tolerance: several passes, so that a checkpoint in
@@ -565,6 +564,30 @@ TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun)
     EXPECT_EQ(a.objective_trace, b.objective_trace);
     EXPECT_EQ(a.mesh.shapes, b.mesh.shapes);
   }
+}
+
+TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun) {
+  ExpectResumedRunEqualsUninterrupted(BuiltSquareToHexagon(160));
+}
+
+// The same with curved outlines: the resumed run slides the boundary along the input's outlines
+// (not the checkpoint's boundary, whose vertices have already left some polyline points).
+TEST(ComeshOptimizerTest, ResumedRunSlidesAlongTheInputOutlines) {
+  Drawing circle, half;
+  Points round, arch;
+  for (int k = 0; k < 96; ++k) {
+    const double t = 2.0 * std::numbers::pi * k / 96.0;
+    round.push_back(Point(0.5 + 0.5 * std::cos(t), 0.5 + 0.5 * std::sin(t)));
+  }
+  for (int k = 0; k <= 32; ++k) {
+    const double t = std::numbers::pi * k / 32.0;
+    arch.push_back(Point(0.5 + 0.5 * std::cos(t), 0.3 + 0.5 * std::sin(t)));
+  }
+  circle.outlines.push_back({round});
+  half.outlines.push_back({arch});
+  MultimeshOptions build;
+  build.boundary_vertices = 48;
+  ExpectResumedRunEqualsUninterrupted(BuildMultimesh({circle, half}, build));
 }
 
 TEST(ComeshOptimizerTest, RejectsAnInvalidCheckpoint) {
