@@ -135,11 +135,12 @@ class Layout {
               outline != nullptr ? outline->Locate(x[v], tolerance) : std::nullopt;
           if (at) {
             if (outline->AtHardPoint(at->loop, at->u, tolerance)) continue;
+            var.direction = outline->Tangent(at->loop, at->u);
+            if (!(var.direction.squaredNorm() > 0.5)) continue;  // a degenerate stretch: fixed
             var.slider = true;
             var.outline = at->loop;
             var.u0 = at->u;
             std::tie(var.lo, var.hi) = outline->Stretch(at->loop, at->u);
-            var.direction = outline->Tangent(at->loop, at->u);
             ++num_outline_;
           } else {
             // Otherwise (no outlines, or a vertex off them): along the straight segment of its
@@ -239,8 +240,9 @@ class Layout {
     for (size_t i = 0; i < vars_.size(); ++i) {
       const Var& var = vars_[i];
       if (var.outline < 0) continue;
-      tangent_[i] = (*outlines_)[var.shape].Tangent(var.outline,
-                                                    std::clamp(z[var.offset], var.lo, var.hi));
+      const Point t = (*outlines_)[var.shape].Tangent(var.outline,
+                                                      std::clamp(z[var.offset], var.lo, var.hi));
+      if (t.squaredNorm() > 0.5) tangent_[i] = t;  // (zero only on a zero-length segment)
     }
   }
 
