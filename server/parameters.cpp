@@ -182,7 +182,8 @@ solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& com
   }
   if (comesh.tolerance() != 0) options.relative_decrease_tolerance = comesh.tolerance();
   if (comesh.has_outer_tolerance()) options.outer_tolerance = comesh.outer_tolerance();
-  if (comesh.has_outline_corner_degrees()) {
+  if (comesh.has_outline_corner_degrees() && comesh.outline_corner_degrees() > 0.0) {
+    options.slide_outline = true;
     options.outline_corner_degrees = comesh.outline_corner_degrees();
   }
   return options;

@@ -58,7 +58,8 @@
 // slides along that line (one unknown), so the domain of every shape is preserved exactly. With
 // slide_outline too, every other boundary vertex (a corner of its own polyline: on a curved
 // outline, nearly all of them) slides along its shape's outline as it was in the input mesh (the
-// polyline of its boundary loops, frozen for the whole run, comesh_outline.h): its unknown is the
+// polyline of its boundary loops, frozen for the whole run, comesh_outline.h; off by default, see
+// ComeshOptions::slide_outline): its unknown is the
 // arc length, its position the point of the polyline there, its gradient taken along the tangent
 // where it is (updated after every step); it passes the polyline's soft corners (turns up to
 // outline_corner_degrees) and stops at the hard ones, at cohesive vertices and at marks. Every
@@ -126,8 +127,14 @@ struct ComeshOptions {
   // With slide_boundary: the other boundary vertices (the corners of their own polyline, as on
   // every curved outline) slide by arc length along their shape's input outline, across its soft
   // corners, stopping at turns above outline_corner_degrees and at cohesive vertices and marks
-  // (comesh_outline.h; see "Unknowns" above).
-  bool slide_outline = true;
+  // (comesh_outline.h; see "Unknowns" above). Off by default: the objective's normalizers are
+  // frozen at each inner run's start, so a vertex that cuts a convex soft corner lowers it by
+  // shrinking the shape (measured: areas -0.02% to -1.2% on the examples, and a worse final
+  // objective on three of them, docs/benchmarks.md); on curved pairs whose initial boundary
+  // correspondence is poor it lowers the map energy far (bird 4.18 -> 2.92).
+  // TODO(issue 5): normalize by the current areas so that cutting corners gains nothing, then
+  // turn it on by default.
+  bool slide_outline = false;
   double outline_corner_degrees = 25.0;
   // Local relaxation (comesh_relax.h): after each accepted step shorter than the unit step (one
   // that backtracked or met the inversion bound), every vertex (of one shape) whose gradient holds

@@ -63,11 +63,14 @@ TEST(ParametersTest, OutOfRangeNamesTheField) {
 
 TEST(ParametersTest, OutlineCornerDegreesIsCheckedAndReachesTheOptimizer) {
   v1::ComeshParameters c;
-  EXPECT_DOUBLE_EQ(ToComeshOptions(c).outline_corner_degrees,
-                   solver::ComeshOptions{}.outline_corner_degrees);
-  c.set_outline_corner_degrees(0.0);  // presence counts: 0 keeps only straight stretches sliding
+  EXPECT_FALSE(ToComeshOptions(c).slide_outline);  // unset: straight stretches only
+  c.set_outline_corner_degrees(0.0);
   ASSERT_TRUE(ValidateComesh(c, "comesh").ok());
-  EXPECT_DOUBLE_EQ(ToComeshOptions(c).outline_corner_degrees, 0.0);
+  EXPECT_FALSE(ToComeshOptions(c).slide_outline);
+  c.set_outline_corner_degrees(30.0);
+  ASSERT_TRUE(ValidateComesh(c, "comesh").ok());
+  EXPECT_TRUE(ToComeshOptions(c).slide_outline);
+  EXPECT_DOUBLE_EQ(ToComeshOptions(c).outline_corner_degrees, 30.0);
   c.set_outline_corner_degrees(181.0);
   const absl::Status s = ValidateComesh(c, "comesh");
   EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);

@@ -29,49 +29,60 @@ class ComeshExamplesTest : public ::testing::TestWithParam<std::string> {
   Multimesh mesh_;
 };
 
+// Both with the default straight-run sliding and with outline sliding (slide_outline).
 TEST_P(ComeshExamplesTest, NoAcceptedIterateInvertsAnyShape) {
-  ComeshOptions options;
-  options.max_outer = 0;  // topology fixed: every iterate is a position set of mesh_.triangles
-  options.max_iterations = 25;
-  int iterates = 0, bad = 0;
-  options.on_iterate = [&](int, const std::vector<Points>& shapes) {
-    ++iterates;
-    ASSERT_EQ(shapes.size(), mesh_.shapes.size());
-    for (const Points& x : shapes) bad += testing::CountNonPositive(mesh_.triangles, x);
-  };
-  ComeshReport report;
-  absl::StatusOr<Multimesh> out = OptimizeComesh(mesh_, options, nullptr, nullptr, &report);
-  ASSERT_TRUE(out.ok()) << out.status();
-  EXPECT_EQ(bad, 0) << "non-positive triangles summed over " << iterates << " iterates";
-  EXPECT_EQ(iterates, report.inner);
-  EXPECT_GT(iterates, 0);
-  EXPECT_LE(report.objective_after, report.objective_before);
-  EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
-  // Boundary vertices slid along their drawings' outlines only, past no sharp corner.
-  testing::ExpectBoundaryKept(mesh_, *out, options.outline_corner_degrees);
+  for (bool slide_outline : {false, true}) {
+    SCOPED_TRACE(slide_outline ? "outline sliding" : "straight-run sliding");
+    ComeshOptions options;
+    options.slide_outline = slide_outline;
+    options.max_outer = 0;  // topology fixed: every iterate is a position set of mesh_.triangles
+    options.max_iterations = 25;
+    int iterates = 0, bad = 0;
+    options.on_iterate = [&](int, const std::vector<Points>& shapes) {
+      ++iterates;
+      ASSERT_EQ(shapes.size(), mesh_.shapes.size());
+      for (const Points& x : shapes) bad += testing::CountNonPositive(mesh_.triangles, x);
+    };
+    ComeshReport report;
+    absl::StatusOr<Multimesh> out = OptimizeComesh(mesh_, options, nullptr, nullptr, &report);
+    ASSERT_TRUE(out.ok()) << out.status();
+    EXPECT_EQ(bad, 0) << "non-positive triangles summed over " << iterates << " iterates";
+    EXPECT_EQ(iterates, report.inner);
+    EXPECT_GT(iterates, 0);
+    EXPECT_LE(report.objective_after, report.objective_before);
+    EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
+    // Boundary vertices slid along their drawings' outlines only, past no sharp corner.
+    testing::ExpectBoundaryKept(mesh_, *out, slide_outline ? options.outline_corner_degrees : -1);
+  }
 }
 
 TEST_P(ComeshExamplesTest, EveryTopologyPassLeavesAValidMultimesh) {
-  ComeshOptions options;
-  options.max_outer = 3;
-  options.outer_inner_iterations = 5;
-  options.max_iterations = 10;
-  int passes = 0;
-  options.on_checkpoint = [&](const ComeshCheckpoint& checkpoint) {
-    ++passes;
-    const absl::Status valid = ValidateMultimesh(checkpoint.mesh);
-    EXPECT_TRUE(valid.ok()) << "after pass " << checkpoint.outer << ": " << valid;
-    for (const Points& x : checkpoint.mesh.shapes) {
-      EXPECT_EQ(testing::CountNonPositive(checkpoint.mesh.triangles, x), 0);
+  for (bool slide_outline : {false, true}) {
+    SCOPED_TRACE(slide_outline ? "outline sliding" : "straight-run sliding");
+    ComeshOptions options;
+    options.slide_outline = slide_outline;
+    options.max_outer = 3;
+    options.outer_inner_iterations = 5;
+    options.max_iterations = 10;
+    int passes = 0;
+    options.on_checkpoint = [&](const ComeshCheckpoint& checkpoint) {
+      ++passes;
+      const absl::Status valid = ValidateMultimesh(checkpoint.mesh);
+      EXPECT_TRUE(valid.ok()) << "after pass " << checkpoint.outer << ": " << valid;
+      for (const Points& x : checkpoint.mesh.shapes) {
+        EXPECT_EQ(testing::CountNonPositive(checkpoint.mesh.triangles, x), 0);
+      }
+    };
+    ComeshReport report;
+    absl::StatusOr<Multimesh> out = OptimizeComesh(mesh_, options, nullptr, nullptr, &report);
+    ASSERT_TRUE(out.ok()) << out.status();
+    EXPECT_EQ(passes, report.outer);
+    EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
+    for (const Points& x : out->shapes) {
+      EXPECT_EQ(testing::CountNonPositive(out->triangles, x), 0);
     }
-  };
-  ComeshReport report;
-  absl::StatusOr<Multimesh> out = OptimizeComesh(mesh_, options, nullptr, nullptr, &report);
-  ASSERT_TRUE(out.ok()) << out.status();
-  EXPECT_EQ(passes, report.outer);
-  EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
-  for (const Points& x : out->shapes) EXPECT_EQ(testing::CountNonPositive(out->triangles, x), 0);
-  testing::ExpectBoundaryKept(mesh_, *out, options.outline_corner_degrees);
+    testing::ExpectBoundaryKept(mesh_, *out, slide_outline ? options.outline_corner_degrees : -1);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Examples, ComeshExamplesTest,
