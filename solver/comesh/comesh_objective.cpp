@@ -1,9 +1,12 @@
 // Comesh objective: (1 - w) * normalized ODT (S-eq.1) + w * normalized cyclic MIPS (S-eq.2).
 #include "solver/comesh/comesh_objective.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "solver/comesh/mips_energy.h"
@@ -14,7 +17,8 @@ namespace inbetween::solver {
 
 absl::StatusOr<ComeshObjective> ComeshObjective::Create(const std::vector<Triangle>& triangles,
                                                         const std::vector<Points>& rest,
-                                                        double map_weight, int threads) {
+                                                        double map_weight, int threads,
+                                                        bool area_invariant) {
   if (rest.empty()) return absl::InvalidArgumentError("comesh objective needs at least one shape");
   if (!(map_weight >= 0.0 && map_weight <= 1.0)) {
     return absl::InvalidArgumentError(
@@ -57,6 +61,25 @@ absl::StatusOr<ComeshObjective> ComeshObjective::Create(const std::vector<Triang
     o.odt_normalizer_.push_back(OdtNormalization(triangles, rest[s]));
   }
   o.threads_ = ResolveThreads(threads);
+  o.mesh_scale_ = o.odt_normalizer_;
+  o.map_scale_ = o.areas_;
+  o.area_invariant_ = area_invariant;
+  if (area_invariant) {
+    // Edges used by one triangle, in that triangle's orientation (sorted: deterministic).
+    std::map<std::pair<int, int>, int> uses;
+    for (const Triangle& t : triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const int a = t[k], b = t[(k + 1) % 3];
+        ++uses[{std::min(a, b), std::max(a, b)}];
+      }
+    }
+    for (const Triangle& t : triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const int a = t[k], b = t[(k + 1) % 3];
+        if (uses[{std::min(a, b), std::max(a, b)}] == 1) o.boundary_edges_.push_back({a, b});
+      }
+    }
+  }
   o.corner_begin_.assign(n + 1, 0);
   for (const Triangle& t : triangles) {
     for (int k = 0; k < 3; ++k) ++o.corner_begin_[t[k] + 1];
@@ -87,7 +110,7 @@ double ComeshObjective::TriangleTerm(const Triangle& t, const std::vector<Points
 
 bool ComeshObjective::AccumulateTriangle(const Triangle& tri, const std::vector<Points>& shapes,
                                          double* mesh_sum, double* map_sum,
-                                         Point* corner_gradient) const {
+                                         Point* corner_gradient, double* shape_sums) const {
   const int n = num_shapes();
   const double w = map_weight_;
   Point* cg = corner_gradient;
@@ -105,11 +128,15 @@ bool ComeshObjective::AccumulateTriangle(const Triangle& tri, const std::vector<
     const double c =
         MipsTriangleEnergy(ci, cj, cg != nullptr ? &g_i : nullptr, cg != nullptr ? &g_j : nullptr);
     if (!std::isfinite(d) || !std::isfinite(c)) return false;
-    *mesh_sum += d / odt_normalizer_[i];
-    *map_sum += c / areas_[i];
+    *mesh_sum += d / mesh_scale_[i];
+    *map_sum += c / map_scale_[i];
+    if (shape_sums != nullptr) {
+      shape_sums[i] += d / mesh_scale_[i];
+      shape_sums[n + i] += c / map_scale_[i];
+    }
     if (cg != nullptr) {
-      const double sd = (1.0 - w) / odt_normalizer_[i];
-      const double sc = w / areas_[i];
+      const double sd = (1.0 - w) / mesh_scale_[i];
+      const double sc = w / map_scale_[i];
       for (int k = 0; k < 3; ++k) {
         cg[k * n + i] += sd * g_odt[k] + sc * g_i[k];
         cg[k * n + j] += sc * g_j[k];
@@ -129,15 +156,33 @@ double ComeshObjective::Evaluate(const std::vector<Points>& shapes, std::vector<
   const bool want_gradient = gradient != nullptr;
   if (want_gradient) corner_gradient_.resize(static_cast<size_t>(3) * num_triangles * n);
   const int chunks = NumChunks(num_triangles, kChunk);
+  // Area-invariant mode: the current areas (from the boundary edges) set the normalizers.
+  std::vector<double> area(n, 0.0);
+  if (area_invariant_) {
+    for (int i = 0; i < n; ++i) {
+      const Points& x = shapes[i];
+      for (const auto& [a, b] : boundary_edges_) {
+        area[i] += 0.5 * (x[a].x() * x[b].y() - x[b].x() * x[a].y());
+      }
+      if (!(area[i] > 0.0) || !std::isfinite(area[i])) return kInf;
+      const double r = area[i] / areas_[i];
+      mesh_scale_[i] = odt_normalizer_[i] * r * r;
+      map_scale_[i] = area[i];
+    }
+  }
   // Per chunk: sum of D_t / N_i and of C_t / A_i over its triangles and shapes; NaN if invalid.
+  // Area-invariant mode: also per shape (2 n per chunk, for the gradient's area term).
   std::vector<double> mesh_part(chunks, 0.0), map_part(chunks, 0.0);
+  std::vector<double> shape_part(area_invariant_ ? static_cast<size_t>(chunks) * 2 * n : 0, 0.0);
   ParallelChunks(num_triangles, kChunk, threads_, [&](int chunk, int begin, int end) {
     if (Cancelled(cancel)) return;  // the result is NaN below
     double mesh_sum = 0.0, map_sum = 0.0;
+    double* shape_sums =
+        area_invariant_ ? &shape_part[static_cast<size_t>(chunk) * 2 * n] : nullptr;
     for (int t = begin; t < end; ++t) {
       const Triangle& tri = triangles_[t];
       Point* cg = want_gradient ? &corner_gradient_[static_cast<size_t>(3) * t * n] : nullptr;
-      if (!AccumulateTriangle(tri, shapes, &mesh_sum, &map_sum, cg)) {
+      if (!AccumulateTriangle(tri, shapes, &mesh_sum, &map_sum, cg, shape_sums)) {
         mesh_part[chunk] = map_part[chunk] = kInf;
         return;
       }
@@ -167,6 +212,24 @@ double ComeshObjective::Evaluate(const std::vector<Points>& shapes, std::vector<
         }
       }
     });
+    if (area_invariant_) {
+      // dE/dX_i += -(2 E_i^mesh + E_i^map) / A_i(X) dA_i/dX_i, A_i = 1/2 sum over the boundary
+      // edges (a, b) of cross(x_a, x_b). Serial, in a fixed order.
+      for (int i = 0; i < n; ++i) {
+        double mesh_i = 0.0, map_i = 0.0;
+        for (int c = 0; c < chunks; ++c) {
+          mesh_i += shape_part[static_cast<size_t>(c) * 2 * n + i];
+          map_i += shape_part[static_cast<size_t>(c) * 2 * n + n + i];
+        }
+        const double coef = -(2.0 * (1.0 - w) * mesh_i + w * map_i) / area[i];
+        const Points& x = shapes[i];
+        Points& g = (*gradient)[i];
+        for (const auto& [a, b] : boundary_edges_) {
+          g[a] += 0.5 * coef * Point(x[b].y(), -x[b].x());
+          g[b] += 0.5 * coef * Point(-x[a].y(), x[a].x());
+        }
+      }
+    }
   }
   const double objective = (1.0 - w) * mesh_sum + w * map_sum;
   if (energies != nullptr) {

@@ -155,6 +155,13 @@ class Layout {
         size_ += var.slider ? 1 : 2;
         vars_.push_back(var);
         tangent_.push_back(var.direction);
+        sides_.emplace_back(var.direction, var.direction);
+        if (var.outline >= 0) {
+          const auto sides = outline->Tangents(var.outline, var.u0);
+          if (sides.first.squaredNorm() > 0.5 && sides.second.squaredNorm() > 0.5) {
+            sides_.back() = sides;
+          }
+        }
       }
     }
     outlines_ = num_outline_ > 0 ? outlines : nullptr;
@@ -197,13 +204,27 @@ class Layout {
     return z;
   }
   // The gradient in the unknowns; a slider's is the 2D gradient along its current tangent (see
-  // Track).
-  VectorXd GatherGradient(const std::vector<Points>& gradient) const {
+  // Track). An outline slider at a polyline point, where the path bends, takes the one-sided
+  // derivative of the side along which the objective falls (0 if it rises both ways), and its
+  // tangent (for Displacements) becomes that side's.
+  VectorXd GatherGradient(const std::vector<Points>& gradient) {
     VectorXd g(size_);
     for (size_t i = 0; i < vars_.size(); ++i) {
       const Var& var = vars_[i];
       const Point& p = gradient[var.shape][var.vertex];
-      if (var.slider) {
+      if (var.outline >= 0 && sides_[i].first != sides_[i].second) {
+        const double forward = p.dot(sides_[i].second), back = p.dot(sides_[i].first);
+        if (forward < 0.0) {
+          g[var.offset] = forward;
+          tangent_[i] = sides_[i].second;
+        } else if (back > 0.0) {
+          g[var.offset] = back;
+          tangent_[i] = sides_[i].first;
+        } else {
+          g[var.offset] = 0.0;
+          tangent_[i] = sides_[i].second;
+        }
+      } else if (var.slider) {
         g[var.offset] = p.dot(tangent_[i]);
       } else {
         g.segment<2>(var.offset) = p;
@@ -240,9 +261,13 @@ class Layout {
     for (size_t i = 0; i < vars_.size(); ++i) {
       const Var& var = vars_[i];
       if (var.outline < 0) continue;
-      const Point t = (*outlines_)[var.shape].Tangent(var.outline,
-                                                      std::clamp(z[var.offset], var.lo, var.hi));
+      const double u = std::clamp(z[var.offset], var.lo, var.hi);
+      const Point t = (*outlines_)[var.shape].Tangent(var.outline, u);
       if (t.squaredNorm() > 0.5) tangent_[i] = t;  // (zero only on a zero-length segment)
+      sides_[i] = (*outlines_)[var.shape].Tangents(var.outline, u);
+      if (!(sides_[i].first.squaredNorm() > 0.5 && sides_[i].second.squaredNorm() > 0.5)) {
+        sides_[i] = {tangent_[i], tangent_[i]};
+      }
     }
   }
 
@@ -254,6 +279,9 @@ class Layout {
   bool cancelled_ = false;
   std::vector<Var> vars_;
   std::vector<Point> tangent_;  // per var: a slider's current unit tangent
+  // Per var: an outline slider's tangents just before and after where it is (equal inside a
+  // segment; a straight slider's direction twice).
+  std::vector<std::pair<Point, Point>> sides_;
   const std::vector<ShapeOutline>* outlines_ = nullptr;
   std::vector<std::vector<int>> index_;  // [shape][vertex] -> var or -1
 };
@@ -947,7 +975,8 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   };
   // The set-up's steps each poll the token.
   absl::StatusOr<ComeshObjective> objective =
-      ComeshObjective::Create(mesh->triangles, mesh->shapes, options.map_weight, threads);
+      ComeshObjective::Create(mesh->triangles, mesh->shapes, options.map_weight, threads,
+                              /*area_invariant=*/outlines != nullptr);
   if (!objective.ok()) return objective.status();
   if (Cancelled(cancel)) return cancelled_at(0);
   Layout layout(*mesh, options.slide_boundary, outlines, cancel);
@@ -1177,6 +1206,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
           total * std::max(options.relax_fraction, options.relax_over_mean / vars.size());
       std::vector<std::pair<double, int>> picked;
       for (int i = 0; i < static_cast<int>(vars.size()); ++i) {
+        // With area-invariant normalizers an outline slider's move changes them (the relaxer
+        // holds them fixed): it moves with the global steps only.
+        if (objective->area_invariant() && vars[i].outline >= 0) continue;
         const double part = vars[i].slider ? g_new[vars[i].offset] * g_new[vars[i].offset]
                                            : g_new.segment<2>(vars[i].offset).squaredNorm();
         if (part >= threshold) picked.emplace_back(part, i);
@@ -1216,6 +1248,13 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
           }
         }
         layout.Track(z_new);
+        if (objective->area_invariant()) {
+          // The moves kept every area, but the gradient's area term on the boundary follows
+          // every shape's energy: evaluate afresh.
+          f_new = objective->Evaluate(trial, &trial_grad, &trial_energies, cancel);
+          ++stats->evaluations;
+          if (Cancelled(cancel)) return cancelled_at(iter);
+        }
         g_new = layout.GatherGradient(trial_grad);
         f_new = trial_energies.objective;
       }

@@ -148,6 +148,16 @@ Point ShapeOutline::Tangent(int l, double u) const {
   return n > 1e-12 ? Point(t / n) : here;
 }
 
+std::pair<Point, Point> ShapeOutline::Tangents(int l, double u) const {
+  const Loop& loop = loops_[l];
+  const double w = Wrap(loop, u);
+  const int k = SegmentAt(loop, w);
+  const double eps = 1e-12 * loop.arc.back();
+  if (w - loop.arc[k] <= eps) return {Direction(loop, k - 1), Direction(loop, k)};
+  if (loop.arc[k + 1] - w <= eps) return {Direction(loop, k), Direction(loop, k + 1)};
+  return {Direction(loop, k), Direction(loop, k)};
+}
+
 std::pair<double, double> ShapeOutline::StraightExtent(int l, double u) const {
   const Loop& loop = loops_[l];
   const int m = static_cast<int>(loop.points.size());

@@ -47,6 +47,10 @@ class ShapeOutline {
   // The unit tangent at u; at a polyline point (within 1e-12 of the loop's length) the
   // normalized sum of its two segments' tangents.
   Point Tangent(int loop, double u) const;
+  // The unit tangents of the outline just before and just after u: the same vector inside a
+  // segment, the two segments' directions at a polyline point (within 1e-12 of the loop's
+  // length).
+  std::pair<Point, Point> Tangents(int loop, double u) const;
   // How far a point at u can move backwards and forwards along the straight line of the outline
   // through it (its segment, extended over neighbouring segments in the same direction), as arc
   // lengths >= 0; both 0 at a polyline point where the outline bends.

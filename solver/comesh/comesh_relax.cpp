@@ -41,11 +41,11 @@ double VertexRelaxer::VertexEnergy(const std::vector<Points>& shapes, int s, int
                                    Point* grad) const {
   const int n = static_cast<int>(shapes.size());
   const double w = objective_.map_weight();
-  const double odt_scale = (1.0 - w) / objective_.odt_normalizer(s);
+  const double odt_scale = (1.0 - w) / objective_.mesh_scale(s);
   // MIPS (s -> s + 1), weighted by shape s's rest area, and (s - 1 -> s) by shape s - 1's.
   const int next = (s + 1) % n, prev = (s + n - 1) % n;
-  const double next_scale = w / objective_.rest_area(s);
-  const double prev_scale = w / objective_.rest_area(prev);
+  const double next_scale = w / objective_.map_scale(s);
+  const double prev_scale = w / objective_.map_scale(prev);
   double e = 0.0;
   grad->setZero();
   std::array<Point, 3> g_odt, g_i, g_j;

@@ -50,6 +50,47 @@ TEST(ComeshObjectiveTest, GradientMatchesFiniteDifferences) {
   }
 }
 
+// Area-invariant mode (outline sliding): the normalizers follow the current areas, so the
+// gradient has a term on the boundary vertices; checked away from the rest shapes (areas changed
+// by a boundary distortion and a scaling).
+TEST(ComeshObjectiveTest, AreaInvariantGradientMatchesFiniteDifferences) {
+  const Multimesh m = testing::SquareGrid(4);
+  const Points a = testing::SmoothlyDistorted(m.shapes[0], 0.07);
+  const Points b = testing::TutteHexagon(m);
+  auto bulged = [](Points x, double amount) {  // moves the boundary too: the area changes
+    for (Point& p : x) p += amount * Point(std::sin(3.0 * p.y()), std::cos(2.0 * p.x()));
+    return x;
+  };
+  const std::vector<Points> rest = {a, b};
+  const std::vector<Points> at = {bulged(a, 0.02), testing::Similar(bulged(b, -0.015), 1.3, 0.2,
+                                                                    Point(0.1, 0))};
+  for (double w : {0.0, 0.5, 1.0}) {
+    auto o = ComeshObjective::Create(m.triangles, rest, w, 1, /*area_invariant=*/true);
+    ASSERT_TRUE(o.ok()) << o.status();
+    EXPECT_LT(RelativeGradientError(*o, at), 1e-5) << "w = " << w;
+  }
+}
+
+// Area-invariant mode: scaling a shape changes nothing (the plain objective would drop with the
+// area), and at the rest shapes it equals the plain objective.
+TEST(ComeshObjectiveTest, AreaInvariantIgnoresScaleAndEqualsPlainAtRest) {
+  const Multimesh m = testing::SquareGrid(6);
+  const std::vector<Points> rest = {m.shapes[0], testing::TutteHexagon(m)};
+  auto plain = ComeshObjective::Create(m.triangles, rest, 0.5);
+  auto invariant = ComeshObjective::Create(m.triangles, rest, 0.5, 1, /*area_invariant=*/true);
+  ASSERT_TRUE(plain.ok() && invariant.ok());
+  ComeshEnergies e_plain, e_invariant;
+  EXPECT_NEAR(invariant->Evaluate(rest, nullptr, &e_invariant),
+              plain->Evaluate(rest, nullptr, &e_plain), 1e-12);
+  const std::vector<Points> shrunk = {testing::Similar(rest[0], 0.0, 0.9, Point(0, 0)),
+                                      testing::Similar(rest[1], 0.3, 0.8, Point(2, 0))};
+  ComeshEnergies e_shrunk;
+  EXPECT_NEAR(invariant->Evaluate(shrunk, nullptr, &e_shrunk), e_invariant.objective, 1e-12);
+  EXPECT_NEAR(e_shrunk.map, e_invariant.map, 1e-12);
+  EXPECT_NEAR(e_shrunk.mesh, e_invariant.mesh, 1e-12);
+  EXPECT_LT(plain->Evaluate(shrunk), e_plain.objective - 0.1);  // what outline sliding exploited
+}
+
 TEST(ComeshObjectiveTest, ReportsConformalAndGridEnergies) {
   const Multimesh m = testing::SquareGrid(6);
   const std::vector<Points> shapes = {m.shapes[0],

@@ -587,7 +587,7 @@ TEST(ComeshOptimizerTest, ResumedRunSlidesAlongTheInputOutlines) {
   circle.outlines.push_back({round});
   half.outlines.push_back({arch});
   MultimeshOptions build;
-  build.boundary_vertices = 48;
+  build.boundary_vertices = 80;
   ExpectResumedRunEqualsUninterrupted(BuildMultimesh({circle, half}, build),
                                       /*slide_outline=*/true);
 }
