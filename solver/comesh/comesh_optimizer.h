@@ -64,7 +64,10 @@
 // where it is (updated after every step); it passes the polyline's soft corners (turns up to
 // outline_corner_degrees) and stops at the hard ones, at cohesive vertices and at marks. Every
 // boundary vertex thus stays on its input outline; the outline of a shape changes only by chords
-// across soft corners that a vertex has left. The line search's inversion bound follows the
+// across soft corners that a vertex has left (the objective, area-invariant then, neither rewards
+// nor penalizes the area that changes). At a polyline point, where the path bends, the gradient
+// is the one-sided derivative of the side along which the objective falls. The line search's
+// inversion bound follows the
 // tangent (first order across a soft corner); the trial's own evaluation, infinite for any
 // non-positive triangle, keeps every accepted iterate valid.
 // Fixed: boundary corners, every vertex of a cohesive edge, correspondence marks
@@ -127,13 +130,13 @@ struct ComeshOptions {
   // With slide_boundary: the other boundary vertices (the corners of their own polyline, as on
   // every curved outline) slide by arc length along their shape's input outline, across its soft
   // corners, stopping at turns above outline_corner_degrees and at cohesive vertices and marks
-  // (comesh_outline.h; see "Unknowns" above). Off by default: the objective's normalizers are
-  // frozen at each inner run's start, so a vertex that cuts a convex soft corner lowers it by
-  // shrinking the shape (measured: areas -0.02% to -1.2% on the examples, and a worse final
-  // objective on three of them, docs/benchmarks.md); on curved pairs whose initial boundary
-  // correspondence is poor it lowers the map energy far (bird 4.18 -> 2.92).
-  // TODO(issue 5): normalize by the current areas so that cutting corners gains nothing, then
-  // turn it on by default.
+  // (comesh_outline.h; see "Unknowns" above). The objective is then area-invariant (its
+  // normalizers follow the current areas, comesh_objective.h), so cutting a soft corner to
+  // shrink a shape gains nothing. Off by default: on curved pairs whose initial boundary
+  // correspondence is poor it lowers the map energy far (bird 4.18 -> 3.02), but on shapes whose
+  // maps are already conformal the extra freedom can lead the greedy topology passes to a
+  // slightly higher final objective (6 of 27 cases, docs/benchmarks.md).
+  // TODO(issue 5): on by default once it never ends worse.
   bool slide_outline = false;
   double outline_corner_degrees = 25.0;
   // Local relaxation (comesh_relax.h): after each accepted step shorter than the unit step (one
