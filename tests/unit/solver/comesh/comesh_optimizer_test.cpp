@@ -567,13 +567,9 @@ void ExpectResumedRunEqualsUninterrupted(const absl::StatusOr<Multimesh>& m,
   }
 }
 
-TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun) {
-  ExpectResumedRunEqualsUninterrupted(BuiltSquareToHexagon(160));
-}
-
-// The same with curved outlines: the resumed run slides the boundary along the input's outlines
-// (not the checkpoint's boundary, whose vertices have already left some polyline points).
-TEST(ComeshOptimizerTest, ResumedRunSlidesAlongTheInputOutlines) {
+// A curved pair built by BuildMultimesh: a circle (96 points) -> a half-disk (a 33-point arc and
+// its diameter: two 90-degree corners).
+absl::StatusOr<Multimesh> CircleToHalfDisk(int boundary_vertices) {
   Drawing circle, half;
   Points round, arch;
   for (int k = 0; k < 96; ++k) {
@@ -587,9 +583,18 @@ TEST(ComeshOptimizerTest, ResumedRunSlidesAlongTheInputOutlines) {
   circle.outlines.push_back({round});
   half.outlines.push_back({arch});
   MultimeshOptions build;
-  build.boundary_vertices = 80;
-  ExpectResumedRunEqualsUninterrupted(BuildMultimesh({circle, half}, build),
-                                      /*slide_outline=*/true);
+  build.boundary_vertices = boundary_vertices;
+  return BuildMultimesh({circle, half}, build);
+}
+
+TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun) {
+  ExpectResumedRunEqualsUninterrupted(BuiltSquareToHexagon(160));
+}
+
+// The same with curved outlines: the resumed run slides the boundary along the input's outlines
+// (not the checkpoint's boundary, whose vertices have already left some polyline points).
+TEST(ComeshOptimizerTest, ResumedRunSlidesAlongTheInputOutlines) {
+  ExpectResumedRunEqualsUninterrupted(CircleToHalfDisk(80), /*slide_outline=*/true);
 }
 
 TEST(ComeshOptimizerTest, RejectsAnInvalidCheckpoint) {
@@ -604,26 +609,12 @@ TEST(ComeshOptimizerTest, RejectsAnInvalidCheckpoint) {
 }
 
 // Curved outlines: every boundary vertex of a circle -> half-disk multimesh is a corner of its
-// own polyline, so only outline sliding (ComeshOptions::slide_outline, off by default) lets the boundary
-// correspondence move. With it the map energy falls far lower; every boundary vertex stays on
+// own polyline, so only outline sliding (ComeshOptions::slide_outline, off by default) lets the
+// boundary correspondence move. With it the map energy falls far lower; every boundary vertex stays on
 // its shape's input outline; the half-disk's two drawn corners (90 degrees) keep a vertex exactly
 // where they were. Without it the boundary is the input's point set, corners in place.
 TEST(ComeshOptimizerTest, CurvedOutlinesSlideAlongTheirPolylines) {
-  Drawing circle, half;
-  Points round, arch;
-  for (int k = 0; k < 96; ++k) {
-    const double t = 2.0 * std::numbers::pi * k / 96.0;
-    round.push_back(Point(0.5 + 0.5 * std::cos(t), 0.5 + 0.5 * std::sin(t)));
-  }
-  for (int k = 0; k <= 32; ++k) {
-    const double t = std::numbers::pi * k / 32.0;
-    arch.push_back(Point(0.5 + 0.5 * std::cos(t), 0.3 + 0.5 * std::sin(t)));
-  }
-  circle.outlines.push_back({round});
-  half.outlines.push_back({arch});
-  MultimeshOptions build;
-  build.boundary_vertices = 48;
-  absl::StatusOr<Multimesh> m = BuildMultimesh({circle, half}, build);
+  absl::StatusOr<Multimesh> m = CircleToHalfDisk(48);
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
   options.slide_outline = true;
