@@ -156,12 +156,7 @@ class Layout {
         vars_.push_back(var);
         tangent_.push_back(var.direction);
         sides_.emplace_back(var.direction, var.direction);
-        if (var.outline >= 0) {
-          const auto sides = outline->Tangents(var.outline, var.u0);
-          if (sides.first.squaredNorm() > 0.5 && sides.second.squaredNorm() > 0.5) {
-            sides_.back() = sides;
-          }
-        }
+        if (var.outline >= 0) UpdateTangents(*outline, vars_.size() - 1, var.u0);
       }
     }
     outlines_ = num_outline_ > 0 ? outlines : nullptr;
@@ -185,7 +180,6 @@ class Layout {
   int num_shapes() const { return num_shapes_; }
   int num_vertices() const { return num_vertices_; }
   int num_outline_sliders() const { return num_outline_; }
-  const Point& tangent(int i) const { return tangent_[i]; }
   const std::vector<Var>& vars() const { return vars_; }
   int index(int shape, int v) const { return index_[shape][v]; }
 
@@ -261,17 +255,22 @@ class Layout {
     for (size_t i = 0; i < vars_.size(); ++i) {
       const Var& var = vars_[i];
       if (var.outline < 0) continue;
-      const double u = std::clamp(z[var.offset], var.lo, var.hi);
-      const Point t = (*outlines_)[var.shape].Tangent(var.outline, u);
-      if (t.squaredNorm() > 0.5) tangent_[i] = t;  // (zero only on a zero-length segment)
-      sides_[i] = (*outlines_)[var.shape].Tangents(var.outline, u);
-      if (!(sides_[i].first.squaredNorm() > 0.5 && sides_[i].second.squaredNorm() > 0.5)) {
-        sides_[i] = {tangent_[i], tangent_[i]};
-      }
+      UpdateTangents((*outlines_)[var.shape], i, std::clamp(z[var.offset], var.lo, var.hi));
     }
   }
 
  private:
+  // Outline slider i's tangent and sides at arc length u of its loop of `outline`.
+  void UpdateTangents(const ShapeOutline& outline, size_t i, double u) {
+    const int loop = vars_[i].outline;
+    const Point t = outline.Tangent(loop, u);
+    if (t.squaredNorm() > 0.5) tangent_[i] = t;  // (zero only on a zero-length segment)
+    sides_[i] = outline.Tangents(loop, u);
+    if (!(sides_[i].first.squaredNorm() > 0.5 && sides_[i].second.squaredNorm() > 0.5)) {
+      sides_[i] = {tangent_[i], tangent_[i]};
+    }
+  }
+
   int num_shapes_ = 0;
   int num_vertices_ = 0;
   int size_ = 0;
@@ -1206,9 +1205,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
           total * std::max(options.relax_fraction, options.relax_over_mean / vars.size());
       std::vector<std::pair<double, int>> picked;
       for (int i = 0; i < static_cast<int>(vars.size()); ++i) {
-        // With area-invariant normalizers an outline slider's move changes them (the relaxer
-        // holds them fixed): it moves with the global steps only.
-        if (objective->area_invariant() && vars[i].outline >= 0) continue;
+        // An outline slider's move changes the areas the (area-invariant) normalizers follow,
+        // which the relaxer holds fixed: it moves with the global steps only.
+        if (vars[i].outline >= 0) continue;
         const double part = vars[i].slider ? g_new[vars[i].offset] * g_new[vars[i].offset]
                                            : g_new.segment<2>(vars[i].offset).squaredNorm();
         if (part >= threshold) picked.emplace_back(part, i);
@@ -1218,36 +1217,21 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       });
       picked.resize(std::min<size_t>(picked.size(), std::max(0, options.relax_max_vertices)));
       std::vector<RelaxTarget> targets;
-      std::vector<Point> before;  // the picked vertices' positions
       for (const auto& [part, i] : picked) {
-        const Layout::Var& var = vars[i];
-        RelaxTarget target{var.shape, var.vertex, var.slider, layout.tangent(i)};
-        if (var.outline >= 0) {
-          // Along the straight piece of the outline it is on (nowhere if at a bend).
-          const double u = std::clamp(z_new[var.offset], var.lo, var.hi);
-          const auto [back, forward] = outlines->at(var.shape).StraightExtent(var.outline, u);
-          target.lo = -std::min(back, u - var.lo);
-          target.hi = std::min(forward, var.hi - u);
-        }
-        targets.push_back(target);
-        before.push_back(trial[var.shape][var.vertex]);
+        targets.push_back({vars[i].shape, vars[i].vertex, vars[i].slider, vars[i].direction});
       }
       if (relaxer->Relax(targets, options.relax_steps, &trial, &trial_grad, &trial_energies) > 0) {
         if (Cancelled(cancel)) return cancelled_at(iter);
         // Only the picked vertices moved (a full Gather would re-round every slider's unknown).
-        for (size_t k = 0; k < picked.size(); ++k) {
-          const int i = picked[k].second;
+        for (const auto& [part, i] : picked) {
           const Layout::Var& var = vars[i];
           const Point& x = trial[var.shape][var.vertex];
-          if (var.outline >= 0) {
-            z_new[var.offset] += (x - before[k]).dot(layout.tangent(i));
-          } else if (var.slider) {
+          if (var.slider) {
             z_new[var.offset] = (x - var.base).dot(var.direction);
           } else {
             z_new.segment<2>(var.offset) = x;
           }
         }
-        layout.Track(z_new);
         if (objective->area_invariant()) {
           // The moves kept every area, but the gradient's area term on the boundary follows
           // every shape's energy: evaluate afresh.

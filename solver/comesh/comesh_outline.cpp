@@ -158,26 +158,6 @@ std::pair<Point, Point> ShapeOutline::Tangents(int l, double u) const {
   return {Direction(loop, k), Direction(loop, k)};
 }
 
-std::pair<double, double> ShapeOutline::StraightExtent(int l, double u) const {
-  const Loop& loop = loops_[l];
-  const int m = static_cast<int>(loop.points.size());
-  const double w = Wrap(loop, u), eps = 1e-12 * loop.arc.back();
-  auto direction = [&](int j) { return Direction(loop, j); };
-  auto length = [&](int j) {
-    j = (j % m + m) % m;
-    return loop.arc[j + 1] - loop.arc[j];
-  };
-  int k = SegmentAt(loop, w);
-  double back = w - loop.arc[k], forward = loop.arc[k + 1] - w;
-  // At a polyline point: the segment it starts (k) and the one it ends (k - 1) must be collinear.
-  if (back <= eps && direction(k - 1).dot(direction(k)) < 1.0 - 1e-12) return {0.0, 0.0};
-  if (forward <= eps && direction(k).dot(direction(k + 1)) < 1.0 - 1e-12) return {0.0, 0.0};
-  const Point t = direction(k);
-  for (int j = k + 1; j < k + m && direction(j).dot(t) >= 1.0 - 1e-12; ++j) forward += length(j);
-  for (int j = k - 1; j > k - m && direction(j).dot(t) >= 1.0 - 1e-12; --j) back += length(j);
-  return {back, forward};
-}
-
 bool ShapeOutline::AtHardPoint(int l, double u, double tolerance) const {
   const Loop& loop = loops_[l];
   const double w = Wrap(loop, u), length = loop.arc.back();

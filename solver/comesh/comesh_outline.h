@@ -51,10 +51,6 @@ class ShapeOutline {
   // segment, the two segments' directions at a polyline point (within 1e-12 of the loop's
   // length).
   std::pair<Point, Point> Tangents(int loop, double u) const;
-  // How far a point at u can move backwards and forwards along the straight line of the outline
-  // through it (its segment, extended over neighbouring segments in the same direction), as arc
-  // lengths >= 0; both 0 at a polyline point where the outline bends.
-  std::pair<double, double> StraightExtent(int loop, double u) const;
   // True if u is within `tolerance` (arc length) of a hard point.
   bool AtHardPoint(int loop, double u, double tolerance) const;
   // The stretch of the loop around u between its hard points: (lo, hi) with lo <= u <= hi in u's

@@ -84,7 +84,6 @@ bool VertexRelaxer::RelaxOne(const RelaxTarget& target, int steps,
   const std::vector<Triangle>& triangles = objective_.triangles();
   Point& x = (*shapes)[s][v];
   bool moved = false;
-  double along = 0.0;  // a slider's displacement along its direction so far
   for (int it = 0; it < steps; ++it) {
     Point g;
     const double e0 = VertexEnergy(*shapes, s, v, x, &g);
@@ -135,9 +134,6 @@ bool VertexRelaxer::RelaxOne(const RelaxTarget& target, int steps,
       if (c1 < 0.0) t_max = std::min(t_max, -Cross(a - x, b - x) / c1);
     }
     double step = std::min(1.0, 0.8 * t_max);
-    const double rate = target.slider ? d.dot(target.direction) : 0.0;
-    if (rate > 0.0) step = std::min(step, (target.hi - along) / rate);
-    if (rate < 0.0) step = std::min(step, (target.lo - along) / rate);
     bool accepted = false;
     for (int tries = 0; tries < 20 && !accepted; ++tries) {
       Point unused;
@@ -147,7 +143,6 @@ bool VertexRelaxer::RelaxOne(const RelaxTarget& target, int steps,
     }
     if (!accepted) return moved;
     x += step * d;
-    along += step * rate;
     moved = true;
   }
   return moved;

@@ -16,7 +16,6 @@
 // given order, each seeing the moves before it; results do not depend on threads.
 #pragma once
 
-#include <limits>
 #include <span>
 #include <vector>
 
@@ -30,9 +29,6 @@ struct RelaxTarget {
   int vertex = 0;
   bool slider = false;              // moves along `direction` only
   Point direction = Point::Zero();  // unit, sliders only
-  // Sliders: the total displacement along `direction` stays within [lo, hi] (lo <= 0 <= hi).
-  double lo = -std::numeric_limits<double>::infinity();
-  double hi = std::numeric_limits<double>::infinity();
 };
 
 class VertexRelaxer {

@@ -382,8 +382,9 @@ class Editor {
   }
 
   // Inserts a new vertex at the midpoint of edge (a, b) in every shape: an interior edge, or a
-  // boundary edge between two vertices that are not fixed (not cohesive, not a mark), whose
-  // midpoint then lies on the boundary's straight segment in every shape (a slider).
+  // boundary edge between two vertices that are not fixed (not cohesive, not a mark); with the
+  // optimizer's outlines a boundary edge's new vertex is on the outline instead
+  // (ShapeOutline::SplitPoint: the midpoint on a straight stretch, the arc's middle otherwise).
   bool TrySplit(int a, int b) {
     if (locked_[a] || locked_[b]) return false;
     int t1 = -1, t2 = -1;

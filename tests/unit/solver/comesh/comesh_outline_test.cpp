@@ -135,24 +135,6 @@ TEST(ShapeOutlineTest, SplitPointsStayOnTheOutline) {
   EXPECT_FALSE(soft.SplitPoint(Point(1.5, 0.1), Point(2, 0.5), 1e-9).has_value());
 }
 
-TEST(ShapeOutlineTest, StraightExtentRunsOverCollinearPointsAndStopsAtBends) {
-  const ShapeOutline square(Loops({SquareWithMidpoints()}), 0, 25.0, {});
-  // Inside the bottom side: back to the corner (0, 0), on over the midpoint (1, 0) to (2, 0).
-  EXPECT_EQ(square.StraightExtent(0, 0.25), std::make_pair(0.25, 1.75));
-  // At the midpoint (turn 0): the whole side.
-  EXPECT_EQ(square.StraightExtent(0, 1.0), std::make_pair(1.0, 1.0));
-  // At a corner (a bend): nowhere.
-  EXPECT_EQ(square.StraightExtent(0, 2.0), std::make_pair(0.0, 0.0));
-  // The left side, reached across the loop's start.
-  EXPECT_EQ(square.StraightExtent(0, -0.5), std::make_pair(1.5, 0.5));
-  Points bent = {Point(0, 0), Point(1, 0), Point(2, 0.1), Point(1, 1)};
-  const ShapeOutline soft(Loops({bent}), 0, 25.0, {});
-  const auto [back, forward] = soft.StraightExtent(0, 0.5);
-  EXPECT_DOUBLE_EQ(back, 0.5);
-  EXPECT_DOUBLE_EQ(forward, 0.5);  // (1, 0) bends by 5.7 degrees: a soft point, still a stop
-  EXPECT_EQ(soft.StraightExtent(0, 1.0), std::make_pair(0.0, 0.0));
-}
-
 TEST(ShapeOutlineTest, LocatesTheRightLoopOfSeveral) {
   Points hole = {Point(0.5, 0.5), Point(0.5, 1.5), Point(1.5, 1.5), Point(1.5, 0.5)};  // clockwise
   const ShapeOutline outline(Loops({SquareWithMidpoints(), hole}), 0, 25.0, {});

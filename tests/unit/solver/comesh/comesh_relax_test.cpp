@@ -139,33 +139,6 @@ TEST(VertexRelaxerTest, RelaxLowersTheObjectiveAndTracksGradientAndEnergies) {
   }
 }
 
-// A slider's bounds (an outline slider's straight piece): the same slider as above, first free
-// to find how far it goes, then bounded to a third of that and to nothing on that side.
-TEST(VertexRelaxerTest, SliderStaysWithinItsBounds) {
-  const int k = 8;
-  Multimesh m = Shapes(k, 2);
-  m.shapes[0] = testing::SmoothlyDistorted(m.shapes[0], 0.06);
-  const ComeshObjective objective = MakeObjective(m);
-  const VertexRelaxer relaxer(objective);
-  const Point start = m.shapes[0][k / 2];
-  RelaxTarget target{0, k / 2, true, Point(1.0, 0.0)};
-  std::vector<Points> free = m.shapes;
-  ASSERT_EQ(relaxer.Relax({&target, 1}, 3, &free), 1);
-  const double travel = free[0][k / 2].x() - start.x();
-  ASSERT_GT(std::abs(travel), 1e-6);
-  // A third of the way: it stops at the bound, on its line.
-  (travel > 0 ? target.hi : target.lo) = travel / 3.0;
-  std::vector<Points> bounded = m.shapes;
-  ASSERT_EQ(relaxer.Relax({&target, 1}, 3, &bounded), 1);
-  EXPECT_EQ(bounded[0][k / 2].y(), start.y());
-  EXPECT_NEAR(bounded[0][k / 2].x() - start.x(), travel / 3.0, 1e-14);
-  // No room on that side: it does not move.
-  (travel > 0 ? target.hi : target.lo) = 0.0;
-  std::vector<Points> blocked = m.shapes;
-  EXPECT_EQ(relaxer.Relax({&target, 1}, 3, &blocked), 0);
-  EXPECT_EQ(blocked[0][k / 2], start);
-}
-
 TEST(VertexRelaxerTest, NoTargetsOrNoStepsChangeNothing) {
   const Multimesh m = Shapes(6, 2);
   const ComeshObjective objective = MakeObjective(m);
