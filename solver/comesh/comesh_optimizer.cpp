@@ -12,6 +12,7 @@
 #include <deque>
 #include <limits>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <span>
 #include <string>
@@ -384,9 +385,11 @@ class InitialHessian {
       }
     }
     if (h.size_ == 0) return h;
+    h.FindFloating(triangles);
     h.matrix_.resize(h.size_, h.size_);
     h.matrix_.setFromTriplets(trip.begin(), trip.end());
-    // A component touching no Dirichlet vertex would make L singular: regularize slightly.
+    // A floating component makes L singular: regularized slightly for the factorization, and
+    // ApplyInverse keeps the constant out of its right-hand sides and solutions.
     for (int k = 0; k < h.size_; ++k) h.matrix_.coeffRef(k, k) *= 1.0 + 1e-8;
     h.matrix_.makeCompressed();
     h.solver_ = std::make_unique<SparseCholesky>();
@@ -424,8 +427,10 @@ class InitialHessian {
       rhs(c, 2 * var.shape) = lifted.x();
       rhs(c, 2 * var.shape + 1) = lifted.y();
     }
+    RemoveFloatingMeans(&rhs);
     // Fails only when cancelled, after a successful factorization.
     if (size_ > 0 && !solver_->SolveInPlace(&rhs, 1, cancel).ok()) return VectorXd();
+    RemoveFloatingMeans(&rhs);
     for (const Layout::Var& var : layout.vars()) {
       const int c = compact_[var.vertex];
       if (c < 0) continue;
@@ -479,12 +484,66 @@ class InitialHessian {
   }
 
  private:
+  // The components of L's graph (compact vertices joined by mesh edges) with no edge to a
+  // Dirichlet vertex: every vertex there moves in every shape (outline sliding round a whole
+  // loop, past soft corners only), so L is singular on them, its null vector the component's
+  // constant (a translation, which its closed loop of sliders cannot follow). Their rows in
+  // floating_rows_, one run per component (floating_begin_).
+  void FindFloating(const std::vector<Triangle>& triangles) {
+    std::vector<int> parent(size_);
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&](int a) {
+      while (parent[a] != a) a = parent[a] = parent[parent[a]];
+      return a;
+    };
+    std::vector<char> anchored(size_, 0);
+    for (const Triangle& t : triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const int ca = compact_[t[k]], cb = compact_[t[(k + 1) % 3]];
+        if (ca >= 0 && cb >= 0) {
+          parent[find(ca)] = find(cb);
+        } else if (ca >= 0 || cb >= 0) {
+          anchored[ca >= 0 ? ca : cb] = 1;
+        }
+      }
+    }
+    std::vector<char> root_anchored(size_, 0);
+    for (int k = 0; k < size_; ++k) {
+      if (anchored[k]) root_anchored[find(k)] = 1;
+    }
+    std::vector<std::vector<int>> rows(size_);
+    for (int k = 0; k < size_; ++k) {
+      if (!root_anchored[find(k)]) rows[find(k)].push_back(k);
+    }
+    floating_begin_ = {0};
+    for (const std::vector<int>& component : rows) {
+      if (component.empty()) continue;
+      floating_rows_.insert(floating_rows_.end(), component.begin(), component.end());
+      floating_begin_.push_back(static_cast<int>(floating_rows_.size()));
+    }
+  }
+  // Projects every column of `m` (rows = L's) onto the complement of the floating components'
+  // constants: L's pseudo-inverse there instead of the regularized inverse, whose constant part
+  // (~1e8 times the rest) would swamp the direction.
+  void RemoveFloatingMeans(Eigen::MatrixXd* m) const {
+    for (size_t c = 0; c + 1 < floating_begin_.size(); ++c) {
+      const int begin = floating_begin_[c], end = floating_begin_[c + 1];
+      for (int col = 0; col < m->cols(); ++col) {
+        double mean = 0.0;
+        for (int i = begin; i < end; ++i) mean += (*m)(floating_rows_[i], col);
+        mean /= end - begin;
+        for (int i = begin; i < end; ++i) (*m)(floating_rows_[i], col) -= mean;
+      }
+    }
+  }
+
   std::vector<double> areas_;
   bool use_laplacian_ = true;
   const Layout* layout_ = nullptr;
   int size_ = 0;
   std::vector<int> compact_;    // vertex -> row of L, or -1
   std::vector<double> degree_;  // L's diagonal over all vertices (Jacobi fallback)
+  std::vector<int> floating_rows_, floating_begin_;  // see FindFloating
   Eigen::SparseMatrix<double> matrix_;
   std::unique_ptr<SparseCholesky> solver_;  // by pointer: keeps InitialHessian movable
 };
