@@ -20,6 +20,7 @@ constexpr absl::string_view kMagic = "INBSNAP1";
 constexpr absl::string_view kEnd = "INBSEND1";
 constexpr absl::string_view kCheckpoint = "INBCKPT1";
 constexpr absl::string_view kCheckpointEnd = "INBCKEND";
+constexpr absl::string_view kCheckpointStage = "INBCKST1";
 
 void PutU32(std::string& out, uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
@@ -146,6 +147,10 @@ void EncodeCheckpoint(const StoredComeshCheckpoint& stored, std::string& out) {
   PutU32(out, static_cast<uint32_t>(c.objective_trace.size()));
   for (double f : c.objective_trace) PutF64(out, f);
   out.append(kCheckpointEnd.data(), kCheckpointEnd.size());
+  if (c.stage != 0) {  // a later section: older servers skip it (and resume in stage 0)
+    out.append(kCheckpointStage.data(), kCheckpointStage.size());
+    PutU32(out, static_cast<uint32_t>(c.stage));
+  }
 }
 
 // The checkpoint section after the end marker (the reader is just past "INBCKPT1").
@@ -194,6 +199,12 @@ absl::StatusOr<StoredComeshCheckpoint> DecodeCheckpoint(Reader& reader, absl::st
     c.objective_trace.push_back(*f);
   }
   if (absl::Status s = reader.Expect(kCheckpointEnd); !s.ok()) return s;
+  if (reader.Consume(kCheckpointStage)) {
+    absl::StatusOr<int> stage = reader.Int();
+    if (!stage.ok()) return stage.status();
+    if (*stage > 1) return reader.Error("bad checkpoint stage");
+    c.stage = *stage;
+  }
   return stored;
 }
 

@@ -9,7 +9,8 @@
 //   "INBCKPT1"  u64 input_version  u64 stored_version  u32 len + ComeshParameters
 //   u32 len + Multimesh (proto)  loops and closed cohesive edges as above  u32 outer, inner,
 //   energy_evaluations, flips, collapses, splits  f64 pass_start_objective  u32 n + n x f64 trace
-//   "INBCKEND"
+//   "INBCKEND"  and, for a checkpoint of the outline-sliding stage (stage != 0 only):
+//   "INBCKST1"  u32 stage
 // (f64: the IEEE-754 bits as a little-endian u64, so the checkpoint comes back bit for bit.)
 // Other bytes after "INBSEND1" are skipped (a later version's sections).
 // The head (owner and summary) can be read without the rest, for listing at start-up.

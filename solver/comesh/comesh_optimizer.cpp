@@ -122,7 +122,9 @@ class Layout {
     index_.assign(num_shapes_, std::vector<int>(n, -1));
     for (int s = 0; s < num_shapes_; ++s) {
       const Points& x = mesh.shapes[s];
-      const ShapeOutline* outline = outlines != nullptr ? &(*outlines)[s] : nullptr;
+      // A shape without soft corners keeps the straight sliders (ShapeOutline::curved).
+      const ShapeOutline* outline =
+          outlines != nullptr && (*outlines)[s].curved() ? &(*outlines)[s] : nullptr;
       const double tolerance = outline != nullptr ? outline->tolerance() : 0.0;
       for (int v = 0; v < n; ++v) {
         if (!used[v] || pinned[v]) continue;
@@ -1354,6 +1356,10 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     if (resume->outer < 0 || resume->inner < 0) {
       return absl::InvalidArgumentError("comesh checkpoint: negative pass or iteration count");
     }
+    if (resume->stage != 0 && resume->stage != 1) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("comesh checkpoint: stage ", resume->stage, " (0 or 1)"));
+    }
   }
   if (options.max_iterations < 0 || options.history < 0 || !(options.max_step_fraction > 0.0) ||
       !(options.max_step_fraction < 1.0) || options.max_outer < 0 ||
@@ -1405,79 +1411,102 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       for (int v : c) fixed[v] = 1;
     }
     for (int v : mesh.pinned) fixed[v] = 1;
+    bool curved = false;
     for (int s = 0; s < mesh.num_shapes(); ++s) {
       outlines.emplace_back(mesh, s, options.outline_corner_degrees, fixed);
+      curved |= outlines.back().curved();
     }
+    // Polygons only (no soft corner anywhere): the straight sliders do all outline sliding would,
+    // and the run is the one without it, bit for bit.
+    if (!curved) outlines.clear();
   }
   SharedFactors factors;
-  auto inner = [&](int max_iterations) {
-    ComeshOptions run = options;
-    run.max_iterations = max_iterations;
-    absl::Status st =
-        InnerLoop(&current, run, threads, outlines.empty() ? nullptr : &outlines, cancel, progress,
-                  stats.iterations, &stats, &factors);
-    if (st.ok()) rep.objective_trace.push_back(stats.objective);
-    return st;
-  };
-  // Topology passes, each after a short inner run (positions only need to be roughly relaxed for
-  // the operations' decisions), then one inner run to convergence on the final topology.
-  for (int outer = first_outer; outer < options.max_outer; ++outer) {
-    if (absl::Status st = inner(std::min(options.max_iterations, options.outer_inner_iterations));
-        !st.ok()) {
+  // Stage 0 is the run without outline sliding, to convergence; stage 1 (curved outlines with
+  // slide_outline only) continues from its result with the boundary sliding along the outlines:
+  // short runs and topology passes again, then a final run. Every step of stage 1 lowers the
+  // objective or keeps it, so outline sliding never ends above the run without it (a run that
+  // slid from the start took other topology passes and ended up to 0.17% higher on some
+  // examples: docs/benchmarks.md, twentieth session).
+  const int last_stage = outlines.empty() ? 0 : 1;
+  int stage = resume != nullptr ? std::min(resume->stage, last_stage) : 0;
+  for (; stage <= last_stage; ++stage) {
+    const std::vector<ShapeOutline>* stage_outlines = stage == 1 ? &outlines : nullptr;
+    auto inner = [&](int max_iterations) {
+      ComeshOptions run = options;
+      run.max_iterations = max_iterations;
+      absl::Status st = InnerLoop(&current, run, threads, stage_outlines, cancel, progress,
+                                  stats.iterations, &stats, &factors);
+      if (st.ok()) rep.objective_trace.push_back(stats.objective);
       return st;
+    };
+    if (stage == 1 && !(resume != nullptr && resume->stage == 1)) {
+      // The first short run is judged against stage 0's result, like a pass's run against the
+      // pass before.
+      first_outer = rep.outer;
+      pass_start_objective = stats.objective;
+      if (progress) progress("comesh", 1.0, "outline sliding");
     }
-    if (outer > 0 && pass_start_objective - stats.objective <=
-                         options.outer_tolerance * std::abs(stats.objective)) {
-      break;
+    // Topology passes, each after a short inner run (positions only need to be roughly relaxed
+    // for the operations' decisions), then one inner run to convergence on the final topology.
+    for (int outer = first_outer; outer < options.max_outer; ++outer) {
+      if (absl::Status st = inner(std::min(options.max_iterations, options.outer_inner_iterations));
+          !st.ok()) {
+        return st;
+      }
+      if ((outer > 0 || stage > 0) && pass_start_objective - stats.objective <=
+                                          options.outer_tolerance * std::abs(stats.objective)) {
+        break;
+      }
+      pass_start_objective = stats.objective;
+      if (Cancelled(cancel)) {
+        return absl::CancelledError(absl::StrCat("comesh optimization cancelled at outer ", outer));
+      }
+      TopologyReport topo;
+      Stopwatch topology_clock;
+      absl::StatusOr<Multimesh> improved = ImproveTopology(
+          current, options.map_weight, options.topology, &topo, cancel, stage_outlines);
+      stats.phases.topology += topology_clock.Lap();
+      if (absl::IsCancelled(improved.status())) {
+        return absl::CancelledError(absl::StrCat("comesh optimization cancelled at outer ", outer));
+      }
+      if (!improved.ok()) return improved.status();
+      if (topo.flips + topo.collapses + topo.splits == 0) break;
+      rep.flips += topo.flips;
+      rep.collapses += topo.collapses;
+      rep.splits += topo.splits;
+      ++rep.outer;
+      current = *std::move(improved);
+      rep.objective_trace.push_back(topo.objective_after);
+      // The pass itself (not the short run after it) gained little: the topology has settled,
+      // and further passes would only interleave restarts with the inner run (on large meshes
+      // the short runs keep gaining, so the pass + run test alone keeps the loop going far too
+      // long).
+      const bool settled = topo.objective_before - topo.objective_after <=
+                           options.outer_tolerance * std::abs(topo.objective_after);
+      if (progress) {
+        progress(
+            "comesh", 1.0,
+            absl::StrFormat("outer %d: %d flips, %d collapses (%d corner swaps), %d splits, "
+                            "vertices %d",
+                            rep.outer, topo.flips, topo.collapses, topo.corner_swaps, topo.splits,
+                            current.num_vertices()));
+      }
+      if (options.on_checkpoint) {
+        options.on_checkpoint(ComeshCheckpoint{.mesh = current,
+                                               .outer = rep.outer,
+                                               .inner = stats.iterations,
+                                               .energy_evaluations = stats.evaluations,
+                                               .flips = rep.flips,
+                                               .collapses = rep.collapses,
+                                               .splits = rep.splits,
+                                               .pass_start_objective = pass_start_objective,
+                                               .objective_trace = rep.objective_trace,
+                                               .stage = stage});
+      }
+      if (settled) break;
     }
-    pass_start_objective = stats.objective;
-    if (Cancelled(cancel)) {
-      return absl::CancelledError(absl::StrCat("comesh optimization cancelled at outer ", outer));
-    }
-    TopologyReport topo;
-    Stopwatch topology_clock;
-    absl::StatusOr<Multimesh> improved =
-        ImproveTopology(current, options.map_weight, options.topology, &topo, cancel,
-                        outlines.empty() ? nullptr : &outlines);
-    stats.phases.topology += topology_clock.Lap();
-    if (absl::IsCancelled(improved.status())) {
-      return absl::CancelledError(absl::StrCat("comesh optimization cancelled at outer ", outer));
-    }
-    if (!improved.ok()) return improved.status();
-    if (topo.flips + topo.collapses + topo.splits == 0) break;
-    rep.flips += topo.flips;
-    rep.collapses += topo.collapses;
-    rep.splits += topo.splits;
-    ++rep.outer;
-    current = *std::move(improved);
-    rep.objective_trace.push_back(topo.objective_after);
-    // The pass itself (not the short run after it) gained little: the topology has settled, and
-    // further passes would only interleave restarts with the inner run (on large meshes the
-    // short runs keep gaining, so the pass + run test alone keeps the loop going far too long).
-    const bool settled = topo.objective_before - topo.objective_after <=
-                         options.outer_tolerance * std::abs(topo.objective_after);
-    if (progress) {
-      progress(
-          "comesh", 1.0,
-          absl::StrFormat("outer %d: %d flips, %d collapses (%d corner swaps), %d splits, "
-                          "vertices %d",
-                          rep.outer, topo.flips, topo.collapses, topo.corner_swaps, topo.splits,
-                          current.num_vertices()));
-    }
-    if (options.on_checkpoint) {
-      options.on_checkpoint(ComeshCheckpoint{.mesh = current,
-                                             .outer = rep.outer,
-                                             .inner = stats.iterations,
-                                             .energy_evaluations = stats.evaluations,
-                                             .flips = rep.flips,
-                                             .collapses = rep.collapses,
-                                             .splits = rep.splits,
-                                             .pass_start_objective = pass_start_objective,
-                                             .objective_trace = rep.objective_trace});
-    }
-    if (settled) break;
+    if (absl::Status st = inner(options.max_iterations); !st.ok()) return st;
   }
-  if (absl::Status st = inner(options.max_iterations); !st.ok()) return st;
   rep.inner = stats.iterations;
   rep.energy_evaluations = stats.evaluations + 1;
   rep.phase_seconds = stats.phases;

@@ -69,7 +69,15 @@
 // is the one-sided derivative of the side along which the objective falls. The line search's
 // inversion bound follows the
 // tangent (first order across a soft corner); the trial's own evaluation, infinite for any
-// non-positive triangle, keeps every accepted iterate valid.
+// non-positive triangle, keeps every accepted iterate valid. Outline sliding is a second stage:
+// the whole run above (passes and final inner run) first goes without it, then, from its result,
+// short runs with the outlines sliding, passes (boundary splits on the outline) and a final run
+// with them (ComeshCheckpoint::stage 1). Each step of that stage lowers the objective or keeps
+// it, so a run with slide_outline never ends above the run without it (sliding from the start
+// led the greedy passes elsewhere: up to 0.17% higher on some examples, docs/benchmarks.md). A
+// shape without a soft corner (ShapeOutline::curved: polygons) keeps the straight sliders, and
+// with no curved shape at all there is no second stage (the run is the one without, bit for
+// bit).
 // Fixed: boundary corners, every vertex of a cohesive edge, correspondence marks
 // (Multimesh::pinned), vertices listed in Multimesh::boundary that are not on the topological
 // boundary, and unused vertices.
@@ -132,11 +140,9 @@ struct ComeshOptions {
   // corners, stopping at turns above outline_corner_degrees and at cohesive vertices and marks
   // (comesh_outline.h; see "Unknowns" above). The objective is then area-invariant (its
   // normalizers follow the current areas, comesh_objective.h), so cutting a soft corner to
-  // shrink a shape gains nothing. Off by default: on curved pairs whose initial boundary
-  // correspondence is poor it lowers the map energy far (bird 4.18 -> 3.02), but on shapes whose
-  // maps are already conformal the extra freedom can lead the greedy topology passes to a
-  // slightly higher final objective (6 of 27 cases, docs/benchmarks.md).
-  // TODO(issue 5): on by default once it never ends worse.
+  // shrink a shape gains nothing. A second stage after the run without it (see "Unknowns"
+  // above): never ends higher than that run; on curved pairs whose initial boundary
+  // correspondence is poor it lowers the map energy far (bird 4.18 -> 3.13, docs/benchmarks.md).
   bool slide_outline = false;
   double outline_corner_degrees = 25.0;
   // Local relaxation (comesh_relax.h): after each accepted step shorter than the unit step (one
@@ -188,6 +194,9 @@ struct ComeshCheckpoint {
   // pass compares with it.
   double pass_start_objective = 0.0;
   std::vector<double> objective_trace;  // ComeshReport::objective_trace so far
+  // 0: a pass of the run without outline sliding; 1: of the run that continues from its result
+  // with it (slide_outline on curved outlines; see "Outline sliding" above).
+  int stage = 0;
 };
 
 // Where a run's time went (seconds, summed over inner runs and passes; for benchmarks).

@@ -39,6 +39,8 @@ ShapeOutline::ShapeOutline(const Multimesh& mesh, int shape, double corner_degre
       // A turn above corner_degrees means cos(turn) below cos(corner_degrees).
       if (is_fixed || !(norms > 0.0) || in.dot(out) < cos_corner * norms) {
         loop.hard.push_back(loop.arc[k]);
+      } else if (std::abs(in.x() * out.y() - in.y() * out.x()) > 1e-9 * norms) {
+        curved_ = true;  // a soft corner (StrictlyInsideSegment's straightness tolerance)
       }
     }
     total += loop.arc.back();

@@ -66,6 +66,11 @@ class ShapeOutline {
   // 1e-9 of the longest loop: the tolerance the optimizer and the topology pass locate with.
   double tolerance() const;
 
+  // True if some loop has a soft corner: a point that turns, but by no more than corner_degrees
+  // (and is not fixed). Without one, sliding along the outline is sliding along its straight
+  // stretches between hard points, which the optimizer's straight sliders already do.
+  bool curved() const { return curved_; }
+
   int num_loops() const { return static_cast<int>(loops_.size()); }
   double length(int loop) const { return loops_[loop].arc.back(); }
 
@@ -83,6 +88,7 @@ class ShapeOutline {
   int64_t CellKey(int64_t ix, int64_t iy) const { return (ix << 32) ^ (iy & 0xffffffff); }
 
   std::vector<Loop> loops_;
+  bool curved_ = false;
   double cell_ = 1.0;
   Point origin_ = Point::Zero();
   std::unordered_map<int64_t, std::vector<std::pair<int, int>>> grid_;  // cell -> (loop, segment)

@@ -85,6 +85,30 @@ TEST(SessionSnapshotTest, WithoutACheckpointTheLayoutIsUnchanged) {
   EXPECT_EQ(decoded->comesh_checkpoint, nullptr);
 }
 
+// A checkpoint of the optimizer's outline-sliding stage carries its stage in a section after the
+// checkpoint's end marker; a stage-0 checkpoint is laid out as before that section existed.
+TEST(SessionSnapshotTest, CheckpointStageRoundTrips) {
+  SessionState state = WithCheckpoint();
+  const std::string stage0 = EncodeSnapshot(state);
+  EXPECT_EQ(stage0.substr(stage0.size() - 8), "INBCKEND");
+  auto stored = std::make_shared<StoredComeshCheckpoint>(*state.comesh_checkpoint);
+  stored->checkpoint.stage = 1;
+  state.comesh_checkpoint = stored;
+  const std::string stage1 = EncodeSnapshot(state);
+  EXPECT_EQ(stage1.substr(0, stage0.size()), stage0);
+  for (int stage : {0, 1}) {
+    auto decoded = DecodeSnapshot(stage == 0 ? stage0 : stage1, "test");
+    ASSERT_TRUE(decoded.ok()) << decoded.status();
+    ASSERT_NE(decoded->comesh_checkpoint, nullptr);
+    EXPECT_EQ(decoded->comesh_checkpoint->checkpoint.stage, stage);
+  }
+  auto cut = DecodeSnapshot(stage1.substr(0, stage1.size() - 1), "file 9");
+  EXPECT_EQ(cut.status().code(), absl::StatusCode::kDataLoss);
+  std::string bad = stage1;
+  bad[bad.size() - 4] = 2;  // stage 2 does not exist
+  EXPECT_EQ(DecodeSnapshot(bad, "file 9").status().code(), absl::StatusCode::kDataLoss);
+}
+
 TEST(SessionSnapshotTest, DamagedCheckpointIsDataLoss) {
   const std::string bytes = EncodeSnapshot(WithCheckpoint());
   for (size_t cut : {bytes.size() - 1, bytes.size() - 12, bytes.size() - 60}) {

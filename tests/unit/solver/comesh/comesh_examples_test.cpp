@@ -85,6 +85,29 @@ TEST_P(ComeshExamplesTest, EveryTopologyPassLeavesAValidMultimesh) {
   }
 }
 
+// Outline sliding continues from the run without it (OptimizeComesh's stages), each step
+// lowering the objective or keeping it: on every example it ends no higher than that run (a run
+// that slid from the start ended up to 0.17% higher on principles_arcs). Short runs.
+TEST_P(ComeshExamplesTest, OutlineSlidingNeverEndsAboveTheRunWithout) {
+  ComeshOptions options;
+  options.max_outer = 3;
+  options.outer_inner_iterations = 5;
+  options.max_iterations = 30;
+  ComeshReport report[2];
+  for (int on = 0; on < 2; ++on) {
+    options.slide_outline = on == 1;
+    absl::StatusOr<Multimesh> out = OptimizeComesh(mesh_, options, nullptr, nullptr, &report[on]);
+    ASSERT_TRUE(out.ok()) << out.status();
+  }
+  EXPECT_LE(report[1].objective_after, report[0].objective_after)
+      << report[1].objective_after << " with outline sliding";
+  for (size_t k = 1; k < report[1].objective_trace.size(); ++k) {
+    EXPECT_LE(report[1].objective_trace[k],
+              report[1].objective_trace[k - 1] * (1.0 + 1e-12))  // (rounding of the recreated
+        << "trace entry " << k;                                  //  normalizers)
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Examples, ComeshExamplesTest,
                          ::testing::ValuesIn(example_projects::List()),
                          example_projects::TestName<::testing::TestParamInfo<std::string>>);
