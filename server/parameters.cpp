@@ -182,9 +182,10 @@ solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& com
   }
   if (comesh.tolerance() != 0) options.relative_decrease_tolerance = comesh.tolerance();
   if (comesh.has_outer_tolerance()) options.outer_tolerance = comesh.outer_tolerance();
-  if (comesh.has_outline_corner_degrees() && comesh.outline_corner_degrees() > 0.0) {
-    options.slide_outline = true;
-    options.outline_corner_degrees = comesh.outline_corner_degrees();
+  // Unset: the solver's default (outline sliding at 25 degrees); 0: off.
+  if (comesh.has_outline_corner_degrees()) {
+    options.slide_outline = comesh.outline_corner_degrees() > 0.0;
+    if (options.slide_outline) options.outline_corner_degrees = comesh.outline_corner_degrees();
   }
   return options;
 }

@@ -58,7 +58,7 @@
 // slides along that line (one unknown), so the domain of every shape is preserved exactly. With
 // slide_outline too, every other boundary vertex (a corner of its own polyline: on a curved
 // outline, nearly all of them) slides along its shape's outline as it was in the input mesh (the
-// polyline of its boundary loops, frozen for the whole run, comesh_outline.h; off by default, see
+// polyline of its boundary loops, frozen for the whole run, comesh_outline.h; on by default, see
 // ComeshOptions::slide_outline): its unknown is the
 // arc length, its position the point of the polyline there, its gradient taken along the tangent
 // where it is (updated after every step); it passes the polyline's soft corners (turns up to
@@ -143,7 +143,8 @@ struct ComeshOptions {
   // shrink a shape gains nothing. A second stage after the run without it (see "Unknowns"
   // above): never ends higher than that run; on curved pairs whose initial boundary
   // correspondence is poor it lowers the map energy far (bird 4.18 -> 3.13, docs/benchmarks.md).
-  bool slide_outline = false;
+  // On by default (off: every boundary vertex off a straight stretch stays where it is).
+  bool slide_outline = true;
   double outline_corner_degrees = 25.0;
   // Local relaxation (comesh_relax.h): after each accepted step shorter than the unit step (one
   // that backtracked or met the inversion bound), every vertex (of one shape) whose gradient holds
@@ -195,7 +196,7 @@ struct ComeshCheckpoint {
   double pass_start_objective = 0.0;
   std::vector<double> objective_trace;  // ComeshReport::objective_trace so far
   // 0: a pass of the run without outline sliding; 1: of the run that continues from its result
-  // with it (slide_outline on curved outlines; see "Outline sliding" above).
+  // with it (slide_outline on curved outlines; see "Unknowns" above).
   int stage = 0;
 };
 

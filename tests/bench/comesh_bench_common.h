@@ -33,7 +33,7 @@ struct ComeshBenchArgs {
 
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
 // --no-corner-swaps, --no-boundary-splits (TopologyOptions::corner_swaps, boundary_splits off),
-// --outline-sliding (ComeshOptions::slide_outline on), --outline-corner DEGREES,
+// --no-outline-sliding (ComeshOptions::slide_outline off), --outline-corner DEGREES,
 // --double-substitutions (ComeshOptions::float_substitutions off),
 // --cure-keep C, --step-fraction F, --scale-by-inverse, --history M, --tolerance R, --laplacian
 // (BCQN's H0), --refresh K, --relax F (0: no local relaxation), --relax-over-mean M,
@@ -48,7 +48,7 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
-                 "[--no-corner-swaps] [--no-boundary-splits] [--outline-sliding] "
+                 "[--no-corner-swaps] [--no-boundary-splits] [--no-outline-sliding] "
                  "[--outline-corner DEGREES] "
                  "[--cure-keep C] [--double-substitutions] [--step-fraction F] [--outer-inner K] "
                  "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
@@ -107,8 +107,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.float_substitutions = false;
     } else if (a == "--no-corner-swaps") {
       args.options.topology.corner_swaps = false;
-    } else if (a == "--outline-sliding") {
-      args.options.slide_outline = true;
+    } else if (a == "--no-outline-sliding") {
+      args.options.slide_outline = false;
     } else if (a == "--outline-corner") {
       args.options.outline_corner_degrees = std::atof(next());
     } else if (a == "--no-boundary-splits") {

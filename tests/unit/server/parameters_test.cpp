@@ -63,8 +63,9 @@ TEST(ParametersTest, OutOfRangeNamesTheField) {
 
 TEST(ParametersTest, OutlineCornerDegreesIsCheckedAndReachesTheOptimizer) {
   v1::ComeshParameters c;
-  EXPECT_FALSE(ToComeshOptions(c).slide_outline);  // unset: straight stretches only
-  c.set_outline_corner_degrees(0.0);
+  EXPECT_TRUE(ToComeshOptions(c).slide_outline);  // unset: the solver's default, 25 degrees
+  EXPECT_DOUBLE_EQ(ToComeshOptions(c).outline_corner_degrees, 25.0);
+  c.set_outline_corner_degrees(0.0);  // off: straight stretches only
   ASSERT_TRUE(ValidateComesh(c, "comesh").ok());
   EXPECT_FALSE(ToComeshOptions(c).slide_outline);
   c.set_outline_corner_degrees(30.0);

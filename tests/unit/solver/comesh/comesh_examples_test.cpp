@@ -29,7 +29,7 @@ class ComeshExamplesTest : public ::testing::TestWithParam<std::string> {
   Multimesh mesh_;
 };
 
-// Both with the default straight-run sliding and with outline sliding (slide_outline).
+// Both with straight-run sliding only and with outline sliding (slide_outline, the default).
 TEST_P(ComeshExamplesTest, NoAcceptedIterateInvertsAnyShape) {
   for (bool slide_outline : {false, true}) {
     SCOPED_TRACE(slide_outline ? "outline sliding" : "straight-run sliding");
