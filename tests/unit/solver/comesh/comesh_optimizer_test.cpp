@@ -601,40 +601,39 @@ void ExpectResumedFrom(const Multimesh& m, ComeshOptions options,
   }
 }
 
+// An axis-aligned ellipse drawn as a 96-point outline.
+Drawing Ellipse(Point center, double a, double b) {
+  Drawing d;
+  Points outline;
+  for (int k = 0; k < 96; ++k) {
+    const double t = 2.0 * std::numbers::pi * k / 96.0;
+    outline.push_back(center + Point(a * std::cos(t), b * std::sin(t)));
+  }
+  d.outlines.push_back({outline});
+  return d;
+}
+
 // A curved pair built by BuildMultimesh: a circle (96 points) -> a half-disk (a 33-point arc and
 // its diameter: two 90-degree corners).
 absl::StatusOr<Multimesh> CircleToHalfDisk(int boundary_vertices) {
-  Drawing circle, half;
-  Points round, arch;
-  for (int k = 0; k < 96; ++k) {
-    const double t = 2.0 * std::numbers::pi * k / 96.0;
-    round.push_back(Point(0.5 + 0.5 * std::cos(t), 0.5 + 0.5 * std::sin(t)));
-  }
+  Drawing half;
+  Points arch;
   for (int k = 0; k <= 32; ++k) {
     const double t = std::numbers::pi * k / 32.0;
     arch.push_back(Point(0.5 + 0.5 * std::cos(t), 0.3 + 0.5 * std::sin(t)));
   }
-  circle.outlines.push_back({round});
   half.outlines.push_back({arch});
   MultimeshOptions build;
   build.boundary_vertices = boundary_vertices;
-  return BuildMultimesh({circle, half}, build);
+  return BuildMultimesh({Ellipse(Point(0.5, 0.5), 0.5, 0.5), half}, build);
 }
 
 // A circle -> a 0.9 x 0.3 ellipse (96 points each): no hard point at all.
 absl::StatusOr<Multimesh> CircleToEllipse(int boundary_vertices) {
-  Drawing circle, ellipse;
-  Points round, flat;
-  for (int k = 0; k < 96; ++k) {
-    const double t = 2.0 * std::numbers::pi * k / 96.0;
-    round.push_back(Point(0.5 + 0.5 * std::cos(t), 0.5 + 0.5 * std::sin(t)));
-    flat.push_back(Point(0.5 + 0.9 * std::cos(t), 0.5 + 0.3 * std::sin(t)));
-  }
-  circle.outlines.push_back({round});
-  ellipse.outlines.push_back({flat});
   MultimeshOptions build;
   build.boundary_vertices = boundary_vertices;
-  return BuildMultimesh({circle, ellipse}, build);
+  return BuildMultimesh(
+      {Ellipse(Point(0.5, 0.5), 0.5, 0.5), Ellipse(Point(0.5, 0.5), 0.9, 0.3)}, build);
 }
 
 TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun) {
@@ -771,20 +770,12 @@ TEST(ComeshOptimizerTest, RandomCurvedDrawingsSlideSafely) {
 // can be conformal) must end no higher with sliding than without (4.5767 against 4.5845; 4.5916
 // before).
 TEST(ComeshOptimizerTest, WholeOutlinesSlidingInThreeShapesStillConverge) {
-  auto circle = [](double cx, double cy, double r) {
-    Drawing d;
-    Points round;
-    for (int k = 0; k < 96; ++k) {
-      const double t = 2.0 * std::numbers::pi * k / 96.0;
-      round.push_back(Point(cx + r * std::cos(t), cy + r * std::sin(t)));
-    }
-    d.outlines.push_back({round});
-    return d;
-  };
   MultimeshOptions build;
   build.boundary_vertices = 40;
-  absl::StatusOr<Multimesh> m =
-      BuildMultimesh({circle(0.5, 0.5, 0.5), circle(1.5, 0.6, 0.5), circle(0.8, 0.3, 0.4)}, build);
+  absl::StatusOr<Multimesh> m = BuildMultimesh({Ellipse(Point(0.5, 0.5), 0.5, 0.5),
+                                                Ellipse(Point(1.5, 0.6), 0.5, 0.5),
+                                                Ellipse(Point(0.8, 0.3), 0.4, 0.4)},
+                                               build);
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
   ASSERT_LT(options.hessian_max_shapes, 3);  // the Laplacian preconditioner's case
