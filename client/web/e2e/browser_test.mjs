@@ -371,6 +371,13 @@ try {
   });
 
   await step("the project file download: version 1, both drawings, the cut, the slider values", async () => {
+    // Outline sliding off is written as outline_corner_degrees 0; on (the default) leaves it out.
+    await page.uncheck("#slide-outline");
+    const [off] = await Promise.all([page.waitForEvent("download"), page.click("#download-project")]);
+    const offPath = join(args.out, "project-no-outline-sliding.json");
+    await off.saveAs(offPath);
+    assert.equal(JSON.parse(readFileSync(offPath, "utf8")).comesh.outline_corner_degrees, 0);
+    await page.check("#slide-outline");
     const [dl] = await Promise.all([page.waitForEvent("download"), page.click("#download-project")]);
     assert.equal(dl.suggestedFilename(), "project.json");
     const path = join(args.out, "project.json");
@@ -379,7 +386,8 @@ try {
     // Only fields docs/project-file.md defines (the CLI refuses unknown ones).
     const allowed = {
       "": ["version", "drawings", "correspondences", "meshing", "comesh", "inbetween", "output"],
-      comesh: ["map_weight", "max_outer_iterations", "max_inner_iterations", "tolerance"],
+      comesh: ["map_weight", "max_outer_iterations", "max_inner_iterations", "tolerance",
+        "outer_tolerance", "outline_corner_degrees"],
       inbetween: ["method", "frames", "timing", "ease", "stiffness", "lambda", "tau", "alpha", "epsilon",
         "rho", "timestep", "max_iterations"],
       output: ["formats", "width", "fps", "fill", "mesh_overlay"],
@@ -414,6 +422,7 @@ try {
     assert.ok(near(ib.stiffness[0].kappa, set.kappa), `kappa ${ib.stiffness[0].kappa}`);
     assert.ok(ib.stiffness[0].polygon.length >= 3 && ib.stiffness[0].polygon.every((q) => q.length === 2));
     assert.equal(project.comesh.map_weight, 0.5);
+    assert.equal(project.comesh.outline_corner_degrees, undefined);
     assert.deepEqual({ fps: project.output.fps, fill: project.output.fill, overlay: project.output.mesh_overlay },
       { fps: 24, fill: "#3b7dd8", overlay: false });
   });

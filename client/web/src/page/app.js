@@ -625,6 +625,8 @@ async function build() {
 async function optimize() {
   await heavy("error-build", async (signal) => {
     const comesh = { mapWeight: Number($("map-weight").value) };
+    // Unset: the server's default (outline sliding at 25 degrees); 0 turns it off.
+    if (!$("slide-outline").checked) comesh.outlineCornerDegrees = 0;
     for await (const m of api.optimizeComesh(
       { sessionId: sid(), expectedVersion: version(), comesh },
       callOptions(signal),
@@ -970,6 +972,7 @@ function downloadProject() {
     },
     output: { formats: ["svg", "json", "gif"], fps: Number($("fps").value) || 24, fill: FILL, mesh_overlay: $("overlay").checked },
   };
+  if (!$("slide-outline").checked) project.comesh.outline_corner_degrees = 0;
   if (state.marks.length) project.correspondences = state.marks.map((m) => m.map((q) => [q.x, q.y]));
   if (p.ease) project.inbetween.ease = p.ease;
   if (p.stiffness) project.inbetween.stiffness = p.stiffness.map((r) => ({ polygon: pts(r.polygon), kappa: r.kappa }));
