@@ -83,9 +83,10 @@ absl::Status ValidateInput(const Multimesh& mesh) {
 
 // Per shape, which vertices move and how: interior vertices move freely in 2D; with sliding on,
 // a boundary vertex that lies strictly between its two boundary neighbours on a straight line
-// (in that shape) moves along that line; with `outlines` (one per shape, may be null), any other
-// boundary vertex that lies on its shape's reference outline away from a hard point moves by arc
-// length along that outline (comesh_outline.h); every other vertex is fixed.
+// (in that shape) moves along that line; with `outlines` (one per shape, may be null), in a shape
+// whose outline has a soft corner (ShapeOutline::curved) any other boundary vertex that lies on
+// the reference outline away from a hard point moves by arc length along it (comesh_outline.h);
+// every other vertex is fixed.
 class Layout {
  public:
   // With a `cancel` token (may be null) the edge list polls it (~0.1 s at 311k vertices); if it
