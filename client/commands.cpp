@@ -191,14 +191,23 @@ absl::StatusOr<v1::OptimizeComeshResult> Optimize(const v1::Session& session,
                                                   const RunContext& ctx) {
   auto optimized = ctx.client->OptimizeComesh(
       session,
+      // The end is not known: the iterations' counters and energies, and the topology passes'
+      // messages (the server's stage "comesh"), under one label.
       [&](const v1::ComeshIteration& it) {
         if (ctx.progress) {
-          ctx.progress->Update("optimize", 0.0,
-                               absl::StrFormat("outer %u inner %u map %.4f mesh %.4f", it.outer(),
-                                               it.inner(), it.map_energy(), it.mesh_energy()));
+          ctx.progress->Update("optimize", -1.0,
+                               absl::StrFormat("outer %u inner %u map %.4f mesh %.4f vertices %u",
+                                               it.outer(), it.inner(), it.map_energy(),
+                                               it.mesh_energy(), it.vertices()));
         }
       },
-      [&](const v1::Progress& p) { ShowProgress(ctx, p); });
+      [&](const v1::Progress& p) {
+        if (ctx.progress && p.stage() == "comesh") {
+          ctx.progress->Update("optimize", -1.0, p.detail());
+        } else {
+          ShowProgress(ctx, p);
+        }
+      });
   FinishProgress(ctx);
   if (!optimized.ok()) return Annotate(optimized.status(), "optimize comesh");
   return optimized;

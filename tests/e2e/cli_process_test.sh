@@ -25,6 +25,24 @@ assert {"triangulate", "map", "frames"} <= stages, stages
 print(f"progress json: {len(events)} events, stages {sorted(stages)}")
 PY
 
+# optimize, whose end is not known: one event per iterate and topology pass under the stage
+# "optimize", fraction 0, the detail naming the iterate's counters and energies.
+"$CLI_BIN" --progress json optimize "$ex/square.svg" "$ex/hexagon.svg" --out opt_out \
+  2>optimize.err >optimize.out
+python3 - optimize.err <<'PY'
+import json, sys
+events = [json.loads(l) for l in open(sys.argv[1]) if l.startswith("{")]
+opt = [e for e in events if e["stage"] == "optimize"]
+iterates = [e for e in opt if e.get("detail", "").startswith("outer ")
+            and " inner " in e["detail"] and " map " in e["detail"]]
+passes = [e for e in opt if ": " in e.get("detail", "") and "flips" in e["detail"]]
+assert len(iterates) >= 10 and passes, opt[:3]
+assert all(e["fraction"] == 0.0 for e in opt), opt
+inner = [int(e["detail"].split()[3]) for e in iterates]
+assert inner == sorted(inner) and len(set(inner)) == len(inner), inner
+print(f"optimize progress: {len(iterates)} iterates, {len(passes)} passes")
+PY
+
 # -q: no progress output (neither JSON events nor a bar), the result path still on stdout.
 "$CLI_BIN" -q animate "$ex/square.svg" "$ex/hexagon.svg" --frames 6 --format json \
   --out quiet_out 2>quiet.err >quiet.out
