@@ -44,6 +44,18 @@ Multimesh SquareToHexagon(int k) {
 // Over every accepted iterate of a run on the fixed topology of `m` (max_outer = 0): the
 // inverted triangles of every shape and the iterates whose objective, evaluated afresh, rose
 // above the one before. Run optimizes with on_iterate set to count them.
+// An axis-aligned ellipse drawn as a 96-point outline.
+Drawing Ellipse(Point center, double a, double b) {
+  Drawing d;
+  Points outline;
+  for (int k = 0; k < 96; ++k) {
+    const double t = 2.0 * std::numbers::pi * k / 96.0;
+    outline.push_back(center + Point(a * std::cos(t), b * std::sin(t)));
+  }
+  d.outlines.push_back({outline});
+  return d;
+}
+
 struct IterateAudit {
   int iterates = 0;
   int inverted = 0;
@@ -407,6 +419,39 @@ TEST(ComeshOptimizerTest, ResultDoesNotDependOnThreadCount) {
   EXPECT_EQ(r1.inner, r2.inner);
 }
 
+// The same with outline sliding's second stage (curved drawings, three shapes: the Laplacian
+// preconditioner with its floating components).
+TEST(ComeshOptimizerTest, SlidingResultDoesNotDependOnThreadCount) {
+  MultimeshOptions build;
+  build.boundary_vertices = 160;
+  build.max_edge_relative = 0.02;
+  absl::StatusOr<Multimesh> m = BuildMultimesh({Ellipse(Point(0.5, 0.5), 0.5, 0.5),
+                                                Ellipse(Point(0.5, 0.5), 0.9, 0.3),
+                                                Ellipse(Point(0.5, 0.5), 0.3, 0.8)},
+                                               build);
+  ASSERT_TRUE(m.ok()) << m.status();
+  ASSERT_GT(m->triangles.size(), 4096u);  // more than one chunk: threads really run
+  ComeshOptions options;
+  options.max_iterations = 15;
+  options.max_outer = 2;
+  options.outer_inner_iterations = 5;
+  int sliding_stages = 0;
+  const ProgressFn progress = [&](const std::string&, double, const std::string& message) {
+    sliding_stages += message == "outline sliding";
+  };
+  ComeshReport r1, r2;
+  options.threads = 1;
+  auto a = OptimizeComesh(*m, options, nullptr, progress, &r1);
+  options.threads = 2;
+  auto b = OptimizeComesh(*m, options, nullptr, progress, &r2);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(sliding_stages, 2);
+  EXPECT_EQ(a->triangles, b->triangles);
+  EXPECT_EQ(a->shapes, b->shapes);
+  EXPECT_EQ(r1.objective_after, r2.objective_after);
+  EXPECT_EQ(r1.inner, r2.inner);
+}
+
 TEST(ComeshOptimizerTest, ObjectiveDoesNotDependOnThreadCount) {
   Multimesh m = SquareToHexagon(70);
   std::vector<Points> g1, g3;
@@ -599,18 +644,6 @@ void ExpectResumedFrom(const Multimesh& m, ComeshOptions options,
     EXPECT_EQ(a.objective_trace, b.objective_trace);
     EXPECT_EQ(a.mesh.shapes, b.mesh.shapes);
   }
-}
-
-// An axis-aligned ellipse drawn as a 96-point outline.
-Drawing Ellipse(Point center, double a, double b) {
-  Drawing d;
-  Points outline;
-  for (int k = 0; k < 96; ++k) {
-    const double t = 2.0 * std::numbers::pi * k / 96.0;
-    outline.push_back(center + Point(a * std::cos(t), b * std::sin(t)));
-  }
-  d.outlines.push_back({outline});
-  return d;
 }
 
 // A curved pair built by BuildMultimesh: a circle (96 points) -> a half-disk (a 33-point arc and
