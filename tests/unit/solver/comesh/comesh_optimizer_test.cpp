@@ -56,6 +56,15 @@ Drawing Ellipse(Point center, double a, double b) {
   return d;
 }
 
+// BuildMultimesh with `boundary_vertices` per shape (and max_edge_relative if > 0).
+absl::StatusOr<Multimesh> BuildDrawings(const std::vector<Drawing>& drawings,
+                                        int boundary_vertices, double max_edge_relative = 0.0) {
+  MultimeshOptions build;
+  build.boundary_vertices = boundary_vertices;
+  if (max_edge_relative > 0.0) build.max_edge_relative = max_edge_relative;
+  return BuildMultimesh(drawings, build);
+}
+
 struct IterateAudit {
   int iterates = 0;
   int inverted = 0;
@@ -422,13 +431,10 @@ TEST(ComeshOptimizerTest, ResultDoesNotDependOnThreadCount) {
 // The same with outline sliding's second stage (curved drawings, three shapes: the Laplacian
 // preconditioner with its floating components).
 TEST(ComeshOptimizerTest, SlidingResultDoesNotDependOnThreadCount) {
-  MultimeshOptions build;
-  build.boundary_vertices = 160;
-  build.max_edge_relative = 0.02;
-  absl::StatusOr<Multimesh> m = BuildMultimesh({Ellipse(Point(0.5, 0.5), 0.5, 0.5),
-                                                Ellipse(Point(0.5, 0.5), 0.9, 0.3),
-                                                Ellipse(Point(0.5, 0.5), 0.3, 0.8)},
-                                               build);
+  absl::StatusOr<Multimesh> m = BuildDrawings({Ellipse(Point(0.5, 0.5), 0.5, 0.5),
+                                               Ellipse(Point(0.5, 0.5), 0.9, 0.3),
+                                               Ellipse(Point(0.5, 0.5), 0.3, 0.8)},
+                                              160, 0.02);
   ASSERT_TRUE(m.ok()) << m.status();
   ASSERT_GT(m->triangles.size(), 4096u);  // more than one chunk: threads really run
   ComeshOptions options;
@@ -656,17 +662,13 @@ absl::StatusOr<Multimesh> CircleToHalfDisk(int boundary_vertices) {
     arch.push_back(Point(0.5 + 0.5 * std::cos(t), 0.3 + 0.5 * std::sin(t)));
   }
   half.outlines.push_back({arch});
-  MultimeshOptions build;
-  build.boundary_vertices = boundary_vertices;
-  return BuildMultimesh({Ellipse(Point(0.5, 0.5), 0.5, 0.5), half}, build);
+  return BuildDrawings({Ellipse(Point(0.5, 0.5), 0.5, 0.5), half}, boundary_vertices);
 }
 
 // A circle -> a 0.9 x 0.3 ellipse (96 points each): no hard point at all.
 absl::StatusOr<Multimesh> CircleToEllipse(int boundary_vertices) {
-  MultimeshOptions build;
-  build.boundary_vertices = boundary_vertices;
-  return BuildMultimesh(
-      {Ellipse(Point(0.5, 0.5), 0.5, 0.5), Ellipse(Point(0.5, 0.5), 0.9, 0.3)}, build);
+  return BuildDrawings({Ellipse(Point(0.5, 0.5), 0.5, 0.5), Ellipse(Point(0.5, 0.5), 0.9, 0.3)},
+                       boundary_vertices);
 }
 
 TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun) {
@@ -803,12 +805,10 @@ TEST(ComeshOptimizerTest, RandomCurvedDrawingsSlideSafely) {
 // can be conformal) must end no higher with sliding than without (4.5767 against 4.5845; 4.5916
 // before).
 TEST(ComeshOptimizerTest, WholeOutlinesSlidingInThreeShapesStillConverge) {
-  MultimeshOptions build;
-  build.boundary_vertices = 40;
-  absl::StatusOr<Multimesh> m = BuildMultimesh({Ellipse(Point(0.5, 0.5), 0.5, 0.5),
-                                                Ellipse(Point(1.5, 0.6), 0.5, 0.5),
-                                                Ellipse(Point(0.8, 0.3), 0.4, 0.4)},
-                                               build);
+  absl::StatusOr<Multimesh> m = BuildDrawings({Ellipse(Point(0.5, 0.5), 0.5, 0.5),
+                                               Ellipse(Point(1.5, 0.6), 0.5, 0.5),
+                                               Ellipse(Point(0.8, 0.3), 0.4, 0.4)},
+                                              40);
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
   ASSERT_LT(options.hessian_max_shapes, 3);  // the Laplacian preconditioner's case
