@@ -514,15 +514,18 @@ class InitialHessian {
     for (int k = 0; k < size_; ++k) {
       if (anchored[k]) root_anchored[find(k)] = 1;
     }
-    std::vector<std::vector<int>> rows(size_);
     for (int k = 0; k < size_; ++k) {
-      if (!root_anchored[find(k)]) rows[find(k)].push_back(k);
+      if (!root_anchored[find(k)]) floating_rows_.push_back(k);
     }
+    if (floating_rows_.empty()) return;  // the usual case
+    // Grouped by component (ascending rows within each), one run per component.
+    std::stable_sort(floating_rows_.begin(), floating_rows_.end(),
+                     [&](int a, int b) { return find(a) < find(b); });
     floating_begin_ = {0};
-    for (const std::vector<int>& component : rows) {
-      if (component.empty()) continue;
-      floating_rows_.insert(floating_rows_.end(), component.begin(), component.end());
-      floating_begin_.push_back(static_cast<int>(floating_rows_.size()));
+    for (size_t i = 1; i <= floating_rows_.size(); ++i) {
+      if (i == floating_rows_.size() || find(floating_rows_[i]) != find(floating_rows_[i - 1])) {
+        floating_begin_.push_back(static_cast<int>(i));
+      }
     }
   }
   // Projects every column of `m` (rows = L's) onto the complement of the floating components'
