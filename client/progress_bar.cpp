@@ -24,7 +24,8 @@ void ProgressBar::Update(const std::string& label, double fraction, const std::s
   } else if (unknown) {
     // A new detail (JSON), or a redraw of the bar's detail at most every 100 ms.
     if (detail == last_detail_) return;
-    if (mode_ == ProgressMode::kAuto && (!tty_ || now - last_draw_ < std::chrono::milliseconds(100))) {
+    if (mode_ == ProgressMode::kAuto &&
+        (!tty_ || now - last_draw_ < std::chrono::milliseconds(100))) {
       pending_ = detail;  // drawn by the next redraw, or by Finish
       return;
     }

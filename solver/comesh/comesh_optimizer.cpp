@@ -1488,12 +1488,11 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       const bool settled = topo.objective_before - topo.objective_after <=
                            options.outer_tolerance * std::abs(topo.objective_after);
       if (progress) {
-        progress(
-            "comesh", 1.0,
-            absl::StrFormat("outer %d: %d flips, %d collapses (%d corner swaps), %d splits, "
-                            "vertices %d",
-                            rep.outer, topo.flips, topo.collapses, topo.corner_swaps, topo.splits,
-                            current.num_vertices()));
+        progress("comesh", 1.0,
+                 absl::StrFormat("outer %d: %d flips, %d collapses (%d corner swaps), %d splits, "
+                                 "vertices %d",
+                                 rep.outer, topo.flips, topo.collapses, topo.corner_swaps,
+                                 topo.splits, current.num_vertices()));
       }
       if (options.on_checkpoint) {
         options.on_checkpoint(ComeshCheckpoint{.mesh = current,

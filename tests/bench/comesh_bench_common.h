@@ -25,7 +25,7 @@ struct ComeshBenchArgs {
   bool cache_order = false;
   std::string json_path;
   bool verbose = false;
-  int repeat = 5;  // runs shorter than a second are repeated (TimedOptimize); the median is reported
+  int repeat = 5;  // runs under a second are repeated (TimedOptimize); the median is reported
   bool malloc_defaults = false;  // --malloc-defaults: glibc's own thresholds (the CLI's are not)
   int cancel_trials = 0;  // comesh-scaling: cancellation latency trials per row (--cancel-trials)
   solver::ComeshOptions options;
