@@ -57,8 +57,8 @@ Drawing Ellipse(Point center, double a, double b) {
 }
 
 // BuildMultimesh with `boundary_vertices` per shape (and max_edge_relative if > 0).
-absl::StatusOr<Multimesh> BuildDrawings(const std::vector<Drawing>& drawings,
-                                        int boundary_vertices, double max_edge_relative = 0.0) {
+absl::StatusOr<Multimesh> BuildDrawings(const std::vector<Drawing>& drawings, int boundary_vertices,
+                                        double max_edge_relative = 0.0) {
   MultimeshOptions build;
   build.boundary_vertices = boundary_vertices;
   if (max_edge_relative > 0.0) build.max_edge_relative = max_edge_relative;
@@ -431,10 +431,10 @@ TEST(ComeshOptimizerTest, ResultDoesNotDependOnThreadCount) {
 // The same with outline sliding's second stage (curved drawings, three shapes: the Laplacian
 // preconditioner with its floating components).
 TEST(ComeshOptimizerTest, SlidingResultDoesNotDependOnThreadCount) {
-  absl::StatusOr<Multimesh> m = BuildDrawings({Ellipse(Point(0.5, 0.5), 0.5, 0.5),
-                                               Ellipse(Point(0.5, 0.5), 0.9, 0.3),
-                                               Ellipse(Point(0.5, 0.5), 0.3, 0.8)},
-                                              160, 0.02);
+  absl::StatusOr<Multimesh> m =
+      BuildDrawings({Ellipse(Point(0.5, 0.5), 0.5, 0.5), Ellipse(Point(0.5, 0.5), 0.9, 0.3),
+                     Ellipse(Point(0.5, 0.5), 0.3, 0.8)},
+                    160, 0.02);
   ASSERT_TRUE(m.ok()) << m.status();
   ASSERT_GT(m->triangles.size(), 4096u);  // more than one chunk: threads really run
   ComeshOptions options;
@@ -589,8 +589,7 @@ void ExpectResumedRunEqualsUninterrupted(const absl::StatusOr<Multimesh>& m,
   }
   for (size_t start : starts) {
     SCOPED_TRACE(absl::StrCat("resumed after pass ", start + 1, " of ", checkpoints.size()));
-    ExpectResumedFrom(*m, options, checkpoints, iterates, full, *uninterrupted,
-                      checkpoints[start]);
+    ExpectResumedFrom(*m, options, checkpoints, iterates, full, *uninterrupted, checkpoints[start]);
   }
 }
 
@@ -696,9 +695,9 @@ TEST(ComeshOptimizerTest, RejectsAnInvalidCheckpoint) {
 
 // Curved outlines: every boundary vertex of a circle -> half-disk multimesh is a corner of its
 // own polyline, so only outline sliding (ComeshOptions::slide_outline, on by default) lets the
-// boundary correspondence move. With it the map energy falls far lower; every boundary vertex stays on
-// its shape's input outline; the half-disk's two drawn corners (90 degrees) keep a vertex exactly
-// where they were. Without it the boundary is the input's point set, corners in place.
+// boundary correspondence move. With it the map energy falls far lower; every boundary vertex stays
+// on its shape's input outline; the half-disk's two drawn corners (90 degrees) keep a vertex
+// exactly where they were. Without it the boundary is the input's point set, corners in place.
 TEST(ComeshOptimizerTest, CurvedOutlinesSlideAlongTheirPolylines) {
   absl::StatusOr<Multimesh> m = CircleToHalfDisk(48);
   ASSERT_TRUE(m.ok()) << m.status();
@@ -805,10 +804,10 @@ TEST(ComeshOptimizerTest, RandomCurvedDrawingsSlideSafely) {
 // can be conformal) must end no higher with sliding than without (4.5767 against 4.5845; 4.5916
 // before).
 TEST(ComeshOptimizerTest, WholeOutlinesSlidingInThreeShapesStillConverge) {
-  absl::StatusOr<Multimesh> m = BuildDrawings({Ellipse(Point(0.5, 0.5), 0.5, 0.5),
-                                               Ellipse(Point(1.5, 0.6), 0.5, 0.5),
-                                               Ellipse(Point(0.8, 0.3), 0.4, 0.4)},
-                                              40);
+  absl::StatusOr<Multimesh> m =
+      BuildDrawings({Ellipse(Point(0.5, 0.5), 0.5, 0.5), Ellipse(Point(1.5, 0.6), 0.5, 0.5),
+                     Ellipse(Point(0.8, 0.3), 0.4, 0.4)},
+                    40);
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
   ASSERT_LT(options.hessian_max_shapes, 3);  // the Laplacian preconditioner's case
