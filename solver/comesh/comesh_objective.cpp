@@ -5,10 +5,10 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "solver/comesh/comesh_topology.h"
 #include "solver/comesh/mips_energy.h"
 #include "solver/comesh/odt_energy.h"
 #include "solver/core/parallel_chunks.h"
@@ -65,18 +65,20 @@ absl::StatusOr<ComeshObjective> ComeshObjective::Create(const std::vector<Triang
   o.map_scale_ = o.areas_;
   o.area_invariant_ = area_invariant;
   if (area_invariant) {
-    // Edges used by one triangle, in that triangle's orientation (sorted: deterministic).
-    std::map<std::pair<int, int>, int> uses;
+    // Edges used by one triangle (EdgeUses: sorted), in that triangle's orientation, in
+    // triangle order.
+    const std::vector<std::pair<std::pair<int, int>, int>> uses =
+        EdgeUses(triangles, std::vector<char>(triangles.size(), 1));
+    auto boundary = [&](int a, int b) {
+      const std::pair<int, int> key(std::min(a, b), std::max(a, b));
+      const auto it = std::lower_bound(uses.begin(), uses.end(), key,
+                                       [](const auto& use, const auto& k) { return use.first < k; });
+      return it != uses.end() && it->first == key && it->second == 1;
+    };
     for (const Triangle& t : triangles) {
       for (int k = 0; k < 3; ++k) {
         const int a = t[k], b = t[(k + 1) % 3];
-        ++uses[{std::min(a, b), std::max(a, b)}];
-      }
-    }
-    for (const Triangle& t : triangles) {
-      for (int k = 0; k < 3; ++k) {
-        const int a = t[k], b = t[(k + 1) % 3];
-        if (uses[{std::min(a, b), std::max(a, b)}] == 1) o.boundary_edges_.push_back({a, b});
+        if (boundary(a, b)) o.boundary_edges_.push_back({a, b});
       }
     }
   }
