@@ -71,8 +71,9 @@ absl::StatusOr<ComeshObjective> ComeshObjective::Create(const std::vector<Triang
         EdgeUses(triangles, std::vector<char>(triangles.size(), 1));
     auto boundary = [&](int a, int b) {
       const std::pair<int, int> key(std::min(a, b), std::max(a, b));
-      const auto it = std::lower_bound(uses.begin(), uses.end(), key,
-                                       [](const auto& use, const auto& k) { return use.first < k; });
+      const auto it =
+          std::lower_bound(uses.begin(), uses.end(), key,
+                           [](const auto& use, const auto& k) { return use.first < k; });
       return it != uses.end() && it->first == key && it->second == 1;
     };
     for (const Triangle& t : triangles) {
