@@ -183,7 +183,6 @@ class Layout {
   int size() const { return size_; }
   int num_shapes() const { return num_shapes_; }
   int num_vertices() const { return num_vertices_; }
-  int num_outline_sliders() const { return num_outline_; }
   const std::vector<Var>& vars() const { return vars_; }
   int index(int shape, int v) const { return index_[shape][v]; }
 
