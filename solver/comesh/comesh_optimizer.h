@@ -174,6 +174,13 @@ struct ComeshOptions {
   double outer_tolerance = 1e-4;    // stop when a pass (or pass + short run) gains less
   int outer_inner_iterations = 10;  // inner iterations between topology passes
   TopologyOptions topology;
+  // With max_outer > 0, the last step: sliver removal (RemoveSlivers, comesh_topology.h) on the
+  // triangles whose quality (TriangleQuality: 1 equilateral, 0 flat) is below min_quality in
+  // some shape. Inner runs can press a triangle flat in every shape alike (two boundary sliders
+  // that meet, an interior vertex onto a boundary edge), which the objective barely resists:
+  // S-Table 2's rows from 4k vertices on ended with 1-6 triangles of quality 3.6e-8 to 8e-4
+  // (twenty-first session). 0: off.
+  double min_quality = 0.02;
   // Called after every accepted inner iterate (numbered globally from 1) with all shapes'
   // positions (of the current topology); for tests, traces and visualisation.
   std::function<void(int iteration, const std::vector<Points>& shapes)> on_iterate;
@@ -231,6 +238,11 @@ struct ComeshReport {
   ComeshPhaseSeconds phase_seconds;
   std::string stop_reason;  // last inner run: "gradient", "decrease", "max_iterations",
                             // "line_search", "no_free"
+  // Sliver removal (ComeshOptions::min_quality): triangles below min_quality before it, the
+  // operations it made, and the worst triangle quality of the result over every shape.
+  int slivers = 0;
+  int sliver_operations = 0;
+  double worst_quality = 0.0;
 };
 
 // Optimizes every shape of `mesh` (positions, and with max_outer > 0 the shared topology).

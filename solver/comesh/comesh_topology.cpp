@@ -217,6 +217,26 @@ class Editor {
             (options_.corner_swaps && (straight_[a] | straight_[b]) == all_straight_));
   }
 
+  // True if b (not fixed) is a boundary neighbour of a and, in every shape where b is not
+  // straight, lies within kCoincident mean edge lengths of a: merging them moves a corner by at
+  // most that much (sliver removal only).
+  bool CoincidentAlong(int a, int b) const {
+    constexpr double kCoincident = 1e-2;
+    if (a < 0 || b < 0 || fixed_[b]) return false;
+    if (boundary_nbrs_[b][0] != a && boundary_nbrs_[b][1] != a) return false;
+    for (size_t s = 0; s < shapes_.size(); ++s) {
+      if (straight_[b] >> s & 1) continue;
+      if ((shapes_[s][a] - shapes_[s][b]).norm() > kCoincident * mean_edge_[s]) return false;
+    }
+    return true;
+  }
+
+  // Twice the area the boundary polygon of shape s changes by when boundary vertex v leaves it.
+  double DropArea2(size_t s, int v) const {
+    const Points& x = shapes_[s];
+    return std::abs(Area2(x[boundary_nbrs_[v][0]], x[v], x[boundary_nbrs_[v][1]]));
+  }
+
   // Length of edge (a, b) relative to the mean edge length, max (or min) over shapes.
   double RelativeLength(int a, int b, bool max) const {
     double r = max ? 0.0 : std::numeric_limits<double>::infinity();
@@ -245,7 +265,9 @@ class Editor {
     return found;
   }
 
-  bool TryFlip(int a, int b) {
+  // With by_quality (sliver removal) the flip must raise the worst quality of the two
+  // triangles instead of lowering the objective.
+  bool TryFlip(int a, int b, bool by_quality = false) {
     int t1 = -1, t2 = -1;
     if (!EdgeTriangles(a, b, &t1, &t2)) return false;
     // Orient: t1 = (a, b, c) and t2 = (b, a, d) up to rotation.
@@ -261,7 +283,10 @@ class Editor {
     const double before = Objective();
     const double after =
         Objective(t_, odt_sum_ - odt_old + odt_new, mips_sum_ - mips_old + mips_new);
-    if (!(after < before - 1e-12 * std::abs(before))) return false;
+    if (by_quality ? !(WorstQuality({n1, n2}) > WorstQuality({triangles_[t1], triangles_[t2]}))
+                   : !(after < before - 1e-12 * std::abs(before))) {
+      return false;
+    }
     Replace(t1, n1);
     Replace(t2, n2);
     odt_sum_ += odt_new - odt_old;
@@ -276,9 +301,17 @@ class Editor {
   // it lay on the straight segment of its neighbours. A corner of one shape can so move past a
   // corner of another along the boundary (square -> hexagon: a square corner onto a hexagon
   // corner), which sliding alone never does: the optimizer's sliders stop at corners.
-  bool TryCollapse(int a, int b) {
+  //
+  // With by_quality (sliver removal) the place is the one with the better worst quality of the
+  // new triangles, and the collapse must raise the worst quality of the triangles it changes
+  // instead of not raising the objective.
+  //
+  // Also with by_quality, b may merge into a boundary neighbour a it (nearly) coincides with in
+  // every shape where b is not straight (CoincidentAlong): a slider that slid onto its neighbour.
+  bool TryCollapse(int a, int b, bool by_quality = false) {
     if (removed_[a] || removed_[b] || locked_[a] || locked_[b]) return false;
-    const bool along_boundary = MergeableAlong(a, b);
+    const bool coincident = by_quality && !MergeableAlong(a, b) && CoincidentAlong(a, b);
+    const bool along_boundary = coincident || MergeableAlong(a, b);
     if (protected_[b] && !along_boundary) return false;
     int t1 = -1, t2 = -1;
     const int on_edge = EdgeTriangleCount(a, b, &t1, &t2);
@@ -311,9 +344,16 @@ class Editor {
     std::vector<Point> original(num_shapes), saved(num_shapes);
     for (int s = 0; s < num_shapes; ++s) {
       original[s] = saved[s] = shapes_[s][a];
-      // Along the boundary, a shape where b is a corner keeps b's place (see above).
-      if (along_boundary && !(straight_[b] >> s & 1)) saved[s] = shapes_[s][b];
+      // Along the boundary, a shape where b is a corner keeps b's place (see above). A
+      // coincident pair keeps the place of the one whose removal changes the shape's boundary
+      // polygon less (none at all for a slider that slid onto a corner), a fixed a its own.
+      if (along_boundary && !(straight_[b] >> s & 1)) {
+        if (!coincident || (!fixed_[a] && DropArea2(s, a) < DropArea2(s, b))) {
+          saved[s] = shapes_[s][b];
+        }
+      }
     }
+    // Minimized: the objective, or (by_quality) minus the worst quality.
     double best = std::numeric_limits<double>::infinity();
     int best_place = -1;
     double best_odt = 0.0, best_mips = 0.0;
@@ -326,8 +366,9 @@ class Editor {
       if (ok) {
         double odt_new, mips_new;
         Terms(new_tris, &odt_new, &mips_new);
-        const double after = Objective(t_ - on_edge, odt_sum_ - odt_old + odt_new,
-                                       mips_sum_ - mips_old + mips_new);
+        const double after = by_quality ? -WorstQuality(new_tris)
+                                        : Objective(t_ - on_edge, odt_sum_ - odt_old + odt_new,
+                                                    mips_sum_ - mips_old + mips_new);
         if (after < best) {
           best = after;
           best_place = place;
@@ -339,7 +380,8 @@ class Editor {
     for (int s = 0; s < num_shapes; ++s) {
       shapes_[s][a] = best_place == 1 ? Point(0.5 * (saved[s] + shapes_[s][b])) : saved[s];
     }
-    if (best_place < 0 || !(best <= before)) {
+    const double limit = by_quality ? -WorstQuality(old_tris) : before;
+    if (best_place < 0 || (by_quality ? !(best < limit) : !(best <= limit))) {
       for (int s = 0; s < num_shapes; ++s) shapes_[s][a] = original[s];
       return false;
     }
@@ -359,7 +401,7 @@ class Editor {
     }
     removed_[b] = 1;
     t_ -= on_edge;
-    corner_swaps_ += along_boundary && straight_[b] != all_straight_;
+    corner_swaps_ += along_boundary && !coincident && straight_[b] != all_straight_;
     if (along_boundary) {  // a and b's other boundary neighbour c become neighbours
       const int c = boundary_nbrs_[b][0] == a ? boundary_nbrs_[b][1] : boundary_nbrs_[b][0];
       for (auto [v, old_nbr, new_nbr] : {std::tuple(a, b, c), std::tuple(c, b, a)}) {
@@ -463,6 +505,135 @@ class Editor {
     mips_sum_ += mips_new - mips_old;
     locked_[a] = locked_[b] = 1;
     return true;
+  }
+
+  // Sliver removal: triangle t = (a, b, c) on boundary edge (a, b), c an interior vertex lying
+  // almost on that edge in every shape. c moves onto the edge (its projection, strictly inside
+  // the segment) in every shape and joins the boundary between a and b; t disappears. Every
+  // shape's domain stays the same point set (c lies on the polygon's edge); with the optimizer's
+  // outlines the projection must also lie on the shape's outline (ShapeOutline::Locate), so
+  // every boundary vertex stays on it. Accepted if c's other triangles stay positive
+  // (min_area_ratio) and their worst quality beats t's.
+  bool TrySnap(int a, int b, int c) {
+    if (removed_[c] || locked_[a] || locked_[b] || locked_[c] || protected_[c]) return false;
+    if (boundary_nbrs_[c][0] >= 0) return false;  // c on a boundary already
+    int t1 = -1, t2 = -1;
+    if (EdgeTriangleCount(a, b, &t1, &t2) != 1) return false;
+    if (boundary_nbrs_[a][0] != b && boundary_nbrs_[a][1] != b) return false;
+    const Triangle sliver = triangles_[t1];
+    if (sliver[0] != c && sliver[1] != c && sliver[2] != c) return false;
+    const int num_shapes = static_cast<int>(shapes_.size());
+    std::vector<Point> original(num_shapes);
+    for (int s = 0; s < num_shapes; ++s) {
+      const Point& pa = shapes_[s][a];
+      const Point ab = shapes_[s][b] - pa;
+      const double lambda = (shapes_[s][c] - pa).dot(ab) / ab.squaredNorm();
+      if (!(lambda > 0.05 && lambda < 0.95)) return false;
+      if (outlines_ != nullptr) {
+        const ShapeOutline& outline = (*outlines_)[s];
+        if (!outline.Locate(pa + lambda * ab, outline.tolerance())) return false;
+      }
+      original[s] = shapes_[s][c];
+    }
+    std::vector<Triangle> others;
+    for (int t : incident_[c]) {
+      if (t != t1) others.push_back(triangles_[t]);
+    }
+    std::vector<Triangle> old_tris = others;
+    old_tris.push_back(sliver);
+    const double old_worst = WorstQuality(old_tris);
+    double odt_old, mips_old;
+    Terms(old_tris, &odt_old, &mips_old);
+    for (int s = 0; s < num_shapes; ++s) {
+      const Point& pa = shapes_[s][a];
+      const Point ab = shapes_[s][b] - pa;
+      shapes_[s][c] = pa + (shapes_[s][c] - pa).dot(ab) / ab.squaredNorm() * ab;
+    }
+    bool ok = true;
+    for (const Triangle& tri : others) ok = ok && Positive(tri);
+    if (!ok || !(WorstQuality(others) > old_worst)) {
+      for (int s = 0; s < num_shapes; ++s) shapes_[s][c] = original[s];
+      return false;
+    }
+    double odt_new, mips_new;
+    Terms(others, &odt_new, &mips_new);
+    Kill(t1);
+    for (int t : incident_[c]) {
+      for (int v : triangles_[t]) MarkDirty(v);
+    }
+    --t_;
+    odt_sum_ += odt_new - odt_old;
+    mips_sum_ += mips_new - mips_old;
+    boundary_nbrs_[c] = {a, b};
+    for (auto [v, other] : {std::pair(a, b), std::pair(b, a)}) {
+      std::array<int, 2>& nbrs = boundary_nbrs_[v];
+      (nbrs[0] == other ? nbrs[0] : nbrs[1]) = c;
+    }
+    protected_[c] = 1;
+    if (options_.boundary_collapses && shapes_.size() <= 64) UpdateStraight(c);
+    boundary_splits_.push_back({a, b, c});
+    locked_[a] = locked_[b] = locked_[c] = 1;
+    ++snaps_;
+    return true;
+  }
+
+  // One attempt on a sliver, triangle t: a needle (one edge much shorter than the longest, in the
+  // shape where t is worst) collapses that edge; a cap (a corner near the opposite, longest edge)
+  // flips that edge if it is interior or snaps the corner onto it if it is on the boundary; then
+  // collapses of the corner into either end of the longest edge. All judged by quality.
+  bool TryRemoveSliver(int t) {
+    if (!alive_[t]) return false;
+    const Triangle tri = triangles_[t];
+    int worst_shape = 0;
+    double worst = std::numeric_limits<double>::infinity();
+    for (size_t s = 0; s < shapes_.size(); ++s) {
+      const double q = Quality(s, tri);
+      if (q < worst) worst = q, worst_shape = static_cast<int>(s);
+    }
+    const Points& x = shapes_[worst_shape];
+    // Edge k is opposite corner k.
+    std::array<double, 3> length;
+    for (int k = 0; k < 3; ++k) length[k] = (x[tri[(k + 1) % 3]] - x[tri[(k + 2) % 3]]).norm();
+    const int longest =
+        static_cast<int>(std::max_element(length.begin(), length.end()) - length.begin());
+    const int shortest =
+        static_cast<int>(std::min_element(length.begin(), length.end()) - length.begin());
+    const int c = tri[longest], a = tri[(longest + 1) % 3], b = tri[(longest + 2) % 3];
+    if (length[shortest] < 0.2 * length[longest]) {
+      const int p = tri[(shortest + 1) % 3], q = tri[(shortest + 2) % 3];
+      if (TryCollapse(p, q, true) || TryCollapse(q, p, true)) return true;
+    }
+    int t1 = -1, t2 = -1;
+    const int on_edge = EdgeTriangleCount(a, b, &t1, &t2);
+    if (on_edge == 2 && !locked_[a] && !locked_[b] && !locked_[c] && TryFlip(a, b, true)) {
+      locked_[a] = locked_[b] = locked_[c] = 1;
+      return true;
+    }
+    if (on_edge == 1 && TrySnap(a, b, c)) return true;
+    return TryCollapse(a, c, true) || TryCollapse(b, c, true);
+  }
+
+  // Live triangles whose quality is below min_quality in some shape, worst first.
+  std::vector<int> Slivers(double min_quality) const {
+    std::vector<std::pair<double, int>> found;
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+      if (!alive_[t]) continue;
+      const double q = WorstQuality({triangles_[t]});
+      if (q < min_quality) found.push_back({q, static_cast<int>(t)});
+    }
+    std::sort(found.begin(), found.end());
+    std::vector<int> out;
+    for (const auto& [q, t] : found) out.push_back(t);
+    return out;
+  }
+  void Unlock() { std::fill(locked_.begin(), locked_.end(), 0); }
+  int snaps() const { return snaps_; }
+  double WorstQuality() const {
+    double q = std::numeric_limits<double>::infinity();
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+      if (alive_[t]) q = std::min(q, WorstQuality({triangles_[t]}));
+    }
+    return q;
   }
 
   // Boundary edges (a, b), a < b, whose endpoints are not fixed, each once, ascending.
@@ -572,6 +743,18 @@ class Editor {
     }
   }
 
+  double Quality(size_t s, const Triangle& t) const {
+    const Points& x = shapes_[s];
+    return TriangleQuality(x[t[0]], x[t[1]], x[t[2]]);
+  }
+  double WorstQuality(const std::vector<Triangle>& tris) const {
+    double q = std::numeric_limits<double>::infinity();
+    for (const Triangle& t : tris) {
+      for (size_t s = 0; s < shapes_.size(); ++s) q = std::min(q, Quality(s, t));
+    }
+    return q;
+  }
+
   bool Positive(const Triangle& t) const {
     for (size_t s = 0; s < shapes_.size(); ++s) {
       const Points& x = shapes_[s];
@@ -658,7 +841,9 @@ class Editor {
   std::vector<uint64_t> straight_;  // per vertex, the shapes where it is a slider (UpdateStraight)
   uint64_t all_straight_ = 0;       // every shape's bit
   int corner_swaps_ = 0;
-  std::vector<std::array<int, 3>> boundary_splits_;  // (a, b, m): m split boundary edge (a, b)
+  int snaps_ = 0;
+  // (a, b, m): m split boundary edge (a, b), a new vertex or (TrySnap) an interior one.
+  std::vector<std::array<int, 3>> boundary_splits_;
   std::vector<double> min_area2_, mean_edge_;
   double t0_;
   int t_;
@@ -713,6 +898,11 @@ bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& a
         }
       },
       cancel);
+}
+
+double TriangleQuality(const Point& a, const Point& b, const Point& c) {
+  const double edges = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
+  return edges > 0.0 ? 2.0 * std::sqrt(3.0) * Area2(a, b, c) / edges : 0.0;
 }
 
 bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v) {
@@ -821,6 +1011,44 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
   }
   rep.objective_after = editor.Objective();
   rep.corner_swaps = editor.corner_swaps();
+  if (report != nullptr) *report = rep;
+  return editor.Compact(mesh);
+}
+
+absl::StatusOr<Multimesh> RemoveSlivers(const Multimesh& mesh, double map_weight,
+                                        double min_quality, SliverReport* report,
+                                        const CancelToken* cancel,
+                                        const std::vector<ShapeOutline>* outlines) {
+  const absl::Status cancelled_status = absl::CancelledError("comesh sliver removal cancelled");
+  absl::StatusOr<ComeshObjective> objective =
+      ComeshObjective::Create(mesh.triangles, mesh.shapes, map_weight);
+  if (!objective.ok()) return objective.status();
+  // Every operation must raise the worst quality of the triangles it changes, so new triangles
+  // need only be positive: the min_area_ratio rule would refuse to touch the thin triangles a
+  // drawing's own sharp spike needs (pentagon -> star).
+  TopologyOptions options;
+  options.min_area_ratio = 0.0;
+  Editor editor(mesh, *objective, options, outlines, cancel);
+  if (editor.cancelled() || Cancelled(cancel)) return cancelled_status;
+  SliverReport rep;
+  rep.worst_quality_before = editor.WorstQuality();
+  // Each sweep touches a sliver's neighbourhood once (locks); a later sweep takes what an earlier
+  // one left or made.
+  for (int sweep = 0; sweep < kSliverSweeps; ++sweep) {
+    const std::vector<int> slivers = editor.Slivers(min_quality);
+    if (sweep == 0) rep.slivers_before = static_cast<int>(slivers.size());
+    int changed = 0;
+    for (int t : slivers) {
+      if (Cancelled(cancel)) return cancelled_status;
+      changed += editor.TryRemoveSliver(t);
+    }
+    rep.operations += changed;
+    editor.Unlock();
+    if (changed == 0) break;
+  }
+  rep.slivers_after = static_cast<int>(editor.Slivers(min_quality).size());
+  rep.worst_quality_after = editor.WorstQuality();
+  rep.snaps = editor.snaps();
   if (report != nullptr) *report = rep;
   return editor.Compact(mesh);
 }

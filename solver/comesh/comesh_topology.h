@@ -85,6 +85,10 @@ std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Tria
 bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& alive,
               const CancelToken* cancel, std::vector<std::pair<std::pair<int, int>, int>>* uses);
 
+// Triangle quality 2 sqrt(3) A / (sum of squared edge lengths), A the signed area: 1 for an
+// equilateral triangle, 0 for a flat one, negative if inverted.
+double TriangleQuality(const Point& a, const Point& b, const Point& c);
+
 // True if v lies strictly inside segment ab (collinear within 1e-9 |ab|^2 of cross product, and
 // strictly between a and b): the optimizer's slider test and the topology pass's boundary one.
 bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v);
@@ -102,5 +106,32 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
                                           TopologyReport* report = nullptr,
                                           const CancelToken* cancel = nullptr,
                                           const std::vector<ShapeOutline>* outlines = nullptr);
+
+// Sliver removal, the optimizer's last step: triangles whose quality (TriangleQuality) is below
+// min_quality in some shape, worst first, each get one local operation applied identically to
+// every shape: a needle collapses its short edge (also a boundary edge whose ends (nearly)
+// coincide where one of them is a corner: within 1e-2 mean edge lengths, the merged vertex where
+// the boundary polygon changes least); a cap flips its long edge (interior) or, on the boundary,
+// its corner moves onto that boundary edge and joins the boundary (a "snap": the triangle
+// disappears, every shape's domain is unchanged; with `outlines`, only onto a point of every
+// shape's outline); else the corner collapses into an end of the long edge. Each must keep every
+// changed triangle positive (min_area_ratio of the mean area, as in ImproveTopology) and raise the
+// worst quality of the triangles it changes; the objective may rise. Up to kSliverSweeps sweeps,
+// until one changes nothing. Inner runs can make such slivers: two boundary sliders that meet, an
+// interior vertex pressed onto a boundary edge, with the same shape in every drawing, so the map
+// term (a ratio between shapes) does not resist, and the ODT term barely does.
+struct SliverReport {
+  int slivers_before = 0;  // triangles below min_quality
+  int slivers_after = 0;
+  int operations = 0;  // accepted operations
+  int snaps = 0;       // of them, corners moved onto the boundary
+  double worst_quality_before = 0.0;
+  double worst_quality_after = 0.0;
+};
+inline constexpr int kSliverSweeps = 4;
+absl::StatusOr<Multimesh> RemoveSlivers(const Multimesh& mesh, double map_weight,
+                                        double min_quality, SliverReport* report = nullptr,
+                                        const CancelToken* cancel = nullptr,
+                                        const std::vector<ShapeOutline>* outlines = nullptr);
 
 }  // namespace inbetween::solver

@@ -34,6 +34,7 @@ struct ComeshBenchArgs {
 // Parses --threads T, --json FILE, --max-outer K, --weight W, --blend B, --no-cure,
 // --no-corner-swaps, --no-boundary-splits (TopologyOptions::corner_swaps, boundary_splits off),
 // --no-outline-sliding (ComeshOptions::slide_outline off), --outline-corner DEGREES,
+// --min-quality Q (ComeshOptions::min_quality; 0: no sliver removal),
 // --double-substitutions (ComeshOptions::float_substitutions off),
 // --cure-keep C, --step-fraction F, --scale-by-inverse, --history M, --tolerance R, --laplacian
 // (BCQN's H0), --refresh K, --relax F (0: no local relaxation), --relax-over-mean M,
@@ -49,7 +50,7 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
                  "[--no-corner-swaps] [--no-boundary-splits] [--no-outline-sliding] "
-                 "[--outline-corner DEGREES] "
+                 "[--outline-corner DEGREES] [--min-quality Q] "
                  "[--cure-keep C] [--double-substitutions] [--step-fraction F] [--outer-inner K] "
                  "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
                  "[--relax F] "
@@ -79,6 +80,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.json_path = next();
     } else if (a == "--threads") {
       args.options.threads = std::atoi(next());
+    } else if (a == "--min-quality") {
+      args.options.min_quality = std::atof(next());
     } else if (a == "--max-outer") {
       args.options.max_outer = std::atoi(next());
     } else if (a == "--weight") {
@@ -150,6 +153,8 @@ inline void PrintPhases(const solver::ComeshReport& r) {
       "  phases (s): hessian %.3f, direction %.3f, step bound %.3f, line search %.3f, "
       "relax %.3f, topology %.3f\n",
       p.hessian, p.direction, p.step_bound, p.line_search, p.relax, p.topology);
+  std::printf("  slivers: %d below min_quality, %d operations, worst quality %.4f\n", r.slivers,
+              r.sliver_operations, r.worst_quality);
 }
 
 // OptimizeComesh, timed: a run shorter than a second is repeated until `repeat` runs and at
@@ -198,6 +203,8 @@ inline nlohmann::json ComeshRow(const std::string& name, const solver::ComeshRep
           {"seconds", r.seconds},
           {"map_energy", r.map_energy},
           {"mesh_energy", r.mesh_energy},
+          {"worst_quality", r.worst_quality},
+          {"slivers", r.slivers},
           {"paper_seconds", paper_seconds},
           {"phase_seconds",
            {{"hessian", r.phase_seconds.hessian},

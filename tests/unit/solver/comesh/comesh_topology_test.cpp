@@ -423,5 +423,125 @@ TEST(ComeshTopologyTest, BoundarySplitsCutALongBoundaryEdge) {
   }
 }
 
+// Twice the area of shape s's boundary polygon (the loop as listed).
+double LoopArea2(const Multimesh& m, int s) {
+  const Points& x = m.shapes.at(s);
+  double a = 0.0;
+  for (size_t k = 0; k < m.boundary.size(); ++k) {
+    const Point& p = x[m.boundary[k]];
+    const Point& q = x[m.boundary[(k + 1) % m.boundary.size()]];
+    a += p.x() * q.y() - p.y() * q.x();
+  }
+  return a;
+}
+
+double WorstQuality(const Multimesh& m) {
+  double q = 1.0;
+  for (const Points& x : m.shapes) {
+    for (const Triangle& t : m.triangles)
+      q = std::min(q, TriangleQuality(x[t[0]], x[t[1]], x[t[2]]));
+  }
+  return q;
+}
+
+// The unit square, corners 0-3, with interior vertex 4 pressed almost onto the bottom edge (0, 1)
+// and interior vertex 5 above it; shape 1 a similar copy. Triangle (0, 1, 4) is a cap sliver
+// (quality ~0.012 at height 0.005) in both shapes.
+Multimesh CapOnTheBoundary(double height) {
+  Multimesh m;
+  m.shapes.push_back(
+      {Point(0, 0), Point(1, 0), Point(1, 1), Point(0, 1), Point(0.5, height), Point(0.5, 0.6)});
+  m.shapes.push_back(testing::Similar(m.shapes[0], 0.3, 1.5, Point(2, 0)));
+  m.triangles = {{0, 1, 4}, {1, 5, 4}, {0, 4, 5}, {1, 2, 5}, {0, 5, 3}, {3, 5, 2}};
+  m.boundary = {0, 1, 2, 3};
+  m.boundary_loops = {m.boundary};
+  return m;
+}
+
+TEST(ComeshSliverTest, TriangleQualityIsOneForEquilateralAndZeroForFlat) {
+  EXPECT_NEAR(TriangleQuality(Point(0, 0), Point(1, 0), Point(0.5, std::sqrt(0.75))), 1.0, 1e-12);
+  EXPECT_EQ(TriangleQuality(Point(0, 0), Point(1, 0), Point(2, 0)), 0.0);
+  EXPECT_LT(TriangleQuality(Point(0, 0), Point(0.5, 1), Point(1, 0)), 0.0);  // clockwise
+  EXPECT_EQ(TriangleQuality(Point(1, 1), Point(1, 1), Point(1, 1)), 0.0);
+}
+
+// A cap on the boundary: vertex 4 moves onto edge (0, 1) and joins the boundary between 0 and 1;
+// the sliver goes, every shape's domain stays the same, the numbering is kept.
+TEST(ComeshSliverTest, SnapsAnInteriorVertexOntoTheBoundaryEdgeUnderIt) {
+  const Multimesh m = CapOnTheBoundary(0.005);
+  ASSERT_TRUE(ValidateMultimesh(m).ok()) << ValidateMultimesh(m);
+  ASSERT_LT(WorstQuality(m), 0.02);
+  SliverReport report;
+  absl::StatusOr<Multimesh> out = RemoveSlivers(m, 0.5, 0.02, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  ExpectValidEverywhere(*out);
+  EXPECT_EQ(report.slivers_before, 1);
+  EXPECT_EQ(report.slivers_after, 0);
+  EXPECT_EQ(report.operations, 1);
+  EXPECT_EQ(report.snaps, 1);
+  EXPECT_EQ(out->num_vertices(), m.num_vertices());
+  EXPECT_EQ(out->triangles.size(), m.triangles.size() - 1);
+  EXPECT_EQ(out->boundary, (std::vector<int>{0, 4, 1, 2, 3}));
+  EXPECT_EQ(out->boundary_loops, std::vector<std::vector<int>>{out->boundary});
+  EXPECT_GT(report.worst_quality_after, 0.3);
+  EXPECT_EQ(report.worst_quality_after, WorstQuality(*out));
+  for (int s = 0; s < 2; ++s) {
+    EXPECT_NEAR(LoopArea2(*out, s), LoopArea2(m, s), 1e-12) << "shape " << s;
+    const Point& a = out->shapes[s][0];
+    const Point& b = out->shapes[s][1];
+    const Point& c = out->shapes[s][4];
+    EXPECT_NEAR((c - a).x() * (b - a).y() - (c - a).y() * (b - a).x(), 0.0, 1e-12);
+  }
+}
+
+// Below the threshold only: the same cap at a height that leaves quality above min_quality, and a
+// mesh without slivers, come back unchanged.
+TEST(ComeshSliverTest, LeavesTrianglesAboveTheThresholdAlone) {
+  for (const Multimesh& m : {CapOnTheBoundary(0.1), testing::SquareGrid(4)}) {
+    ASSERT_GT(WorstQuality(m), 0.02);
+    SliverReport report;
+    absl::StatusOr<Multimesh> out = RemoveSlivers(m, 0.5, 0.02, &report);
+    ASSERT_TRUE(out.ok()) << out.status();
+    EXPECT_EQ(report.slivers_before, 0);
+    EXPECT_EQ(report.operations, 0);
+    EXPECT_EQ(out->triangles, m.triangles);
+    EXPECT_EQ(out->shapes, m.shapes);
+    EXPECT_EQ(out->boundary, m.boundary);
+  }
+}
+
+// Two boundary neighbours that coincide where one of them is a corner (a slider that slid onto
+// its neighbour): the bottom side of a grid gets vertex 1 almost onto corner 0, exactly on the
+// side in shape 0 but 1e-8 off it in shape 1 (a corner there, so no plain boundary collapse may
+// take it). Sliver removal merges the two, keeping corner 0 where it is and every shape's
+// boundary polygon within that tiny corner.
+TEST(ComeshSliverTest, MergesBoundaryNeighboursThatCoincide) {
+  Multimesh m = testing::SquareGrid(6);
+  m.shapes.push_back(testing::Similar(m.shapes[0], 0.4, 1.7, Point(3, 1)));
+  m.boundary_loops = {m.boundary};
+  for (int s = 0; s < 2; ++s) {
+    Points& x = m.shapes[s];
+    x[1] = x[0] + 1e-6 * (x[1] - x[0]);
+  }
+  const Point side = m.shapes[1][6] - m.shapes[1][0];
+  m.shapes[1][1] += 1e-8 * Point(-side.y(), side.x()) / side.norm();  // inwards
+  ASSERT_TRUE(ValidateMultimesh(m).ok()) << ValidateMultimesh(m);
+  ASSERT_LT(WorstQuality(m), 1e-3);
+  SliverReport report;
+  absl::StatusOr<Multimesh> out = RemoveSlivers(m, 0.5, 0.02, &report);
+  ASSERT_TRUE(out.ok()) << out.status();
+  ExpectValidEverywhere(*out);
+  EXPECT_EQ(report.slivers_after, 0);
+  EXPECT_GT(WorstQuality(*out), 0.02);
+  EXPECT_EQ(out->num_vertices(), m.num_vertices() - 1);
+  EXPECT_EQ(out->boundary.size(), m.boundary.size() - 1);
+  for (int s = 0; s < 2; ++s) {
+    int at_corner = 0;
+    for (int v : out->boundary) at_corner += out->shapes[s][v] == m.shapes[s][0];
+    EXPECT_EQ(at_corner, 1) << "shape " << s;
+    EXPECT_NEAR(LoopArea2(*out, s), LoopArea2(m, s), 1e-8) << "shape " << s;
+  }
+}
+
 }  // namespace
 }  // namespace inbetween::solver
