@@ -468,7 +468,8 @@ absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
               {"outer", optimized->outer_iterations()},
               {"seconds", optimized->seconds()},
               {"map_energy", optimized->stats().map_energy()},
-              {"mesh_energy", optimized->stats().mesh_energy()}};
+              {"mesh_energy", optimized->stats().mesh_energy()},
+              {"worst_quality", optimized->stats().worst_quality()}};
   }
   std::error_code ec;
   std::filesystem::create_directories(options.out_dir, ec);

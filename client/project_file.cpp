@@ -162,7 +162,7 @@ absl::Status ParseMeshing(const Node& node, v1::MeshingParameters* out) {
 absl::Status ParseComesh(const Node& node, v1::ComeshParameters* out) {
   if (absl::Status s = node.CheckKeys(
           {"map_weight", "max_outer_iterations", "max_inner_iterations", "tolerance",
-           "outer_tolerance", "outline_corner_degrees"});
+           "outer_tolerance", "outline_corner_degrees", "min_quality"});
       !s.ok()) {
     return s;
   }
@@ -189,6 +189,10 @@ absl::Status ParseComesh(const Node& node, v1::ComeshParameters* out) {
   if (node.Has("outline_corner_degrees")) {
     PROJECT_ASSIGN_OR_RETURN(v, node.Child("outline_corner_degrees").Number(0.0, 180.0));
     out->set_outline_corner_degrees(v);
+  }
+  if (node.Has("min_quality")) {
+    PROJECT_ASSIGN_OR_RETURN(v, node.Child("min_quality").Number(0.0, 0.999));
+    out->set_min_quality(v);
   }
   return absl::OkStatus();
 }
@@ -466,6 +470,7 @@ json ProjectToJson(const Project& project, const std::filesystem::path& base_dir
   if (c.max_inner_iterations()) comesh["max_inner_iterations"] = c.max_inner_iterations();
   if (c.tolerance() > 0) comesh["tolerance"] = c.tolerance();
   if (c.has_outer_tolerance()) comesh["outer_tolerance"] = c.outer_tolerance();
+  if (c.has_min_quality()) comesh["min_quality"] = c.min_quality();
   if (c.has_outline_corner_degrees()) {
     comesh["outline_corner_degrees"] = c.outline_corner_degrees();
   }

@@ -51,6 +51,13 @@ absl::Status ValidateComesh(const inbetween::v1::ComeshParameters& comesh,
       return s;
     }
   }
+  if (comesh.has_min_quality()) {
+    if (!(std::isfinite(comesh.min_quality()) && comesh.min_quality() >= 0 &&
+          comesh.min_quality() < 1)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".min_quality = ", comesh.min_quality(), " is not in [0, 1)"));
+    }
+  }
   if (comesh.tolerance() != 0) {
     if (!(std::isfinite(comesh.tolerance()) && comesh.tolerance() > 0 && comesh.tolerance() < 1)) {
       return absl::InvalidArgumentError(
@@ -187,6 +194,7 @@ solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& com
     options.slide_outline = comesh.outline_corner_degrees() > 0.0;
     if (options.slide_outline) options.outline_corner_degrees = comesh.outline_corner_degrees();
   }
+  if (comesh.has_min_quality()) options.min_quality = comesh.min_quality();  // unset: 0.02
   return options;
 }
 

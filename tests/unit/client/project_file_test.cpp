@@ -28,7 +28,8 @@ TEST(ProjectFileTest, FullProjectRoundTrips) {
                  {"file": "b.svg", "key_time": 1, "openings": [[[2,2],[3,3],[4,2]]]}],
     "correspondences": [[[0,0],[5,5]]],
     "meshing": {"boundary_vertices": 96, "shape_bound": 0.1},
-    "comesh": {"map_weight": 0.3, "max_outer_iterations": 7, "outline_corner_degrees": 40},
+    "comesh": {"map_weight": 0.3, "max_outer_iterations": 7, "outline_corner_degrees": 40,
+               "min_quality": 0.05},
     "inbetween": {"method": "alexa", "frames": 30, "timing": "ease_in_out", "ease": [0.5],
                   "stiffness": [{"polygon": [[0,0],[1,0],[1,1]], "kappa": 10}],
                   "lambda": 2, "tau": 0.2, "alpha": 0.25, "epsilon": 0.5, "rho": 3,
@@ -41,6 +42,7 @@ TEST(ProjectFileTest, FullProjectRoundTrips) {
   EXPECT_DOUBLE_EQ(p->parameters.inbetween().tau(), 0.2);
   EXPECT_DOUBLE_EQ(p->parameters.comesh().map_weight(), 0.3);
   EXPECT_DOUBLE_EQ(p->parameters.comesh().outline_corner_degrees(), 40.0);
+  EXPECT_DOUBLE_EQ(p->parameters.comesh().min_quality(), 0.05);
   EXPECT_EQ(p->drawings[0].cuts.size(), 1u);
   EXPECT_EQ(p->drawings[1].openings[0].size(), 3u);
   EXPECT_EQ(p->output.width, 256);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "server/parameters.h"
+#include "solver/comesh/comesh_topology.h"
 #include "solver/core/types.h"
 #include "solver/mesh/validate.h"
 #include "tests/unit/server/test_server.h"
@@ -685,6 +686,18 @@ TEST_F(InbetweenServiceTest, FullFlowOnTheSquareHexagonExample) {
   EXPECT_GT(result.stats().vertices(), 3u);
   EXPECT_EQ(result.stats().triangles(), static_cast<uint32_t>(result.multimesh().triangles_size()));
   EXPECT_EQ(result.stats().inverted_triangles(), 0u);
+  // The worst quality over both drawings, from the multimesh itself.
+  double worst = 1.0;
+  for (const v1::ShapeGeometry& shape : result.multimesh().shapes()) {
+    for (const v1::Triangle& t : result.multimesh().triangles()) {
+      const auto p = [&](uint32_t v) {
+        return solver::Point(shape.vertices(v).x(), shape.vertices(v).y());
+      };
+      worst = std::min(worst, solver::TriangleQuality(p(t.a()), p(t.b()), p(t.c())));
+    }
+  }
+  EXPECT_GT(worst, 0.0);
+  EXPECT_DOUBLE_EQ(result.stats().worst_quality(), worst);
   EXPECT_EQ(result.session().multimesh_stats().vertices(), result.stats().vertices());
   EXPECT_FALSE(build.progress.empty());
   for (const v1::Progress& p : build.progress) {

@@ -80,6 +80,23 @@ TEST(ParametersTest, OutlineCornerDegreesIsCheckedAndReachesTheOptimizer) {
   EXPECT_EQ(ValidateComesh(c, "comesh").code(), absl::StatusCode::kInvalidArgument);
 }
 
+TEST(ParametersTest, MinQualityIsCheckedAndReachesTheOptimizer) {
+  v1::ComeshParameters c;
+  EXPECT_DOUBLE_EQ(ToComeshOptions(c).min_quality, 0.02);  // unset: the solver's default
+  c.set_min_quality(0.0);                                    // off
+  ASSERT_TRUE(ValidateComesh(c, "comesh").ok());
+  EXPECT_EQ(ToComeshOptions(c).min_quality, 0.0);
+  c.set_min_quality(0.1);
+  ASSERT_TRUE(ValidateComesh(c, "comesh").ok());
+  EXPECT_DOUBLE_EQ(ToComeshOptions(c).min_quality, 0.1);
+  for (double bad : {1.0, -0.1, std::numeric_limits<double>::quiet_NaN()}) {
+    c.set_min_quality(bad);
+    const absl::Status s = ValidateComesh(c, "comesh");
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << bad;
+    EXPECT_THAT(std::string(s.message()), HasSubstr("comesh.min_quality = ")) << bad;
+  }
+}
+
 TEST(ParametersTest, TimingCurvesMapOntoTheSolver) {
   v1::InbetweenParameters p;
   absl::StatusOr<solver::TimingOptions> t = ToTimingOptions(p, 3, "parameters");
