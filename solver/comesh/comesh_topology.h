@@ -85,7 +85,7 @@ std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Tria
 bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& alive,
               const CancelToken* cancel, std::vector<std::pair<std::pair<int, int>, int>>* uses);
 
-// Triangle quality 2 sqrt(3) A / (sum of squared edge lengths), A the signed area: 1 for an
+// Triangle quality 4 sqrt(3) A / (sum of squared edge lengths), A the signed area: 1 for an
 // equilateral triangle, 0 for a flat one, negative if inverted.
 double TriangleQuality(const Point& a, const Point& b, const Point& c);
 

@@ -42,6 +42,25 @@ inner = [int(e["detail"].split()[3]) for e in iterates]
 assert inner == sorted(inner) and len(set(inner)) == len(inner), inner
 print(f"optimize progress: {len(iterates)} iterates, {len(passes)} passes")
 PY
+# report.json: the paper's columns and the worst triangle quality of multimesh.json's shapes.
+python3 - opt_out <<'PY'
+import json, math, os, sys
+report = json.load(open(os.path.join(sys.argv[1], "report.json")))
+for key in ("vertices_before", "vertices_after", "inner", "outer", "seconds", "map_energy",
+            "mesh_energy", "worst_quality"):
+    assert key in report, (key, report)
+mesh = json.load(open(os.path.join(sys.argv[1], "multimesh.json")))
+worst = 1.0
+for shape in (s["vertices"] for s in mesh["shapes"]):
+    for a, b, c in mesh["triangles"]:
+        (ax, ay), (bx, by), (cx, cy) = shape[a], shape[b], shape[c]
+        area2 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+        edges = sum((p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2
+                    for p, q in ((shape[a], shape[b]), (shape[b], shape[c]), (shape[c], shape[a])))
+        worst = min(worst, 2 * math.sqrt(3) * area2 / edges)
+assert abs(report["worst_quality"] - worst) < 1e-6 and worst >= 0.02, (report, worst)
+print(f"report.json: worst quality {worst:.4f}")
+PY
 
 # -q: no progress output (neither JSON events nor a bar), the result path still on stdout.
 "$CLI_BIN" -q animate "$ex/square.svg" "$ex/hexagon.svg" --frames 6 --format json \
