@@ -207,6 +207,10 @@ try {
     assert.ok(points >= 2, `chart has ${points} points`);
     assert.equal(await page.locator("#chart polyline").count(), 2);
     assert.match(await text(page, "#session-info"), / optimized$/);
+    // The optimized multimesh's worst triangle quality (MultimeshStats.worst_quality), in (0, 1].
+    const quality = /worst triangle quality (\d\.\d{3})$/.exec(await text(page, "#mesh-stats"));
+    assert.ok(quality && Number(quality[1]) > 0 && Number(quality[1]) <= 1,
+      await text(page, "#mesh-stats"));
   });
 
   await step("inbetweens stream in and play", async () => {

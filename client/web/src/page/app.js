@@ -586,7 +586,8 @@ function setProgress(p) {
 function showStats(s) {
   $("mesh-stats").textContent =
     `${s.vertices} vertices · ${s.triangles} triangles · ${s.shapes} shapes · ` +
-    `map energy ${s.mapEnergy.toFixed(4)} · mesh energy ${s.meshEnergy.toPrecision(4)}`;
+    `map energy ${s.mapEnergy.toFixed(4)} · mesh energy ${s.meshEnergy.toPrecision(4)} · ` +
+    `worst triangle quality ${s.worstQuality.toFixed(3)}`;
 }
 
 async function heavy(slot, run) {
