@@ -1516,7 +1516,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     Stopwatch topology_clock;
     absl::StatusOr<Multimesh> cleaned =
         RemoveSlivers(current, options.map_weight, options.min_quality, &slivers, cancel,
-                      outlines.empty() ? nullptr : &outlines);
+                      outlines.empty() ? nullptr : &outlines, &mesh);
     if (absl::IsCancelled(cleaned.status())) {
       return absl::CancelledError("comesh optimization cancelled at sliver removal");
     }

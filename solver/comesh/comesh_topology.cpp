@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <optional>
@@ -14,9 +14,14 @@
 #include <vector>
 
 #include "solver/comesh/comesh_objective.h"
+#include "solver/mesh/validate.h"
 
 namespace inbetween::solver {
 namespace {
+
+bool LexicographicLess(const Point& p, const Point& q) {
+  return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y());
+}
 
 double Area2(const Point& a, const Point& b, const Point& c) {
   const Point ab = b - a, ac = c - a;
@@ -86,6 +91,7 @@ class Editor {
       mips_sum_ += mips;
     }
     boundary_nbrs_.assign(n, {-1, -1});
+    many_boundary_edges_.assign(n, 0);
     fixed_.assign(n, 0);  // never slides: a non-manifold edge, cohesive, >2 boundary edges
     std::vector<char>& fixed = fixed_;
     for (const auto& [edge, count] : uses) {
@@ -100,6 +106,7 @@ class Editor {
           nb[1] = u;
         } else {
           fixed[v] = 1;
+          many_boundary_edges_[v] = 1;
         }
       }
     }
@@ -231,6 +238,13 @@ class Editor {
     return true;
   }
 
+  // True if v's place in shape s is one of the anchors (RemoveSlivers).
+  bool Anchor(size_t s, int v) const {
+    if (anchors_ == nullptr) return false;
+    const Points& a = (*anchors_)[s];
+    return std::binary_search(a.begin(), a.end(), shapes_[s][v], LexicographicLess);
+  }
+
   // Twice the area the boundary polygon of shape s changes by when boundary vertex v leaves it.
   double DropArea2(size_t s, int v) const {
     const Points& x = shapes_[s];
@@ -345,12 +359,17 @@ class Editor {
     for (int s = 0; s < num_shapes; ++s) {
       original[s] = saved[s] = shapes_[s][a];
       // Along the boundary, a shape where b is a corner keeps b's place (see above). A
-      // coincident pair keeps the place of the one whose removal changes the shape's boundary
-      // polygon less (none at all for a slider that slid onto a corner), a fixed a its own.
+      // coincident pair keeps a fixed a's place, else the place that is an anchor (an input
+      // boundary point: a corner that never moved, not the slider that slid onto it), else the
+      // place of the one whose removal changes the shape's boundary polygon more.
       if (along_boundary && !(straight_[b] >> s & 1)) {
-        if (!coincident || (!fixed_[a] && DropArea2(s, a) < DropArea2(s, b))) {
-          saved[s] = shapes_[s][b];
+        bool keep_b = true;
+        if (coincident) {
+          const bool anchor_a = Anchor(s, a), anchor_b = Anchor(s, b);
+          keep_b =
+              !fixed_[a] && (anchor_a != anchor_b ? anchor_b : DropArea2(s, a) < DropArea2(s, b));
         }
+        if (keep_b) saved[s] = shapes_[s][b];
       }
     }
     // Minimized: the objective, or (by_quality) minus the worst quality.
@@ -482,6 +501,7 @@ class Editor {
     removed_.push_back(0);
     protected_.push_back(boundary ? 1 : 0);
     locked_.push_back(1);
+    many_boundary_edges_.push_back(0);
     incident_.emplace_back();
     fixed_.push_back(0);
     boundary_nbrs_.push_back(boundary ? std::array<int, 2>{a, b} : std::array<int, 2>{-1, -1});
@@ -626,6 +646,8 @@ class Editor {
     for (const auto& [q, t] : found) out.push_back(t);
     return out;
   }
+  // Between sliver sweeps: a later sweep may work where an earlier one did (Compact traces the
+  // boundary loops as they now run, whatever sequence of boundary operations made them).
   void Unlock() { std::fill(locked_.begin(), locked_.end(), 0); }
   int snaps() const { return snaps_; }
   double WorstQuality() const {
@@ -647,6 +669,51 @@ class Editor {
     }
     std::sort(edges.begin(), edges.end());
     return edges;
+  }
+
+  // The boundary loop through the first kept vertex of `loop` (an input loop, interior on the
+  // left), walked along boundary_nbrs_ in the direction of its live triangles, in editor
+  // numbering. Empty if that walk is not safe: a vertex with more than two boundary edges on the
+  // way, a step that is not a boundary edge, a kept vertex of `loop` the walk does not meet (a
+  // listed vertex inside the mesh), or no way back to the start.
+  std::vector<int> Traced(const std::vector<int>& loop) const {
+    int start = -1;
+    for (int v : loop) {
+      if (!removed_[v]) {
+        start = v;
+        break;
+      }
+    }
+    if (start < 0 || many_boundary_edges_[start]) return {};
+    auto directed = [&](int u, int w) {  // a live triangle runs u -> w
+      for (int t : incident_[u]) {
+        if (Opposite(triangles_[t], u, w) >= 0) return true;
+      }
+      return false;
+    };
+    std::vector<int> out;
+    int prev = -1, cur = start;
+    const size_t limit = removed_.size();
+    do {
+      if (many_boundary_edges_[cur] || out.size() > limit) return {};
+      out.push_back(cur);
+      const auto [n0, n1] = boundary_nbrs_[cur];
+      if (n0 < 0 || n1 < 0) return {};
+      const int next = prev < 0 ? (directed(cur, n0) ? n0 : n1) : (n0 == prev ? n1 : n0);
+      int t1 = -1, t2 = -1;
+      if (removed_[next] || EdgeTriangleCount(cur, next, &t1, &t2) != 1 || !directed(cur, next)) {
+        return {};
+      }
+      prev = cur;
+      cur = next;
+    } while (cur != start);
+    std::vector<int> sorted = out;
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return {};
+    for (int v : loop) {
+      if (!removed_[v] && !std::binary_search(sorted.begin(), sorted.end(), v)) return {};
+    }
+    return out;
   }
 
   Multimesh Compact(const Multimesh& input) const {
@@ -695,11 +762,19 @@ class Editor {
       }
       return out_loop;
     };
+    // Preferably the loop as the boundary now runs (boundary_nbrs_), which follows any sequence
+    // of boundary operations; the patched input list where it cannot be traced.
+    auto loop_of = [&](const std::vector<int>& loop) {
+      std::vector<int> out_loop = Traced(loop);
+      if (out_loop.empty()) return with_splits(kept(loop));
+      for (int& v : out_loop) v = index[v];
+      return out_loop;
+    };
     for (const std::vector<int>& loop : input.boundary_loops) {
-      out.boundary_loops.push_back(with_splits(kept(loop)));
+      out.boundary_loops.push_back(loop_of(loop));
     }
     if (input.boundary_loops.empty()) {
-      out.boundary = with_splits(kept(input.boundary));
+      out.boundary = loop_of(input.boundary);
     } else {
       for (const std::vector<int>& loop : out.boundary_loops) {
         out.boundary.insert(out.boundary.end(), loop.begin(), loop.end());
@@ -828,12 +903,16 @@ class Editor {
 
   const ComeshObjective& objective_;
   const std::vector<ShapeOutline>* outlines_ = nullptr;  // may be null
+ public:
+  const std::vector<Points>* anchors_ = nullptr;  // RemoveSlivers' anchors; may be null
+ private:
   const TopologyOptions& options_;
   std::vector<Triangle> triangles_;
   std::vector<char> alive_;
   std::vector<Points> shapes_;
   std::vector<std::vector<int>> incident_;
   std::vector<char> removed_, locked_, protected_;
+  std::vector<char> many_boundary_edges_;          // more than two boundary edges (Traced)
   std::vector<std::array<int, 2>> boundary_nbrs_;  // the two boundary neighbours, or -1
   // Never removed along the boundary, and no boundary edge at it is split: non-manifold,
   // cohesive-edge and mark vertices, and those with more than two boundary edges (constructor).
@@ -1018,8 +1097,17 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
 absl::StatusOr<Multimesh> RemoveSlivers(const Multimesh& mesh, double map_weight,
                                         double min_quality, SliverReport* report,
                                         const CancelToken* cancel,
-                                        const std::vector<ShapeOutline>* outlines) {
+                                        const std::vector<ShapeOutline>* outlines,
+                                        const Multimesh* anchor_mesh) {
   const absl::Status cancelled_status = absl::CancelledError("comesh sliver removal cancelled");
+  std::vector<Points> anchors;
+  if (anchor_mesh != nullptr) {
+    for (const Points& x : anchor_mesh->shapes) {
+      Points& a = anchors.emplace_back();
+      for (int v : anchor_mesh->boundary) a.push_back(x[v]);
+      std::sort(a.begin(), a.end(), LexicographicLess);
+    }
+  }
   absl::StatusOr<ComeshObjective> objective =
       ComeshObjective::Create(mesh.triangles, mesh.shapes, map_weight);
   if (!objective.ok()) return objective.status();
@@ -1030,6 +1118,7 @@ absl::StatusOr<Multimesh> RemoveSlivers(const Multimesh& mesh, double map_weight
   options.min_area_ratio = 0.0;
   Editor editor(mesh, *objective, options, outlines, cancel);
   if (editor.cancelled() || Cancelled(cancel)) return cancelled_status;
+  if (anchor_mesh != nullptr) editor.anchors_ = &anchors;
   SliverReport rep;
   rep.worst_quality_before = editor.WorstQuality();
   // Each sweep touches a sliver's neighbourhood once (locks); a later sweep takes what an earlier
@@ -1049,8 +1138,18 @@ absl::StatusOr<Multimesh> RemoveSlivers(const Multimesh& mesh, double map_weight
   rep.slivers_after = static_cast<int>(editor.Slivers(min_quality).size());
   rep.worst_quality_after = editor.WorstQuality();
   rep.snaps = editor.snaps();
+  Multimesh out = editor.Compact(mesh);
+  // Boundary lists that could not be traced (a vertex with more than two boundary edges) are
+  // patched from the input's, which several boundary operations at one place can defeat: then
+  // nothing is changed rather than a broken multimesh handed on.
+  if (rep.operations > 0 && !ValidateMultimesh(out).ok()) {
+    rep.slivers_after = rep.slivers_before;
+    rep.worst_quality_after = rep.worst_quality_before;
+    rep.operations = rep.snaps = 0;
+    out = mesh;
+  }
   if (report != nullptr) *report = rep;
-  return editor.Compact(mesh);
+  return out;
 }
 
 }  // namespace inbetween::solver

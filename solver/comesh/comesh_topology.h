@@ -110,8 +110,10 @@ absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weig
 // Sliver removal, the optimizer's last step: triangles whose quality (TriangleQuality) is below
 // min_quality in some shape, worst first, each get one local operation applied identically to
 // every shape: a needle collapses its short edge (also a boundary edge whose ends (nearly)
-// coincide where one of them is a corner: within 1e-2 mean edge lengths, the merged vertex where
-// the boundary polygon changes least); a cap flips its long edge (interior) or, on the boundary,
+// coincide where one of them is a corner: within 1e-2 mean edge lengths; the merged vertex keeps
+// the place that is a boundary point of `anchor_mesh` (the optimizer's input: so a drawn corner
+// keeps its exact place, not the slider that slid onto it), else the one whose removal would
+// change the boundary polygon more); a cap flips its long edge (interior) or, on the boundary,
 // its corner moves onto that boundary edge and joins the boundary (a "snap": the triangle
 // disappears, every shape's domain is unchanged; with `outlines`, only onto a point of every
 // shape's outline); else the corner collapses into an end of the long edge. Each must keep every
@@ -128,10 +130,11 @@ struct SliverReport {
   double worst_quality_before = 0.0;
   double worst_quality_after = 0.0;
 };
-inline constexpr int kSliverSweeps = 4;
+inline constexpr int kSliverSweeps = 8;
 absl::StatusOr<Multimesh> RemoveSlivers(const Multimesh& mesh, double map_weight,
                                         double min_quality, SliverReport* report = nullptr,
                                         const CancelToken* cancel = nullptr,
-                                        const std::vector<ShapeOutline>* outlines = nullptr);
+                                        const std::vector<ShapeOutline>* outlines = nullptr,
+                                        const Multimesh* anchor_mesh = nullptr);
 
 }  // namespace inbetween::solver
