@@ -44,7 +44,11 @@
 // lowered the objective by at most outer_tolerance (relative; that pass is kept), or a pass plus
 // its short run lowered the objective by less than outer_tolerance (relative); then one inner run
 // to convergence on the final topology. The objective is a mean quality (the ODT normalizer uses
-// the current triangle count), so it is comparable across passes and never increases.
+// the current triangle count), so it is comparable across passes and never increases. Last (with
+// max_outer > 0 and min_quality > 0), sliver removal (RemoveSlivers, comesh_topology.h): local
+// operations on the triangles nearly flat in some shape, judged by triangle quality; it may raise
+// the objective a little, and the report's energies are those of its result (objective_trace ends
+// before it).
 //
 // Checkpoints: after every topology pass that changed the mesh, on_checkpoint (if set) receives
 // a ComeshCheckpoint: the multimesh at that point plus every number the rest of the run reads

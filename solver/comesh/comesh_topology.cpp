@@ -238,7 +238,9 @@ class Editor {
     return true;
   }
 
-  // True if v's place in shape s is one of the anchors (RemoveSlivers).
+  // Per shape, sorted (LexicographicLess): places a coincident merge keeps (RemoveSlivers).
+  void set_anchors(const std::vector<Points>* anchors) { anchors_ = anchors; }
+  // True if v's place in shape s is one of the anchors.
   bool Anchor(size_t s, int v) const {
     if (anchors_ == nullptr) return false;
     const Points& a = (*anchors_)[s];
@@ -903,9 +905,7 @@ class Editor {
 
   const ComeshObjective& objective_;
   const std::vector<ShapeOutline>* outlines_ = nullptr;  // may be null
- public:
-  const std::vector<Points>* anchors_ = nullptr;  // RemoveSlivers' anchors; may be null
- private:
+  const std::vector<Points>* anchors_ = nullptr;        // RemoveSlivers' anchors; may be null
   const TopologyOptions& options_;
   std::vector<Triangle> triangles_;
   std::vector<char> alive_;
@@ -1118,7 +1118,7 @@ absl::StatusOr<Multimesh> RemoveSlivers(const Multimesh& mesh, double map_weight
   options.min_area_ratio = 0.0;
   Editor editor(mesh, *objective, options, outlines, cancel);
   if (editor.cancelled() || Cancelled(cancel)) return cancelled_status;
-  if (anchor_mesh != nullptr) editor.anchors_ = &anchors;
+  if (anchor_mesh != nullptr) editor.set_anchors(&anchors);
   SliverReport rep;
   rep.worst_quality_before = editor.WorstQuality();
   // Each sweep touches a sliver's neighbourhood once (locks); a later sweep takes what an earlier
