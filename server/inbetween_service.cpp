@@ -236,13 +236,7 @@ v1::MultimeshStats StatsOf(const solver::Multimesh& mesh) {
     inverted += solver::CountInverted(mesh.triangles, shape);
   }
   stats.set_inverted_triangles(inverted);
-  double worst = mesh.triangles.empty() ? 0.0 : 1.0;
-  for (const solver::Points& x : mesh.shapes) {
-    for (const solver::Triangle& t : mesh.triangles) {
-      worst = std::min(worst, solver::TriangleQuality(x[t[0]], x[t[1]], x[t[2]]));
-    }
-  }
-  stats.set_worst_quality(worst);
+  stats.set_worst_quality(mesh.triangles.empty() ? 0.0 : solver::WorstQuality(mesh));
   // The comesh objective's reported energies (2 = conformal maps, 1 = equilateral tiling), with
   // the mesh itself as the rest state; left 0 for a mesh it cannot evaluate (one shape).
   if (mesh.num_shapes() >= 2 && inverted == 0) {

@@ -1533,12 +1533,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     }
     stats.phases.topology += topology_clock.Lap();
   }
-  rep.worst_quality = std::numeric_limits<double>::infinity();
-  for (const Points& x : current.shapes) {
-    for (const Triangle& t : current.triangles) {
-      rep.worst_quality = std::min(rep.worst_quality, TriangleQuality(x[t[0]], x[t[1]], x[t[2]]));
-    }
-  }
+  rep.worst_quality = WorstQuality(current);
   rep.inner = stats.iterations;
   rep.energy_evaluations = stats.evaluations + 1;
   rep.phase_seconds = stats.phases;

@@ -984,6 +984,16 @@ double TriangleQuality(const Point& a, const Point& b, const Point& c) {
   return edges > 0.0 ? 2.0 * std::sqrt(3.0) * Area2(a, b, c) / edges : 0.0;
 }
 
+double WorstQuality(const Multimesh& mesh) {
+  double worst = 1.0;
+  for (const Points& x : mesh.shapes) {
+    for (const Triangle& t : mesh.triangles) {
+      worst = std::min(worst, TriangleQuality(x[t[0]], x[t[1]], x[t[2]]));
+    }
+  }
+  return worst;
+}
+
 bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v) {
   const Point ab = b - a, av = v - a;
   const double len2 = ab.squaredNorm();

@@ -88,6 +88,8 @@ bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& a
 // Triangle quality 4 sqrt(3) A / (sum of squared edge lengths), A the signed area: 1 for an
 // equilateral triangle, 0 for a flat one, negative if inverted.
 double TriangleQuality(const Point& a, const Point& b, const Point& c);
+// The smallest TriangleQuality over every triangle of every shape (1 without triangles).
+double WorstQuality(const Multimesh& mesh);
 
 // True if v lies strictly inside segment ab (collinear within 1e-9 |ab|^2 of cross product, and
 // strictly between a and b): the optimizer's slider test and the topology pass's boundary one.

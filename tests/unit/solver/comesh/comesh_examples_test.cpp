@@ -119,23 +119,14 @@ TEST_P(ComeshExamplesTest, SliverRemovalOnlyRaisesTheWorstQuality) {
   options.max_outer = 3;
   options.outer_inner_iterations = 5;
   options.max_iterations = 30;
-  auto worst = [](const Multimesh& m) {
-    double q = 1.0;
-    for (const Points& x : m.shapes) {
-      for (const Triangle& t : m.triangles) {
-        q = std::min(q, TriangleQuality(x[t[0]], x[t[1]], x[t[2]]));
-      }
-    }
-    return q;
-  };
   ComeshReport with, without;
   absl::StatusOr<Multimesh> cleaned = OptimizeComesh(mesh_, options, nullptr, nullptr, &with);
   ASSERT_TRUE(cleaned.ok()) << cleaned.status();
   options.min_quality = 0.0;
   absl::StatusOr<Multimesh> raw = OptimizeComesh(mesh_, options, nullptr, nullptr, &without);
   ASSERT_TRUE(raw.ok()) << raw.status();
-  EXPECT_GE(worst(*cleaned), worst(*raw));
-  EXPECT_EQ(with.worst_quality, worst(*cleaned));
+  EXPECT_GE(WorstQuality(*cleaned), WorstQuality(*raw));
+  EXPECT_EQ(with.worst_quality, WorstQuality(*cleaned));
   EXPECT_EQ(with.sliver_operations == 0, cleaned->triangles == raw->triangles);
   EXPECT_TRUE(ValidateMultimesh(*cleaned).ok()) << ValidateMultimesh(*cleaned);
   testing::ExpectBoundaryKept(mesh_, *cleaned, options.outline_corner_degrees);
@@ -143,7 +134,8 @@ TEST_P(ComeshExamplesTest, SliverRemovalOnlyRaisesTheWorstQuality) {
   absl::StatusOr<Multimesh> twice =
       RemoveSlivers(*cleaned, options.map_weight, ComeshOptions().min_quality, &again);
   ASSERT_TRUE(twice.ok()) << twice.status();
-  EXPECT_EQ(again.operations, 0) << again.slivers_before << " slivers, worst " << worst(*cleaned);
+  EXPECT_EQ(again.operations, 0) << again.slivers_before << " slivers, worst "
+                                 << WorstQuality(*cleaned);
 }
 
 // The whole run as the service makes it (its default of 50 passes; every other option the

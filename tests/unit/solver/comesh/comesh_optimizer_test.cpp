@@ -757,22 +757,13 @@ TEST(ComeshOptimizerTest, RemovesTheSliversInnerRunsLeave) {
   options.min_quality = 0.0;
   absl::StatusOr<Multimesh> raw = OptimizeComesh(*m, options, nullptr, nullptr, &without);
   ASSERT_TRUE(raw.ok()) << raw.status();
-  auto worst = [](const Multimesh& mesh) {
-    double q = 1.0;
-    for (const Points& x : mesh.shapes) {
-      for (const Triangle& t : mesh.triangles) {
-        q = std::min(q, TriangleQuality(x[t[0]], x[t[1]], x[t[2]]));
-      }
-    }
-    return q;
-  };
-  EXPECT_LT(worst(*raw), 0.02);
+  EXPECT_LT(WorstQuality(*raw), 0.02);
   EXPECT_EQ(without.slivers, 0);  // not looked for
-  EXPECT_EQ(without.worst_quality, worst(*raw));
+  EXPECT_EQ(without.worst_quality, WorstQuality(*raw));
   EXPECT_GE(with.slivers, 1);
   EXPECT_GE(with.sliver_operations, 1);
-  EXPECT_GE(worst(*cleaned), ComeshOptions().min_quality);
-  EXPECT_EQ(with.worst_quality, worst(*cleaned));
+  EXPECT_GE(WorstQuality(*cleaned), ComeshOptions().min_quality);
+  EXPECT_EQ(with.worst_quality, WorstQuality(*cleaned));
   EXPECT_TRUE(ValidateMultimesh(*cleaned).ok()) << ValidateMultimesh(*cleaned);
   EXPECT_NEAR(with.map_energy, without.map_energy, 0.01 * without.map_energy);
   // The report's energies are the result's.

@@ -435,15 +435,6 @@ double LoopArea2(const Multimesh& m, int s) {
   return a;
 }
 
-double WorstQuality(const Multimesh& m) {
-  double q = 1.0;
-  for (const Points& x : m.shapes) {
-    for (const Triangle& t : m.triangles)
-      q = std::min(q, TriangleQuality(x[t[0]], x[t[1]], x[t[2]]));
-  }
-  return q;
-}
-
 // The unit square, corners 0-3, with interior vertex 4 pressed almost onto the bottom edge (0, 1)
 // and interior vertex 5 above it; shape 1 a similar copy. Triangle (0, 1, 4) is a cap sliver
 // (quality ~0.012 at height 0.005) in both shapes.
