@@ -1513,8 +1513,9 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   // so the report's energies are evaluated afresh after it; the trace ends before it.
   // Skipped where no triangle is below min_quality (with 4 slivers the step took ~0.1 s at 165k
   // vertices; its topology editor is set up over every triangle).
+  rep.worst_quality = WorstQuality(current);
   if (options.max_outer > 0 && options.min_quality > 0.0 &&
-      WorstQuality(current) < options.min_quality) {
+      rep.worst_quality < options.min_quality) {
     SliverReport slivers;
     Stopwatch topology_clock;
     absl::StatusOr<Multimesh> cleaned =
@@ -1534,9 +1535,9 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       stats.objective = final_objective->Evaluate(current.shapes, nullptr, &stats.energies);
       ++stats.evaluations;
     }
+    rep.worst_quality = slivers.worst_quality_after;
     stats.phases.topology += topology_clock.Lap();
   }
-  rep.worst_quality = WorstQuality(current);
   rep.inner = stats.iterations;
   rep.energy_evaluations = stats.evaluations + 1;
   rep.phase_seconds = stats.phases;

@@ -652,13 +652,6 @@ class Editor {
   // boundary loops as they now run, whatever sequence of boundary operations made them).
   void Unlock() { std::fill(locked_.begin(), locked_.end(), 0); }
   int snaps() const { return snaps_; }
-  double WorstQuality() const {
-    double q = std::numeric_limits<double>::infinity();
-    for (size_t t = 0; t < triangles_.size(); ++t) {
-      if (alive_[t]) q = std::min(q, WorstQuality({triangles_[t]}));
-    }
-    return q;
-  }
 
   // Boundary edges (a, b), a < b, whose endpoints are not fixed, each once, ascending.
   std::vector<std::pair<int, int>> SplittableBoundaryEdges() const {
@@ -1130,7 +1123,7 @@ absl::StatusOr<Multimesh> RemoveSlivers(const Multimesh& mesh, double map_weight
   if (editor.cancelled() || Cancelled(cancel)) return cancelled_status;
   if (anchor_mesh != nullptr) editor.set_anchors(&anchors);
   SliverReport rep;
-  rep.worst_quality_before = editor.WorstQuality();
+  rep.worst_quality_before = WorstQuality(mesh);
   // Each sweep touches a sliver's neighbourhood once (locks); a later sweep takes what an earlier
   // one left or made.
   for (int sweep = 0; sweep < kSliverSweeps; ++sweep) {
@@ -1146,9 +1139,9 @@ absl::StatusOr<Multimesh> RemoveSlivers(const Multimesh& mesh, double map_weight
     if (changed == 0) break;
   }
   rep.slivers_after = static_cast<int>(editor.Slivers(min_quality).size());
-  rep.worst_quality_after = editor.WorstQuality();
   rep.snaps = editor.snaps();
   Multimesh out = editor.Compact(mesh);
+  rep.worst_quality_after = WorstQuality(out);
   // Boundary lists that could not be traced (a vertex with more than two boundary edges) are
   // patched from the input's, which several boundary operations at one place can defeat: then
   // nothing is changed rather than a broken multimesh handed on.
