@@ -988,11 +988,12 @@ double WorstQuality(const Multimesh& mesh) {
 }
 
 bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v) {
-  const Point ab = b - a, av = v - a;
-  const double len2 = ab.squaredNorm();
-  const double along = av.dot(ab);
-  return len2 > 0.0 && std::abs(ab.x() * av.y() - ab.y() * av.x()) <= 1e-9 * len2 &&
-         along > 0.0 && along < len2;
+  // The turn at v (sine, from the cross product of av and vb) rather than v's distance from the
+  // line relative to |ab|: a corner whose neighbour has slid to within 1e-9 |ab| of it is off
+  // that line by less than that and was taken for straight, then slid or collapsed away.
+  const Point av = v - a, vb = b - v;
+  return av.dot(vb) > 0.0 &&
+         std::abs(av.x() * vb.y() - av.y() * vb.x()) <= 1e-9 * av.norm() * vb.norm();
 }
 
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,

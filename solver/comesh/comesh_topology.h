@@ -91,8 +91,9 @@ double TriangleQuality(const Point& a, const Point& b, const Point& c);
 // The smallest TriangleQuality over every triangle of every shape (1 without triangles).
 double WorstQuality(const Multimesh& mesh);
 
-// True if v lies strictly inside segment ab (collinear within 1e-9 |ab|^2 of cross product, and
-// strictly between a and b): the optimizer's slider test and the topology pass's boundary one.
+// True if v lies strictly inside segment ab: strictly between a and b, and the polyline a-v-b
+// turns at v by an angle whose sine is at most 1e-9 (the outlines' straightness tolerance too).
+// The optimizer's slider test and the topology pass's boundary one.
 bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v);
 
 // One topology pass. `mesh` must be valid (positive triangles in every shape). The returned

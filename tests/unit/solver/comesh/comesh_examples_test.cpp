@@ -150,6 +150,7 @@ TEST_P(ComeshExamplesTest, DefaultRunHandsOutAValidMultimesh) {
   ASSERT_TRUE(out.ok()) << out.status();
   EXPECT_TRUE(ValidateMultimesh(*out).ok()) << ValidateMultimesh(*out);
   for (const Points& x : out->shapes) EXPECT_EQ(testing::CountNonPositive(out->triangles, x), 0);
+  testing::ExpectBoundaryKept(mesh_, *out, options.outline_corner_degrees);
   // And its sliver removal went through (had it handed on a broken multimesh, RemoveSlivers would
   // have returned its input, leaving operations to a second call).
   SliverReport again;

@@ -279,6 +279,23 @@ TEST(ComeshTopologyTest, BoundaryCollapseRemovesACrowdedVertexOnAStraightSide) {
 // A boundary vertex on a straight side of one shape but at a corner of the other is never removed:
 // the square grid's boundary on a hexagon (Tutte), crowded in many places; only vertices straight
 // in both shapes may go.
+// A right-angle corner v whose neighbour a has slid along the side to within 1e-10 of it: v is
+// off the line a-b by less than 1e-9 |ab| (the old tolerance took it for straight, so a corner of
+// pentagon_star/hard4 became a slider and moved ~1e-9), but the polyline turns by 90 degrees.
+TEST(ComeshTopologyTest, StrictlyInsideSegmentJudgesTheTurnNotTheDistance) {
+  const Point v(0.0, 0.0), b(0.0, 1.0);
+  EXPECT_FALSE(StrictlyInsideSegment(Point(1e-10, 0.0), b, v));
+  EXPECT_FALSE(StrictlyInsideSegment(Point(1e-13, 0.0), b, v));
+  // Straight, however close to either end, and with roundoff off the line.
+  EXPECT_TRUE(StrictlyInsideSegment(Point(0.0, -1e-10), b, v));
+  EXPECT_TRUE(StrictlyInsideSegment(Point(0.0, -1.0), b, Point(1e-17, 0.999999)));
+  // A turn of 1e-8 radians is a corner, 1e-10 is not; ends and points beyond them are not inside.
+  EXPECT_FALSE(StrictlyInsideSegment(Point(0.0, -1.0), b, Point(1e-8, 0.0)));
+  EXPECT_TRUE(StrictlyInsideSegment(Point(0.0, -1.0), b, Point(1e-10, 0.0)));
+  EXPECT_FALSE(StrictlyInsideSegment(Point(0.0, -1.0), b, b));
+  EXPECT_FALSE(StrictlyInsideSegment(Point(0.0, -1.0), b, Point(0.0, 2.0)));
+}
+
 TEST(ComeshTopologyTest, BoundaryCollapseKeepsCornersOfEveryShape) {
   Multimesh m = testing::SquareGrid(12);
   m.shapes.push_back(testing::TutteHexagon(m));
