@@ -244,6 +244,78 @@ double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, co
   return b.length() * best / m;
 }
 
+// A corner of a loop: its arc length and the sign of its turn (+1 convex, -1 reflex, for a loop
+// with the drawing on its left).
+struct Corner {
+  double arc;
+  int turn;
+};
+
+std::vector<Corner> CornersOf(const Curve& c, double corner_angle_degrees) {
+  std::vector<Corner> out;
+  const size_t n = c.p.size();
+  for (int k : FindCorners(c.p, corner_angle_degrees)) {
+    const Point in = c.p[k] - c.p[(k + n - 1) % n], next = c.p[(k + 1) % n] - c.p[k];
+    out.push_back({c.cum[k], in.x() * next.y() - in.y() * next.x() > 0.0 ? 1 : -1});
+  }
+  std::sort(out.begin(), out.end(), [](const Corner& a, const Corner& b) { return a.arc < b.arc; });
+  return out;
+}
+
+// Automatic corner matching (BoundaryCorrespondenceOptions::match_corners): for one loop group
+// without marks, pairs of (arc in drawing 1, arcs in every drawing) of corners matched to
+// corners, or nothing. Every drawing must have as many corners on the loop as drawing 1; they are
+// matched in cyclic order, at the shift that best agrees with the automatic alignment (`start`:
+// drawing d's arc aligned with drawing 1's arc 0), each pair turning the same way and lying
+// within kCornerMatchWindow of the loop (as fractions of its length, after the alignment).
+constexpr double kCornerMatchWindow = 0.25;
+
+std::vector<std::pair<double, std::vector<double>>> MatchCorners(
+    const std::vector<const Curve*>& curves, const std::vector<double>& start,
+    double corner_angle_degrees) {
+  const int num_shapes = static_cast<int>(curves.size());
+  const std::vector<Corner> first = CornersOf(*curves[0], corner_angle_degrees);
+  const int n = static_cast<int>(first.size());
+  if (n == 0) return {};
+  std::vector<std::pair<double, std::vector<double>>> pairs(n);
+  for (int i = 0; i < n; ++i) pairs[i] = {first[i].arc, std::vector<double>(num_shapes)};
+  for (int i = 0; i < n; ++i) pairs[i].second[0] = first[i].arc;
+  for (int d = 1; d < num_shapes; ++d) {
+    const Curve& c = *curves[d];
+    std::vector<Corner> corners = CornersOf(c, corner_angle_degrees);
+    if (static_cast<int>(corners.size()) != n) return {};
+    // Corner fractions of the loop, counted from the aligned start, in increasing order.
+    std::vector<std::pair<double, int>> at;
+    for (int j = 0; j < n; ++j) at.push_back({Wrap01((corners[j].arc - start[d]) / c.length()), j});
+    std::sort(at.begin(), at.end());
+    int best = -1;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < n; ++r) {
+      double cost = 0.0;
+      for (int i = 0; i < n && cost < best_cost; ++i) {
+        const auto& [fraction, j] = at[(i + r) % n];
+        const double gap = std::abs(fraction - first[i].arc / curves[0]->length());
+        const double dist = std::min(gap, 1.0 - gap);
+        if (corners[j].turn != first[i].turn || !(dist < kCornerMatchWindow)) {
+          cost = std::numeric_limits<double>::infinity();
+        }
+        cost += dist * dist;
+      }
+      if (cost < best_cost) best_cost = cost, best = r;
+    }
+    if (best < 0) return {};
+    double previous = -1.0;  // strictly increasing from the first pair's corner (else no match)
+    for (int i = 0; i < n; ++i) {
+      const double arc = corners[at[(i + best) % n].second].arc;
+      const double from_first = std::fmod(arc - pairs[0].second[d] + c.length(), c.length());
+      if (i > 0 && !(from_first > previous)) return {};
+      previous = from_first;
+      pairs[i].second[d] = arc;
+    }
+  }
+  return pairs;
+}
+
 struct UnionFind {
   std::vector<int> parent;
   explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
@@ -402,16 +474,31 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     marks_on[group].push_back({at0, at});
   }
   for (int g = 0; g < num_groups; ++g) {
-    auto& marks = marks_on[g];
-    std::sort(marks.begin(), marks.end());
+    std::sort(marks_on[g].begin(), marks_on[g].end());
+    // Without marks: the automatic alignment, and corners matched to corners where every drawing
+    // has as many on this loop (they then pin the parameterization as marks would, without
+    // being marks: not pinned in the optimizer, not in mark_vertices).
+    std::vector<double> start(num_shapes, 0.0);
+    std::vector<std::pair<double, std::vector<double>>> corner_pairs;
+    if (marks_on[g].empty()) {
+      std::vector<const Curve*> loop_curves;
+      for (int d = 0; d < num_shapes; ++d) {
+        loop_curves.push_back(&curve(d, g));
+        if (d > 0) {
+          start[d] = AlignStart(curve(0, g), curve(d, g), centre[0], scale[0], centre[d], scale[d]);
+        }
+      }
+      if (options.match_corners) {
+        corner_pairs = MatchCorners(loop_curves, start, options.corner_angle_degrees);
+      }
+    }
+    const auto& marks = marks_on[g].empty() ? corner_pairs : marks_on[g];
     for (int d = 0; d < num_shapes; ++d) {
       Param& p = param[d][g];
       p.length = curve(d, g).length();
       if (marks.empty()) {
         p.t = {0.0};
-        p.a = {d == 0 ? 0.0
-                      : AlignStart(curve(0, g), curve(d, g), centre[0], scale[0], centre[d],
-                                   scale[d])};
+        p.a = {start[d]};
         continue;
       }
       const double len0 = curve(0, g).length();

@@ -20,6 +20,14 @@ struct BoundaryCorrespondenceOptions {
   // pins the nearest boundary point of drawing 1 to the nearest point of the matching loop in
   // every other drawing; marks on a loop must keep their cyclic order in every drawing.
   std::vector<std::vector<Point>> marks;
+  // Without marks on a loop: when every drawing has as many corners on it as drawing 1, they are
+  // matched in cyclic order (at the shift closest to the automatic alignment, each pair turning
+  // the same way, convex or reflex, and within a quarter of the loop of each other after the
+  // alignment) and the loop is reparameterized by arc length between them. So corners go onto
+  // corners, and an affine image of a polygon gets the affine correspondence (plain arc length
+  // put a sheared arrowhead's corners onto straight sides, and its map folded). Otherwise, and
+  // with false, arc length from the aligned start.
+  bool match_corners = true;
 };
 
 // Loops are matched as follows (documented default): each drawing is normalised by its

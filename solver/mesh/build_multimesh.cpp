@@ -225,6 +225,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   BoundaryCorrespondenceOptions correspondence_options;
   correspondence_options.vertices = options.boundary_vertices;
   correspondence_options.corner_angle_degrees = options.corner_angle_degrees;
+  correspondence_options.match_corners = options.match_corners;
   correspondence_options.marks = options.marks;
   if (options.marks.empty()) {
     absl::StatusOr<std::vector<std::vector<Point>>> drawn = MarksFromDrawings(drawings);

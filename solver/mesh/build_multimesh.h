@@ -26,6 +26,9 @@ struct MultimeshOptions {
   std::vector<std::vector<Point>> marks;
   // Boundary vertices turning by more than this many degrees are kept as mesh vertices.
   double corner_angle_degrees = 30.0;
+  // Without marks, loops with as many corners in every drawing are matched corner to corner
+  // (BoundaryCorrespondenceOptions::match_corners); false: by arc length only.
+  bool match_corners = true;
   // Bound on the vertices of the initial mesh (TriangulateOptions::max_vertices); above it the
   // build is RESOURCE_EXHAUSTED instead of refining (practically) forever.
   int max_mesh_vertices = 2'000'000;

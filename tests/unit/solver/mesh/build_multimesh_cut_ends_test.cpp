@@ -5,6 +5,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+
 #include "solver/mesh/build_multimesh.h"
 #include "solver/mesh/validate.h"
 
@@ -13,10 +16,24 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// A 10 x 10 square with a slit from (x, 0) on its bottom edge up to (x + lean, depth).
-Drawing SlitSquare(double x, double lean, double depth) {
+// A 10 x 10 square with a slit from (x, 0) on its bottom edge up to (x + lean, depth). With
+// `rounded`, each corner is a quarter circle of radius 1 in five steps (18 degrees: no corner,
+// so the boundaries are matched by arc length alone, not corner to corner).
+Drawing SlitSquare(double x, double lean, double depth, bool rounded = false) {
   Drawing d;
-  d.outlines.push_back({{{0, 0}, {10, 0}, {10, 10}, {0, 10}}});
+  if (!rounded) {
+    d.outlines.push_back({{{0, 0}, {10, 0}, {10, 10}, {0, 10}}});
+  } else {
+    Outline o;
+    const Point centres[4] = {{9, 1}, {9, 9}, {1, 9}, {1, 1}};
+    for (int c = 0; c < 4; ++c) {
+      for (int k = 0; k <= 5; ++k) {
+        const double angle = (c - 1) * std::numbers::pi / 2 + k * std::numbers::pi / 10;
+        o.points.push_back(centres[c] + Point(std::cos(angle), std::sin(angle)));
+      }
+    }
+    d.outlines.push_back(o);
+  }
   d.cuts.push_back({{x, 0}, {x + lean, depth}});
   return d;
 }
@@ -36,15 +53,28 @@ TEST(BuildMultimeshCutEndsTest, SlitsEndingAtTheSamePlacesBuild) {
 }
 
 TEST(BuildMultimeshCutEndsTest, SlitsEndingAtDifferentPlacesAreRefusedWithWhatToDo) {
-  // Slits at different places and of different depths in four drawings, nothing marked: each
-  // drawing's mirror maps the others' breakpoints somewhere new.
-  const std::vector<Drawing> drawings = {SlitSquare(3.1, 0.3, 5.3), SlitSquare(4.7, -0.4, 6.9),
-                                         SlitSquare(5.9, 0.8, 4.1), SlitSquare(3.8, 0.1, 7.7)};
+  // Slits at different places and of different depths in four drawings, nothing marked and no
+  // corners to match: each drawing's mirror maps the others' breakpoints somewhere new.
+  const std::vector<Drawing> drawings = {
+      SlitSquare(3.1, 0.3, 5.3, true), SlitSquare(4.7, -0.4, 6.9, true),
+      SlitSquare(5.9, 0.8, 4.1, true), SlitSquare(3.8, 0.1, 7.7, true)};
   const absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, {});
   ASSERT_FALSE(mesh.ok()) << mesh->shapes[0].size() << " vertices";
   EXPECT_EQ(mesh.status().code(), absl::StatusCode::kInvalidArgument) << mesh.status();
   EXPECT_THAT(mesh.status().message(), HasSubstr("cuts or openings of drawings 1, 2, 3, 4"));
   EXPECT_THAT(mesh.status().message(), HasSubstr("pin both ends of every cut"));
+}
+
+// The same slits in squares: the four corners, matched corner to corner, pin every drawing's
+// parameterization, and the mirrored slit ends stay few enough to build (matched by arc length
+// alone, as before corner matching, these four were refused like the rounded ones above).
+TEST(BuildMultimeshCutEndsTest, SlitsInSquaresBuildOnceTheCornersAreMatched) {
+  const std::vector<Drawing> drawings = {SlitSquare(3.1, 0.3, 5.3), SlitSquare(4.7, -0.4, 6.9),
+                                         SlitSquare(5.9, 0.8, 4.1), SlitSquare(3.8, 0.1, 7.7)};
+  const absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, {});
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
+  EXPECT_FALSE(mesh->cohesive_edges.empty());
 }
 
 }  // namespace
