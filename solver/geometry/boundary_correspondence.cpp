@@ -492,6 +492,7 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
         corner_pairs = MatchCorners(loop_curves, start, options.corner_angle_degrees);
       }
     }
+    out.corner_matched_loops += corner_pairs.empty() ? 0 : 1;
     const auto& marks = marks_on[g].empty() ? corner_pairs : marks_on[g];
     for (int d = 0; d < num_shapes; ++d) {
       Param& p = param[d][g];

@@ -26,8 +26,10 @@ struct BoundaryCorrespondenceOptions {
   // alignment) and the loop is reparameterized by arc length between them. So corners go onto
   // corners, and an affine image of a polygon gets the affine correspondence (plain arc length
   // put a sheared arrowhead's corners onto straight sides, and its map folded). Otherwise, and
-  // with false, arc length from the aligned start.
-  bool match_corners = true;
+  // with false (the default), arc length from the aligned start. BuildMultimesh turns it on
+  // when the arc-length correspondence cannot be built or mapped (MultimeshOptions::
+  // corner_matching).
+  bool match_corners = false;
 };
 
 // Loops are matched as follows (documented default): each drawing is normalised by its
@@ -49,6 +51,8 @@ struct BoundaryCorrespondence {
   // The global vertex of each correspondence mark (ascending, each once; marks that fell onto
   // the same breakpoint share it).
   std::vector<int> mark_vertices;
+  // Loops parameterized by matched corners (BoundaryCorrespondenceOptions::match_corners).
+  int corner_matched_loops = 0;
   int num_loops() const { return static_cast<int>(loop_start.size()) - 1; }
   int num_vertices() const { return loop_start.back(); }
 };

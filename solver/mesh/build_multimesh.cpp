@@ -185,11 +185,13 @@ absl::StatusOr<std::vector<std::vector<Point>>> MarksFromDrawings(
   return marks;
 }
 
-}  // namespace
-
-absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
-                                         const MultimeshOptions& options, const CancelToken* cancel,
-                                         const ProgressFn& progress, MultimeshReport* report) {
+// One attempt of BuildMultimesh, corners matched or not. With require_match, returns ABORTED
+// (not an answer: the caller keeps its first error) when no loop's corners matched, before any
+// meshing.
+absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
+                                    const MultimeshOptions& options, bool match_corners,
+                                    bool require_match, const CancelToken* cancel,
+                                    const ProgressFn& progress, MultimeshReport* report) {
   const auto start = std::chrono::steady_clock::now();
   auto notify = [&](const std::string& stage, double fraction, const std::string& detail) {
     if (progress) progress(stage, fraction, detail);
@@ -225,7 +227,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   BoundaryCorrespondenceOptions correspondence_options;
   correspondence_options.vertices = options.boundary_vertices;
   correspondence_options.corner_angle_degrees = options.corner_angle_degrees;
-  correspondence_options.match_corners = options.match_corners;
+  correspondence_options.match_corners = match_corners;
   correspondence_options.marks = options.marks;
   if (options.marks.empty()) {
     absl::StatusOr<std::vector<std::vector<Point>>> drawn = MarksFromDrawings(drawings);
@@ -235,6 +237,9 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   absl::StatusOr<BoundaryCorrespondence> bc =
       ComputeBoundaryCorrespondence(graphs, correspondence_options);
   if (!bc.ok()) return bc.status();
+  if (require_match && bc->corner_matched_loops == 0) {
+    return absl::AbortedError("no loop has corners to match");
+  }
   for (int d = 0; d < num_shapes; ++d) {
     for (int g = 0; g < bc->num_loops(); ++g) {
       const Points& loop = bc->shapes[d][g];
@@ -535,6 +540,39 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   notify("done", 1.0,
          absl::StrCat(mesh.num_vertices(), " vertices, ", mesh.triangles.size(), " triangles"));
   return mesh;
+}
+
+}  // namespace
+
+absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
+                                         const MultimeshOptions& options, const CancelToken* cancel,
+                                         const ProgressFn& progress, MultimeshReport* report) {
+  using CornerMatching = MultimeshOptions::CornerMatching;
+  if (options.corner_matching == CornerMatching::kAlways) {
+    return BuildOnce(drawings, options, true, false, cancel, progress, report);
+  }
+  // Progress stays monotone across the two attempts.
+  double reached = 0.0;
+  const ProgressFn monotone = [&](const std::string& stage, double fraction,
+                                  const std::string& detail) {
+    reached = std::max(reached, fraction);
+    if (progress) progress(stage, reached, detail);
+  };
+  absl::StatusOr<Multimesh> first =
+      BuildOnce(drawings, options, false, false, cancel, monotone, report);
+  const absl::StatusCode code = first.status().code();
+  if (first.ok() || options.corner_matching == CornerMatching::kNever ||
+      (code != absl::StatusCode::kInvalidArgument &&
+       code != absl::StatusCode::kFailedPrecondition)) {
+    return first;
+  }
+  monotone("correspondence", reached,
+           absl::StrCat("by arc length: ", first.status().message(),
+                        "; again with corners matched to corners"));
+  absl::StatusOr<Multimesh> second =
+      BuildOnce(drawings, options, true, true, cancel, monotone, report);
+  if (second.ok() || second.status().code() == absl::StatusCode::kCancelled) return second;
+  return first;
 }
 
 }  // namespace inbetween::solver

@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -65,16 +66,30 @@ TEST(BuildMultimeshCutEndsTest, SlitsEndingAtDifferentPlacesAreRefusedWithWhatTo
   EXPECT_THAT(mesh.status().message(), HasSubstr("pin both ends of every cut"));
 }
 
-// The same slits in squares: the four corners, matched corner to corner, pin every drawing's
-// parameterization, and the mirrored slit ends stay few enough to build (matched by arc length
-// alone, as before corner matching, these four were refused like the rounded ones above).
+// The same slits in squares: matched by arc length they are refused like the rounded ones
+// above; the second attempt matches the four corners corner to corner, which pins every
+// drawing's parameterization, and the mirrored slit ends stay few enough to build.
 TEST(BuildMultimeshCutEndsTest, SlitsInSquaresBuildOnceTheCornersAreMatched) {
   const std::vector<Drawing> drawings = {SlitSquare(3.1, 0.3, 5.3), SlitSquare(4.7, -0.4, 6.9),
                                          SlitSquare(5.9, 0.8, 4.1), SlitSquare(3.8, 0.1, 7.7)};
-  const absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, {});
+  MultimeshOptions arc_length;
+  arc_length.corner_matching = MultimeshOptions::CornerMatching::kNever;
+  const absl::StatusOr<Multimesh> refused = BuildMultimesh(drawings, arc_length);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(refused.status().message(), HasSubstr("pin both ends of every cut"));
+  std::vector<std::string> details;
+  std::vector<double> fractions;
+  const absl::StatusOr<Multimesh> mesh = BuildMultimesh(
+      drawings, {}, nullptr, [&](const std::string&, double fraction, const std::string& detail) {
+        details.push_back(detail);
+        fractions.push_back(fraction);
+      });
   ASSERT_TRUE(mesh.ok()) << mesh.status();
   EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
   EXPECT_FALSE(mesh->cohesive_edges.empty());
+  // The progress says why the build started again, and never goes back.
+  EXPECT_THAT(details, ::testing::Contains(HasSubstr("again with corners matched to corners")));
+  EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
 }
 
 }  // namespace
