@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <string>
 
@@ -244,11 +245,12 @@ double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, co
   return b.length() * best / m;
 }
 
-// A corner of a loop: its arc length and the sign of its turn (+1 convex, -1 reflex, for a loop
-// with the drawing on its left).
+// A corner of a loop: its arc length, the sign of its turn (+1 convex, -1 reflex, for a loop
+// with the drawing on its left) and the turn's angle (radians, unsigned).
 struct Corner {
   double arc;
   int turn;
+  double angle;
 };
 
 std::vector<Corner> CornersOf(const Curve& c, double corner_angle_degrees) {
@@ -256,7 +258,8 @@ std::vector<Corner> CornersOf(const Curve& c, double corner_angle_degrees) {
   const size_t n = c.p.size();
   for (int k : FindCorners(c.p, corner_angle_degrees)) {
     const Point in = c.p[k] - c.p[(k + n - 1) % n], next = c.p[(k + 1) % n] - c.p[k];
-    out.push_back({c.cum[k], in.x() * next.y() - in.y() * next.x() > 0.0 ? 1 : -1});
+    const double cross = in.x() * next.y() - in.y() * next.x();
+    out.push_back({c.cum[k], cross > 0.0 ? 1 : -1, std::atan2(std::abs(cross), in.dot(next))});
   }
   std::sort(out.begin(), out.end(), [](const Corner& a, const Corner& b) { return a.arc < b.arc; });
   return out;
@@ -265,12 +268,29 @@ std::vector<Corner> CornersOf(const Curve& c, double corner_angle_degrees) {
 // Automatic corner matching (BoundaryCorrespondenceOptions::match_corners): for one loop group
 // without marks, pairs of (arc in drawing 1, arcs in every drawing) of corners matched to
 // corners, or nothing. Every drawing must have as many corners on the loop as drawing 1; they are
-// matched in cyclic order, at the shift that best agrees with the automatic alignment (`start`:
-// drawing d's arc aligned with drawing 1's arc 0), each pair turning the same way and lying
-// within kCornerMatchWindow of the loop (as fractions of its length, after the alignment).
-constexpr double kCornerMatchWindow = 0.25;
+// matched in cyclic order, each pair turning the same way, at the shift that best agrees in the
+// pairs' turn angles and with the automatic alignment (`start`: drawing d's arc aligned with
+// drawing 1's arc 0; on thin sheared shapes it can be a quarter of the loop off: the turn angles
+// tell a needle's tip from its other corners).
+// Corners are first every vertex turning by more than kFineCornerDegrees (a polygon and its
+// affine copy: vertex onto vertex), else those above `corner_angle_degrees`.
+constexpr double kFineCornerDegrees = 1.0;
+
+std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(
+    const std::vector<const Curve*>& curves, const std::vector<double>& start,
+    double corner_angle_degrees);
 
 std::vector<std::pair<double, std::vector<double>>> MatchCorners(
+    const std::vector<const Curve*>& curves, const std::vector<double>& start,
+    double corner_angle_degrees) {
+  auto pairs = MatchCornersAbove(curves, start, std::min(kFineCornerDegrees, corner_angle_degrees));
+  if (pairs.empty() && corner_angle_degrees > kFineCornerDegrees) {
+    pairs = MatchCornersAbove(curves, start, corner_angle_degrees);
+  }
+  return pairs;
+}
+
+std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(
     const std::vector<const Curve*>& curves, const std::vector<double>& start,
     double corner_angle_degrees) {
   const int num_shapes = static_cast<int>(curves.size());
@@ -296,10 +316,11 @@ std::vector<std::pair<double, std::vector<double>>> MatchCorners(
         const auto& [fraction, j] = at[(i + r) % n];
         const double gap = std::abs(fraction - first[i].arc / curves[0]->length());
         const double dist = std::min(gap, 1.0 - gap);
-        if (corners[j].turn != first[i].turn || !(dist < kCornerMatchWindow)) {
+        if (corners[j].turn != first[i].turn) {
           cost = std::numeric_limits<double>::infinity();
         }
-        cost += dist * dist;
+        const double turn = (corners[j].angle - first[i].angle) / std::numbers::pi;
+        cost += dist * dist + turn * turn;
       }
       if (cost < best_cost) best_cost = cost, best = r;
     }

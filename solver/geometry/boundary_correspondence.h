@@ -21,14 +21,15 @@ struct BoundaryCorrespondenceOptions {
   // every other drawing; marks on a loop must keep their cyclic order in every drawing.
   std::vector<std::vector<Point>> marks;
   // Without marks on a loop: when every drawing has as many corners on it as drawing 1, they are
-  // matched in cyclic order (at the shift closest to the automatic alignment, each pair turning
-  // the same way, convex or reflex, and within a quarter of the loop of each other after the
-  // alignment) and the loop is reparameterized by arc length between them. So corners go onto
-  // corners, and an affine image of a polygon gets the affine correspondence (plain arc length
-  // put a sheared arrowhead's corners onto straight sides, and its map folded). Otherwise, and
-  // with false (the default), arc length from the aligned start. BuildMultimesh turns it on
-  // when the arc-length correspondence cannot be built or mapped (MultimeshOptions::
-  // corner_matching).
+  // matched in cyclic order (each pair turning the same way, convex or reflex; of such shifts,
+  // the one closest in the pairs' turn angles and to the automatic alignment) and the loop is
+  // reparameterized by arc length between them. Corners here: first every vertex turning by
+  // more than 1 degree (so a polygon and its affine copy match vertex to vertex), else those
+  // above corner_angle_degrees. So corners go onto corners, and an affine image of a polygon
+  // gets the affine correspondence (plain arc length put a sheared arrowhead's corners onto
+  // straight sides, and its map folded). Otherwise, and with false (the default), arc length
+  // from the aligned start. BuildMultimesh turns it on when the arc-length correspondence
+  // cannot be built or mapped (MultimeshOptions::corner_matching).
   bool match_corners = false;
 };
 

@@ -274,7 +274,8 @@ struct Stage {
 
 // marks[m][d] as in BoundaryCorrespondenceOptions::marks.
 absl::StatusOr<Stage> Correspond(const std::vector<Drawing>& drawings,
-                                 const std::vector<std::vector<Point>>& marks, int vertices = 0) {
+                                 const std::vector<std::vector<Point>>& marks, int vertices = 0,
+                                 bool match_corners = false) {
   Stage out;
   for (size_t d = 0; d < drawings.size(); ++d) {
     absl::StatusOr<BoundaryGraph> g = BuildBoundaries(drawings[d], static_cast<int>(d) + 1);
@@ -284,6 +285,7 @@ absl::StatusOr<Stage> Correspond(const std::vector<Drawing>& drawings,
   BoundaryCorrespondenceOptions options;
   options.vertices = vertices;
   options.marks = marks;
+  options.match_corners = match_corners;
   absl::StatusOr<BoundaryCorrespondence> bc = ComputeBoundaryCorrespondence(out.graphs, options);
   if (!bc.ok()) return bc.status();
   out.bc = *std::move(bc);
@@ -681,6 +683,54 @@ TEST(BoundaryReparamCountsTest, RandomPairsAndTriplesAtTheCorrespondenceStage) {
   EXPECT_GT(holes, 10);
   EXPECT_GT(two_components, 10);
   EXPECT_GT(marks, 150);
+}
+
+// The same cases with corners matched to corners (BuildMultimesh's second attempt), every
+// drawing after the first replaced by a sheared, rotated copy of it (so that there are corners to
+// match): the counts, marks and loops check out alike, and loops get matched (and none where the
+// corner counts differ: a hexagon against a square).
+TEST(BoundaryReparamCountsTest, RandomPairsAndTriplesWithCornersMatched) {
+  int matched = 0;
+  const Eigen::Matrix2d shear{{1.1, -0.4}, {0.3, 0.9}};
+  auto copy = [&](const Point& p) -> Point { return shear * p + Point(7, -2); };
+  for (unsigned seed = 1; seed <= 60; ++seed) {
+    Case c = RandomCase(seed);
+    for (size_t d = 1; d < c.drawings.size(); ++d) {
+      Drawing& to = c.drawings[d];
+      to = c.drawings[0];
+      for (Outline& o : to.outlines) {
+        for (Point& p : o.points) p = copy(p);
+      }
+      for (auto* lines : {&to.cuts, &to.openings}) {
+        for (Points& line : *lines) {
+          for (Point& p : line) p = copy(p);
+        }
+      }
+      for (CorrespondenceMark& m : to.marks) m.point = copy(m.point);
+    }
+    for (std::vector<Point>& mark : c.marks) {
+      for (size_t d = 1; d < mark.size(); ++d) mark[d] = copy(mark[0]);
+    }
+    absl::StatusOr<Stage> s = Correspond(c.drawings, c.marks, c.vertices, true);
+    ASSERT_TRUE(s.ok()) << c.name << ": " << s.status();
+    EXPECT_EQ(CountMarks(s->views), static_cast<int>(c.marks.size())) << c.name;
+    EXPECT_TRUE(CheckAll(s->views)) << c.name;
+    matched += s->bc.corner_matched_loops;
+  }
+  EXPECT_GE(matched, 8);  // 10 loops (the others have marks, which take precedence)
+  Drawing square{{Outline{{{0, 0}, {10, 0}, {10, 10}, {0, 10}}}}};
+  Drawing hexagon;
+  hexagon.outlines.push_back({});
+  for (int k = 0; k < 6; ++k) {
+    hexagon.outlines[0].points.emplace_back(5 + 5 * std::cos(k * M_PI / 3),
+                                            5 + 5 * std::sin(k * M_PI / 3));
+  }
+  for (const auto& pair : {std::vector<Drawing>{hexagon, square}, {square, hexagon}}) {
+    absl::StatusOr<Stage> s = Correspond(pair, {}, 0, true);
+    ASSERT_TRUE(s.ok()) << s.status();
+    EXPECT_EQ(s->bc.corner_matched_loops, 0);
+    EXPECT_TRUE(CheckAll(s->views));
+  }
 }
 
 // Gentle random cases (see RandomCase) that BuildMultimesh maps, with a coarse interior to keep

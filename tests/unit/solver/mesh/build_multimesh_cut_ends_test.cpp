@@ -18,8 +18,8 @@ namespace {
 using ::testing::HasSubstr;
 
 // A 10 x 10 square with a slit from (x, 0) on its bottom edge up to (x + lean, depth). With
-// `rounded`, each corner is a quarter circle of radius 1 in five steps (18 degrees: no corner,
-// so the boundaries are matched by arc length alone, not corner to corner).
+// `rounded`, each corner is a quarter circle of radius 1 in 100 steps (0.9 degrees: no vertex
+// turns by a degree, so no corners to match: the boundaries are matched by arc length alone).
 Drawing SlitSquare(double x, double lean, double depth, bool rounded = false) {
   Drawing d;
   if (!rounded) {
@@ -28,8 +28,8 @@ Drawing SlitSquare(double x, double lean, double depth, bool rounded = false) {
     Outline o;
     const Point centres[4] = {{9, 1}, {9, 9}, {1, 9}, {1, 1}};
     for (int c = 0; c < 4; ++c) {
-      for (int k = 0; k <= 5; ++k) {
-        const double angle = (c - 1) * std::numbers::pi / 2 + k * std::numbers::pi / 10;
+      for (int k = 0; k <= 100; ++k) {
+        const double angle = (c - 1) * std::numbers::pi / 2 + k * std::numbers::pi / 200;
         o.points.push_back(centres[c] + Point(std::cos(angle), std::sin(angle)));
       }
     }
