@@ -139,8 +139,22 @@ absl::Status ParseDrawing(const Node& node, const std::filesystem::path& base_di
   return absl::OkStatus();
 }
 
+// meshing.corner_matching's names, indexed by v1::CornerMatching (0: unspecified).
+constexpr const char* kCornerMatchings[] = {"when_arc_length_fails", "when_arc_length_fails",
+                                            "never", "always"};
+
+absl::StatusOr<v1::CornerMatching> CornerMatchingFromName(const Node& node) {
+  PROJECT_ASSIGN_OR_RETURN(name, node.String());
+  for (int k = v1::CORNER_MATCHING_WHEN_ARC_LENGTH_FAILS; k <= v1::CORNER_MATCHING_ALWAYS; ++k) {
+    if (name == kCornerMatchings[k]) return static_cast<v1::CornerMatching>(k);
+  }
+  return node.Error(absl::StrCat("unknown corner matching '", name,
+                                 "' (when_arc_length_fails, never, always)"));
+}
+
 absl::Status ParseMeshing(const Node& node, v1::MeshingParameters* out) {
-  if (absl::Status s = node.CheckKeys({"boundary_vertices", "max_edge_relative", "shape_bound"});
+  if (absl::Status s = node.CheckKeys(
+          {"boundary_vertices", "max_edge_relative", "shape_bound", "corner_matching"});
       !s.ok()) {
     return s;
   }
@@ -155,6 +169,10 @@ absl::Status ParseMeshing(const Node& node, v1::MeshingParameters* out) {
   if (node.Has("shape_bound")) {
     PROJECT_ASSIGN_OR_RETURN(v, node.Child("shape_bound").Number(1e-6, 0.125));
     out->set_shape_bound(v);
+  }
+  if (node.Has("corner_matching")) {
+    PROJECT_ASSIGN_OR_RETURN(v, CornerMatchingFromName(node.Child("corner_matching")));
+    out->set_corner_matching(v);
   }
   return absl::OkStatus();
 }
@@ -462,6 +480,10 @@ json ProjectToJson(const Project& project, const std::filesystem::path& base_dir
   if (m.boundary_vertices()) meshing["boundary_vertices"] = m.boundary_vertices();
   if (m.max_edge_relative() > 0) meshing["max_edge_relative"] = m.max_edge_relative();
   if (m.shape_bound() > 0) meshing["shape_bound"] = m.shape_bound();
+  if (m.corner_matching() != v1::CORNER_MATCHING_UNSPECIFIED &&
+      v1::CornerMatching_IsValid(m.corner_matching())) {
+    meshing["corner_matching"] = kCornerMatchings[m.corner_matching()];
+  }
   if (!meshing.empty()) doc["meshing"] = std::move(meshing);
   const v1::ComeshParameters& c = project.parameters.comesh();
   json comesh = json::object();

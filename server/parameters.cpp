@@ -85,6 +85,11 @@ absl::Status ValidateMeshing(const inbetween::v1::MeshingParameters& meshing,
       return s;
     }
   }
+  if (!inbetween::v1::CornerMatching_IsValid(meshing.corner_matching())) {
+    return absl::InvalidArgumentError(absl::StrCat(field, ".corner_matching = ",
+                                                   meshing.corner_matching(),
+                                                   " is not a known CornerMatching"));
+  }
   return absl::OkStatus();
 }
 
@@ -174,6 +179,17 @@ solver::MultimeshOptions ToMultimeshOptions(const inbetween::v1::MeshingParamete
   options.boundary_vertices = static_cast<int>(meshing.boundary_vertices());
   options.max_edge_relative = meshing.max_edge_relative();
   if (meshing.shape_bound() != 0) options.shape_bound = meshing.shape_bound();
+  switch (meshing.corner_matching()) {
+    case inbetween::v1::CORNER_MATCHING_NEVER:
+      options.corner_matching = solver::MultimeshOptions::CornerMatching::kNever;
+      break;
+    case inbetween::v1::CORNER_MATCHING_ALWAYS:
+      options.corner_matching = solver::MultimeshOptions::CornerMatching::kAlways;
+      break;
+    default:  // unspecified or when arc length fails (validated before)
+      options.corner_matching = solver::MultimeshOptions::CornerMatching::kWhenArcLengthFails;
+      break;
+  }
   return options;
 }
 

@@ -27,7 +27,7 @@ TEST(ProjectFileTest, FullProjectRoundTrips) {
     "drawings": [{"file": "a.svg", "key_time": 0, "cuts": [[[0,0],[1,1]]]},
                  {"file": "b.svg", "key_time": 1, "openings": [[[2,2],[3,3],[4,2]]]}],
     "correspondences": [[[0,0],[5,5]]],
-    "meshing": {"boundary_vertices": 96, "shape_bound": 0.1},
+    "meshing": {"boundary_vertices": 96, "shape_bound": 0.1, "corner_matching": "always"},
     "comesh": {"map_weight": 0.3, "max_outer_iterations": 7, "outline_corner_degrees": 40,
                "min_quality": 0.05},
     "inbetween": {"method": "alexa", "frames": 30, "timing": "ease_in_out", "ease": [0.5],
@@ -43,6 +43,7 @@ TEST(ProjectFileTest, FullProjectRoundTrips) {
   EXPECT_DOUBLE_EQ(p->parameters.comesh().map_weight(), 0.3);
   EXPECT_DOUBLE_EQ(p->parameters.comesh().outline_corner_degrees(), 40.0);
   EXPECT_DOUBLE_EQ(p->parameters.comesh().min_quality(), 0.05);
+  EXPECT_EQ(p->parameters.meshing().corner_matching(), v1::CORNER_MATCHING_ALWAYS);
   EXPECT_EQ(p->drawings[0].cuts.size(), 1u);
   EXPECT_EQ(p->drawings[1].openings[0].size(), 3u);
   EXPECT_EQ(p->output.width, 256);
@@ -84,6 +85,9 @@ INSTANTIATE_TEST_SUITE_P(
                 "$.comesh.outline_corner_degrees: value 200 out of range [0, 180]"},
         BadCase{R"({"version": 1, "drawings": ["a", "b"], "inbetween": {"method": "x"}})",
                 "$.inbetween.method: unknown method 'x'"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"],
+                    "meshing": {"corner_matching": "sometimes"}})",
+                "$.meshing.corner_matching: unknown corner matching 'sometimes'"},
         BadCase{R"({"version": 1, "drawings": ["a", {"file": "b", "cuts": [[[0,0]]]}]})",
                 "$.drawings[1].cuts[0]: needs at least 2 points"},
         BadCase{R"({"version": 1, "drawings": ["a", "b"], "correspondences": [[[0,0]]]})",
@@ -105,6 +109,22 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{R"({"version": 1, "drawings": [{"file": "a", "key_time": 0},
                     {"file": "b", "key_time": 0.5}]})",
                 "$.drawings: key_time: the first time must be 0 and the last 1"}));
+
+TEST(ProjectFileTest, EveryCornerMatchingRoundTrips) {
+  for (const char* name : {"when_arc_length_fails", "never", "always"}) {
+    json doc = Minimal();
+    doc["meshing"] = {{"corner_matching", name}};
+    auto p = ParseProject(doc, "/base");
+    ASSERT_TRUE(p.ok()) << p.status();
+    EXPECT_NE(p->parameters.meshing().corner_matching(), v1::CORNER_MATCHING_UNSPECIFIED);
+    EXPECT_EQ(ProjectToJson(*p, "/base")["meshing"]["corner_matching"], name);
+  }
+  // Unset stays unset (the server's default) and is not written.
+  auto p = ParseProject(Minimal(), "/base");
+  ASSERT_TRUE(p.ok()) << p.status();
+  EXPECT_EQ(p->parameters.meshing().corner_matching(), v1::CORNER_MATCHING_UNSPECIFIED);
+  EXPECT_FALSE(ProjectToJson(*p, "/base").contains("meshing"));
+}
 
 TEST(ProjectFileTest, TimingAcceptsHyphensAndUnderscores) {
   for (const char* name : {"catmull-rom", "catmull_rom"}) {

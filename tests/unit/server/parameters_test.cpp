@@ -61,6 +61,25 @@ TEST(ParametersTest, OutOfRangeNamesTheField) {
               HasSubstr("meshing.boundary_vertices"));
 }
 
+TEST(ParametersTest, CornerMatchingIsCheckedAndReachesTheBuilder) {
+  using CornerMatching = solver::MultimeshOptions::CornerMatching;
+  v1::MeshingParameters m;
+  EXPECT_TRUE(ValidateMeshing(m, "meshing").ok());
+  EXPECT_EQ(ToMultimeshOptions(m).corner_matching, CornerMatching::kWhenArcLengthFails);
+  m.set_corner_matching(v1::CORNER_MATCHING_WHEN_ARC_LENGTH_FAILS);
+  EXPECT_EQ(ToMultimeshOptions(m).corner_matching, CornerMatching::kWhenArcLengthFails);
+  m.set_corner_matching(v1::CORNER_MATCHING_NEVER);
+  EXPECT_TRUE(ValidateMeshing(m, "meshing").ok());
+  EXPECT_EQ(ToMultimeshOptions(m).corner_matching, CornerMatching::kNever);
+  m.set_corner_matching(v1::CORNER_MATCHING_ALWAYS);
+  EXPECT_EQ(ToMultimeshOptions(m).corner_matching, CornerMatching::kAlways);
+  // An enum value this server does not know (a newer client's) is refused, naming the field.
+  m.set_corner_matching(static_cast<v1::CornerMatching>(17));
+  const absl::Status s = ValidateMeshing(m, "meshing");
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(s.message()), HasSubstr("meshing.corner_matching = 17"));
+}
+
 TEST(ParametersTest, OutlineCornerDegreesIsCheckedAndReachesTheOptimizer) {
   v1::ComeshParameters c;
   EXPECT_TRUE(ToComeshOptions(c).slide_outline);  // unset: the solver's default, 25 degrees
