@@ -624,6 +624,7 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext* context,
       stats.set_map_energy(session.multimesh_stats().map_energy());
       stats.set_mesh_energy(session.multimesh_stats().mesh_energy());
       stats.set_build_seconds(session.multimesh_stats().build_seconds());
+      stats.set_corner_matched_loops(session.multimesh_stats().corner_matched_loops());
       *session.mutable_multimesh_stats() = stats;
       session.set_stage(std::max(session.stage(), v1::STAGE_MULTIMESH));
       state.multimesh = std::make_shared<const solver::Multimesh>(*std::move(mesh));
@@ -866,6 +867,7 @@ grpc::Status InbetweenService::BuildMultimesh(
         }
         v1::MultimeshStats stats = StatsOf(*mesh);
         stats.set_build_seconds(report.seconds > 0 ? report.seconds : seconds);
+        stats.set_corner_matched_loops(static_cast<uint32_t>(report.corner_matched_loops));
 
         v1::BuildMultimeshResponse message;
         v1::BuildMultimeshResult* result = message.mutable_result();
@@ -995,6 +997,7 @@ grpc::Status InbetweenService::OptimizeComesh(
         stats.set_map_energy(report.map_energy);
         stats.set_mesh_energy(report.mesh_energy);
         stats.set_build_seconds(state->session.multimesh_stats().build_seconds());
+        stats.set_corner_matched_loops(state->session.multimesh_stats().corner_matched_loops());
 
         v1::OptimizeComeshResponse message;
         v1::OptimizeComeshResult* result = message.mutable_result();

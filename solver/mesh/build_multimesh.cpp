@@ -532,6 +532,7 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
     report->triangles = static_cast<int>(mesh.triangles.size());
     report->boundary_loops = static_cast<int>(mesh.boundary_loops.size());
     report->cohesive_edges = static_cast<int>(mesh.cohesive_edges.size());
+    report->corner_matched_loops = bc->corner_matched_loops;
     report->equivalence.clear();
     for (const BoundaryGraph& g : graphs) report->equivalence.push_back(g.equivalence.ToString());
     report->seconds =

@@ -55,6 +55,9 @@ struct MultimeshReport {
   std::vector<std::string> equivalence;
   int boundary_loops = 0;
   int cohesive_edges = 0;
+  // Boundary loops (groups of corresponding loops) whose correspondence matched corners to
+  // corners (MultimeshOptions::corner_matching); 0 when arc length (or marks) gave it.
+  int corner_matched_loops = 0;
 };
 
 // Builds one compatible mesh across all drawings (>= 2): S-Alg.1 boundaries of each drawing

@@ -46,6 +46,30 @@ TEST_P(ExamplesBuildTest, BuildsAValidMultimesh) {
   RecordProperty("ms", static_cast<int>(1e3 * report.seconds));
 }
 
+// MeshingParameters.corner_matching = ALWAYS (the API's and project file's choice): corners
+// matched to corners from the start, on every loop where the drawings' corners match, must also
+// give a valid multimesh, with every drawing's boundary vertices on that drawing's outlines as
+// with arc length (same loop count, no inverted triangle).
+TEST_P(ExamplesBuildTest, BuildsWithCornersMatchedFromTheStart) {
+  absl::StatusOr<example_projects::Example> example = example_projects::Load(GetParam());
+  ASSERT_TRUE(example.ok()) << example.status();
+  MultimeshOptions options = example->options;
+  options.corner_matching = MultimeshOptions::CornerMatching::kAlways;
+  MultimeshReport report;
+  absl::StatusOr<Multimesh> mesh =
+      BuildMultimesh(example->drawings, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(mesh.ok()) << GetParam() << ": " << mesh.status();
+  EXPECT_LE(report.corner_matched_loops, report.boundary_loops);
+  std::printf("[ corners  ] %-32s %d of %d loops corner-matched\n", GetParam().c_str(),
+              report.corner_matched_loops, report.boundary_loops);
+  EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
+  EXPECT_TRUE(ValidateBoundaryLoops(*mesh).ok()) << ValidateBoundaryLoops(*mesh);
+  EXPECT_TRUE(ValidateCohesiveEdges(*mesh).ok()) << ValidateCohesiveEdges(*mesh);
+  for (int s = 0; s < mesh->num_shapes(); ++s) {
+    EXPECT_EQ(CountInverted(mesh->triangles, mesh->shapes[s]), 0) << "drawing " << s + 1;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Examples, ExamplesBuildTest, ::testing::ValuesIn(example_projects::List()),
                          example_projects::TestName<::testing::TestParamInfo<std::string>>);
 
