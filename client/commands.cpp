@@ -469,7 +469,8 @@ absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
               {"seconds", optimized->seconds()},
               {"map_energy", optimized->stats().map_energy()},
               {"mesh_energy", optimized->stats().mesh_energy()},
-              {"worst_quality", optimized->stats().worst_quality()}};
+              {"worst_quality", optimized->stats().worst_quality()},
+              {"corner_matched_loops", built->stats().corner_matched_loops()}};
   }
   std::error_code ec;
   std::filesystem::create_directories(options.out_dir, ec);
@@ -495,6 +496,12 @@ absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
                  stats.shapes(), mesh.shapes_size() ? mesh.shapes(0).vertices_size() : 0,
                  mesh.triangles_size(), static_cast<size_t>(mesh.cohesive_edges_size()),
                  options.out_dir.string().c_str());
+    if (stats.corner_matched_loops() > 0) {
+      std::fprintf(stderr,
+                   "boundary correspondence: corners matched to corners on %u loop(s) (arc "
+                   "length could not be meshed, or project meshing.corner_matching = always)\n",
+                   stats.corner_matched_loops());
+    }
   }
   std::printf("%s\n", (options.out_dir / "multimesh.json").string().c_str());
   return absl::OkStatus();

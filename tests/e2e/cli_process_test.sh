@@ -47,8 +47,9 @@ python3 - opt_out <<'PY'
 import json, math, os, sys
 report = json.load(open(os.path.join(sys.argv[1], "report.json")))
 for key in ("vertices_before", "vertices_after", "inner", "outer", "seconds", "map_energy",
-            "mesh_energy", "worst_quality"):
+            "mesh_energy", "worst_quality", "corner_matched_loops"):
     assert key in report, (key, report)
+assert report["corner_matched_loops"] == 0, report  # square -> hexagon: arc length meshes it
 mesh = json.load(open(os.path.join(sys.argv[1], "multimesh.json")))
 worst = 1.0
 for shape in (s["vertices"] for s in mesh["shapes"]):
@@ -60,6 +61,21 @@ for shape in (s["vertices"] for s in mesh["shapes"]):
         worst = min(worst, 2 * math.sqrt(3) * area2 / edges)
 assert abs(report["worst_quality"] - worst) < 1e-6 and worst >= 0.02, (report, worst)
 print(f"report.json: worst quality {worst:.4f}")
+PY
+
+# A project's meshing.corner_matching reaches the build: bar -> arch with corners matched from
+# the start reports its one loop in report.json and says so on stderr.
+cat > corners.json <<JSON
+{"version": 1, "drawings": ["$INBETWEEN_SRC/examples/bar_arch/bar.svg",
+                            "$INBETWEEN_SRC/examples/bar_arch/arch.svg"],
+ "meshing": {"corner_matching": "always"}}
+JSON
+"$CLI_BIN" optimize --project corners.json --out corners_out 2> corners.err >/dev/null
+grep -q "corners matched to corners on 1 loop" corners.err || { cat corners.err; exit 1; }
+python3 - corners_out <<'PY'
+import json, os, sys
+report = json.load(open(os.path.join(sys.argv[1], "report.json")))
+assert report["corner_matched_loops"] == 1, report
 PY
 
 # -q: no progress output (neither JSON events nor a bar), the result path still on stdout.
