@@ -298,8 +298,10 @@ std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(
   const int n = static_cast<int>(first.size());
   if (n == 0) return {};
   std::vector<std::pair<double, std::vector<double>>> pairs(n);
-  for (int i = 0; i < n; ++i) pairs[i] = {first[i].arc, std::vector<double>(num_shapes)};
-  for (int i = 0; i < n; ++i) pairs[i].second[0] = first[i].arc;
+  for (int i = 0; i < n; ++i) {
+    pairs[i] = {first[i].arc, std::vector<double>(num_shapes)};
+    pairs[i].second[0] = first[i].arc;
+  }
   for (int d = 1; d < num_shapes; ++d) {
     const Curve& c = *curves[d];
     std::vector<Corner> corners = CornersOf(c, corner_angle_degrees);
