@@ -254,6 +254,13 @@ v1::MultimeshStats StatsOf(const solver::Multimesh& mesh) {
   return stats;
 }
 
+// What only the build knew (its time, the loops it matched corner to corner), kept from the
+// build's stats into those of a later mesh of the same session (optimized or imported).
+void KeepBuildFacts(const v1::MultimeshStats& build, v1::MultimeshStats* stats) {
+  stats->set_build_seconds(build.build_seconds());
+  stats->set_corner_matched_loops(build.corner_matched_loops());
+}
+
 // The status to return once the token tripped: the deadline's, or the client's cancellation.
 absl::Status StoppedStatus(const grpc::ServerContext& context, absl::string_view rpc) {
   if (context.deadline() <= std::chrono::system_clock::now()) {
@@ -623,8 +630,7 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext* context,
       v1::MultimeshStats stats = StatsOf(*mesh);
       stats.set_map_energy(session.multimesh_stats().map_energy());
       stats.set_mesh_energy(session.multimesh_stats().mesh_energy());
-      stats.set_build_seconds(session.multimesh_stats().build_seconds());
-      stats.set_corner_matched_loops(session.multimesh_stats().corner_matched_loops());
+      KeepBuildFacts(session.multimesh_stats(), &stats);
       *session.mutable_multimesh_stats() = stats;
       session.set_stage(std::max(session.stage(), v1::STAGE_MULTIMESH));
       state.multimesh = std::make_shared<const solver::Multimesh>(*std::move(mesh));
@@ -996,8 +1002,7 @@ grpc::Status InbetweenService::OptimizeComesh(
         v1::MultimeshStats stats = StatsOf(*mesh);
         stats.set_map_energy(report.map_energy);
         stats.set_mesh_energy(report.mesh_energy);
-        stats.set_build_seconds(state->session.multimesh_stats().build_seconds());
-        stats.set_corner_matched_loops(state->session.multimesh_stats().corner_matched_loops());
+        KeepBuildFacts(state->session.multimesh_stats(), &stats);
 
         v1::OptimizeComeshResponse message;
         v1::OptimizeComeshResult* result = message.mutable_result();

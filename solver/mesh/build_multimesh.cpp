@@ -550,7 +550,8 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
                                          const ProgressFn& progress, MultimeshReport* report) {
   using CornerMatching = MultimeshOptions::CornerMatching;
   if (options.corner_matching == CornerMatching::kAlways) {
-    return BuildOnce(drawings, options, true, false, cancel, progress, report);
+    return BuildOnce(drawings, options, /*match_corners=*/true, /*require_match=*/false, cancel,
+                     progress, report);
   }
   // Progress stays monotone across the two attempts.
   double reached = 0.0;
@@ -559,8 +560,8 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     reached = std::max(reached, fraction);
     if (progress) progress(stage, reached, detail);
   };
-  absl::StatusOr<Multimesh> first =
-      BuildOnce(drawings, options, false, false, cancel, monotone, report);
+  absl::StatusOr<Multimesh> first = BuildOnce(drawings, options, /*match_corners=*/false,
+                                              /*require_match=*/false, cancel, monotone, report);
   const absl::StatusCode code = first.status().code();
   if (first.ok() || options.corner_matching == CornerMatching::kNever ||
       (code != absl::StatusCode::kInvalidArgument &&
@@ -570,8 +571,8 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   monotone("correspondence", reached,
            absl::StrCat("by arc length: ", first.status().message(),
                         "; again with corners matched to corners"));
-  absl::StatusOr<Multimesh> second =
-      BuildOnce(drawings, options, true, true, cancel, monotone, report);
+  absl::StatusOr<Multimesh> second = BuildOnce(drawings, options, /*match_corners=*/true,
+                                               /*require_match=*/true, cancel, monotone, report);
   if (second.ok() || second.status().code() == absl::StatusCode::kCancelled) return second;
   return first;
 }

@@ -25,37 +25,26 @@ Pt Affine(Pt p) {
   return {c * x - s * y + 5, s * x + c * y - 3};
 }
 
-class CornerMatchingServiceTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    ServerOptions options;
-    options.shutdown_grace = std::chrono::milliseconds(500);
-    absl::StatusOr<std::unique_ptr<InbetweenServer>> server = InbetweenServer::Start(options);
-    ASSERT_TRUE(server.ok()) << server.status();
-    server_ = *std::move(server);
-    stub_ = v1::Inbetween::NewStub(server_->InProcessChannel());
+// An outline element through the given points (counter-clockwise: positive signed area).
+v1::TopologyElement Outline(const std::vector<Pt>& points) {
+  v1::TopologyElement element;
+  element.set_kind(v1::ELEMENT_KIND_OUTLINE);
+  for (Pt p : points) {
+    v1::Point* q = element.mutable_polyline()->add_points();
+    q->set_x(p.first);
+    q->set_y(p.second);
   }
+  return element;
+}
 
-  // A new session holding one drawing per outline (counter-clockwise points).
-  void PutDrawings(const std::vector<std::vector<Pt>>& outlines) {
-    grpc::ClientContext context;
-    v1::CreateSessionResponse created;
-    ASSERT_TRUE(stub_->CreateSession(&context, v1::CreateSessionRequest(), &created).ok());
-    session_ = created.session();
-    for (const std::vector<Pt>& points : outlines) {
-      grpc::ClientContext put_context;
-      v1::PutDrawingRequest request;
-      request.set_session_id(session_.id());
-      request.set_expected_version(session_.version());
-      v1::TopologyElement* outline = request.mutable_drawing()->mutable_polylines()->add_elements();
-      outline->set_kind(v1::ELEMENT_KIND_OUTLINE);
-      for (Pt p : points) {
-        v1::Point* q = outline->mutable_polyline()->add_points();
-        q->set_x(p.first);
-        q->set_y(p.second);
-      }
+class CornerMatchingServiceTest : public ServerTest {
+ protected:
+  // A new session holding one drawing per outline.
+  void PutDrawings(const std::vector<v1::TopologyElement>& outlines) {
+    session_ = CreateSession("corner matching");
+    for (const v1::TopologyElement& outline : outlines) {
       v1::PutDrawingResponse response;
-      const grpc::Status status = stub_->PutDrawing(&put_context, request, &response);
+      const grpc::Status status = PutPolylines(session_, outline, &response);
       ASSERT_TRUE(status.ok()) << status.error_message();
       session_ = response.session();
     }
@@ -81,15 +70,13 @@ class CornerMatchingServiceTest : public ::testing::Test {
     return reader->Finish();
   }
 
-  std::unique_ptr<InbetweenServer> server_;
-  std::unique_ptr<v1::Inbetween::Stub> stub_;
   v1::Session session_;
 };
 
 TEST_F(CornerMatchingServiceTest, TheSettingDecidesWhetherTheAffineCopyIsMeshed) {
   std::vector<Pt> copy;
   for (Pt p : Arrowhead()) copy.push_back(Affine(p));
-  ASSERT_NO_FATAL_FAILURE(PutDrawings({Arrowhead(), copy}));
+  ASSERT_NO_FATAL_FAILURE(PutDrawings({Outline(Arrowhead()), Outline(copy)}));
   v1::Multimesh mesh;
   const grpc::Status never = Build(v1::CORNER_MATCHING_NEVER, &mesh);
   EXPECT_FALSE(never.ok());
@@ -123,8 +110,7 @@ TEST_F(CornerMatchingServiceTest, TheSettingDecidesWhetherTheAffineCopyIsMeshed)
 
 TEST_F(CornerMatchingServiceTest, ArcLengthBuildsCountNoCornerMatchedLoop) {
   // Two squares: arc length meshes them, so the default build matches no corners; ALWAYS does.
-  ASSERT_NO_FATAL_FAILURE(
-      PutDrawings({{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{0, 0}, {2, 0}, {2, 2}, {0, 2}}}));
+  ASSERT_NO_FATAL_FAILURE(PutDrawings({SquareOutline(0, 0, 1), SquareOutline(0, 0, 2)}));
   v1::Multimesh mesh;
   v1::MultimeshStats stats;
   ASSERT_TRUE(Build(v1::CORNER_MATCHING_UNSPECIFIED, &mesh, &stats).ok());
