@@ -270,11 +270,14 @@ std::vector<Corner> CornersOf(const Curve& c, double corner_angle_degrees) {
 // corners, or nothing. Every drawing must have as many corners on the loop as drawing 1; they are
 // matched in cyclic order, each pair turning the same way, at the shift that best agrees in the
 // pairs' turn angles and with the automatic alignment (`start`: drawing d's arc aligned with
-// drawing 1's arc 0; on thin sheared shapes it can be a quarter of the loop off: the turn angles
-// tell a needle's tip from its other corners).
+// drawing 1's arc 0). The turn angles weigh kTurnWeight times more: corners are matched when arc
+// length failed, often because the alignment is far off (a needle's tip aligned with its blunt
+// end, half the loop away), while the turn angles tell the tip from the other corners; the
+// alignment decides between corners that turn alike (a square's, a parallelogram's).
 // Corners are first every vertex turning by more than kFineCornerDegrees (a polygon and its
 // affine copy: vertex onto vertex), else those above `corner_angle_degrees`.
 constexpr double kFineCornerDegrees = 1.0;
+constexpr double kTurnWeight = 10.0;
 
 std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(
     const std::vector<const Curve*>& curves, const std::vector<double>& start,
@@ -322,16 +325,19 @@ std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(
           cost = std::numeric_limits<double>::infinity();
         }
         const double turn = (corners[j].angle - first[i].angle) / std::numbers::pi;
-        cost += dist * dist + turn * turn;
+        cost += dist * dist + kTurnWeight * turn * turn;
       }
       if (cost < best_cost) best_cost = cost, best = r;
     }
     if (best < 0) return {};
-    double previous = -1.0;  // strictly increasing from the first pair's corner (else no match)
+    // The matched corners' arcs, measured from the first pair's corner, must increase strictly
+    // (else no match).
+    const double first_arc = corners[at[best].second].arc;
+    double previous = -1.0;
     for (int i = 0; i < n; ++i) {
       const double arc = corners[at[(i + best) % n].second].arc;
-      const double from_first = std::fmod(arc - pairs[0].second[d] + c.length(), c.length());
-      if (i > 0 && !(from_first > previous)) return {};
+      const double from_first = std::fmod(arc - first_arc + c.length(), c.length());
+      if (!(from_first > previous)) return {};
       previous = from_first;
       pairs[i].second[d] = arc;
     }

@@ -22,7 +22,8 @@ struct BoundaryCorrespondenceOptions {
   std::vector<std::vector<Point>> marks;
   // Without marks on a loop: when every drawing has as many corners on it as drawing 1, they are
   // matched in cyclic order (each pair turning the same way, convex or reflex; of such shifts,
-  // the one closest in the pairs' turn angles and to the automatic alignment) and the loop is
+  // the one closest in the pairs' turn angles and, far less, to the automatic alignment) and the
+  // loop is
   // reparameterized by arc length between them. Corners here: first every vertex turning by
   // more than 1 degree (so a polygon and its affine copy match vertex to vertex), else those
   // above corner_angle_degrees. So corners go onto corners, and an affine image of a polygon

@@ -19,7 +19,7 @@ using ::testing::HasSubstr;
 
 // A 10 x 10 square with a slit from (x, 0) on its bottom edge up to (x + lean, depth). With
 // `rounded`, each corner is a quarter circle of radius 1 in 100 steps (0.9 degrees: no vertex
-// turns by a degree, so no corners to match: the boundaries are matched by arc length alone).
+// of the outline turns by a degree; the only corners are the slit's mouth and tip).
 Drawing SlitSquare(double x, double lean, double depth, bool rounded = false) {
   Drawing d;
   if (!rounded) {
@@ -54,16 +54,27 @@ TEST(BuildMultimeshCutEndsTest, SlitsEndingAtTheSamePlacesBuild) {
 }
 
 TEST(BuildMultimeshCutEndsTest, SlitsEndingAtDifferentPlacesAreRefusedWithWhatToDo) {
-  // Slits at different places and of different depths in four drawings, nothing marked and no
-  // corners to match: each drawing's mirror maps the others' breakpoints somewhere new.
+  // Slits at different places and of different depths in four drawings, nothing marked, matched
+  // by arc length alone: each drawing's mirror maps the others' breakpoints somewhere new.
   const std::vector<Drawing> drawings = {
       SlitSquare(3.1, 0.3, 5.3, true), SlitSquare(4.7, -0.4, 6.9, true),
       SlitSquare(5.9, 0.8, 4.1, true), SlitSquare(3.8, 0.1, 7.7, true)};
-  const absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, {});
+  MultimeshOptions arc_length;
+  arc_length.corner_matching = MultimeshOptions::CornerMatching::kNever;
+  const absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, arc_length);
   ASSERT_FALSE(mesh.ok()) << mesh->shapes[0].size() << " vertices";
   EXPECT_EQ(mesh.status().code(), absl::StatusCode::kInvalidArgument) << mesh.status();
   EXPECT_THAT(mesh.status().message(), HasSubstr("cuts or openings of drawings 1, 2, 3, 4"));
   EXPECT_THAT(mesh.status().message(), HasSubstr("pin both ends of every cut"));
+  // By default the second attempt matches the slits' mouths and tips, the loop's only corners,
+  // corner to corner (the slit mouth is not the loop's start, so this needs the matched corners'
+  // arcs measured from the first matched corner, not from the loop's start), and builds.
+  MultimeshReport report;
+  const absl::StatusOr<Multimesh> matched =
+      BuildMultimesh(drawings, {}, nullptr, nullptr, &report);
+  ASSERT_TRUE(matched.ok()) << matched.status();
+  EXPECT_TRUE(ValidateMultimesh(*matched).ok()) << ValidateMultimesh(*matched);
+  EXPECT_EQ(report.corner_matched_loops, 1);
 }
 
 // The same slits in squares: matched by arc length they are refused like the rounded ones

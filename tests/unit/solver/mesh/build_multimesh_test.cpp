@@ -107,6 +107,10 @@ TEST(BuildMultimeshTest, AffineCopyOfAConcavePolygonMapsCornerToCorner) {
       {{{0, 30}, {0, 0}, {25, 0}, {2, 2}}, 0.5, 1.0, -0.4},
       {{{0, 27}, {0, 0}, {6, 0}, {2, 5}}, 0.3, 1.0, -0.4},
       {{{16, 30}, {30, 0}, {31, 0}}, 3.0, 0.5, -0.5},
+      // A needle (mesh_fuzz's corpus): arc length maps its tip onto the blunt end, and of the
+      // corner pairings the turn angles must pick tip onto tip (the aligned start is far off).
+      {{{0, 0}, {32, 0}, {32, 1}}, 1.8, 0.5, -0.5},
+      {{{0, 0}, {32, 0}, {32, 1}}, 4.5, 1.5, 0.0},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
     SCOPED_TRACE(::testing::Message() << "case " << i);
