@@ -275,8 +275,12 @@ std::vector<Corner> CornersOf(const Curve& c, double corner_angle_degrees) {
 // end, half the loop away), while the turn angles tell the tip from the other corners; the
 // alignment decides between corners that turn alike (a square's, a parallelogram's).
 // Corners are first every vertex turning by more than kFineCornerDegrees (a polygon and its
-// affine copy: vertex onto vertex), else those above `corner_angle_degrees`.
+// affine copy: vertex onto vertex); if their counts differ, every vertex that is not collinear
+// with its neighbours (turning by more than kCollinearDegrees: a shear can take a vertex's turn
+// across 1 degree, but an affine map keeps collinear points collinear); else those above
+// `corner_angle_degrees`.
 constexpr double kFineCornerDegrees = 1.0;
+constexpr double kCollinearDegrees = 1e-6;
 constexpr double kTurnWeight = 10.0;
 
 std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(
@@ -286,11 +290,12 @@ std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(
 std::vector<std::pair<double, std::vector<double>>> MatchCorners(
     const std::vector<const Curve*>& curves, const std::vector<double>& start,
     double corner_angle_degrees) {
-  auto pairs = MatchCornersAbove(curves, start, std::min(kFineCornerDegrees, corner_angle_degrees));
-  if (pairs.empty() && corner_angle_degrees > kFineCornerDegrees) {
-    pairs = MatchCornersAbove(curves, start, corner_angle_degrees);
+  for (double degrees : {std::min(kFineCornerDegrees, corner_angle_degrees), kCollinearDegrees,
+                         corner_angle_degrees}) {
+    auto pairs = MatchCornersAbove(curves, start, degrees);
+    if (!pairs.empty()) return pairs;
   }
-  return pairs;
+  return {};
 }
 
 std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(

@@ -23,14 +23,15 @@ struct BoundaryCorrespondenceOptions {
   // Without marks on a loop: when every drawing has as many corners on it as drawing 1, they are
   // matched in cyclic order (each pair turning the same way, convex or reflex; of such shifts,
   // the one closest in the pairs' turn angles and, far less, to the automatic alignment) and the
-  // loop is
-  // reparameterized by arc length between them. Corners here: first every vertex turning by
-  // more than 1 degree (so a polygon and its affine copy match vertex to vertex), else those
-  // above corner_angle_degrees. So corners go onto corners, and an affine image of a polygon
-  // gets the affine correspondence (plain arc length put a sheared arrowhead's corners onto
-  // straight sides, and its map folded). Otherwise, and with false (the default), arc length
-  // from the aligned start. BuildMultimesh turns it on when the arc-length correspondence
-  // cannot be built or mapped (MultimeshOptions::corner_matching).
+  // loop is reparameterized by arc length between them. Corners here: first every vertex
+  // turning by more than 1 degree (so a polygon and its affine copy match vertex to vertex); if
+  // their counts differ, every vertex off its neighbours' line (a shear can take a turn across 1
+  // degree, but an affine map keeps collinear points collinear); else those above
+  // corner_angle_degrees. So corners go onto corners, and an affine image of a polygon gets the
+  // affine correspondence (plain arc length put a sheared arrowhead's corners onto straight
+  // sides, and its map folded). Otherwise, and with false (the default), arc length from the
+  // aligned start. BuildMultimesh turns it on when the arc-length correspondence cannot be built
+  // or mapped (MultimeshOptions::corner_matching).
   bool match_corners = false;
 };
 

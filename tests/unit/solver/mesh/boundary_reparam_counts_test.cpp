@@ -733,6 +733,49 @@ TEST(BoundaryReparamCountsTest, RandomPairsAndTriplesWithCornersMatched) {
   }
 }
 
+// Affine copies whose corners the first matching attempts got wrong: every polygon vertex must
+// correspond to its own image.
+TEST(BoundaryReparamCountsTest, AffineCopiesMatchVertexToVertex) {
+  struct AffineCase {
+    Points polygon;
+    double angle, scale, shear;
+  };
+  const std::vector<AffineCase> cases = {
+      // A needle: arc length aligns its tip with the copy's blunt end, half the loop away, so
+      // the first matched corner lies far along the copy's loop, and only the turn angles tell
+      // the tip from the other corners.
+      {{{0, 0}, {32, 0}, {32, 1}}, 1.8, 0.5, -0.5},
+      // A random star-shaped polygon whose vertex (16.91, 23.46) turns by less than a degree and,
+      // sheared, by more: the corners above a degree differ in count, the vertices off their
+      // neighbours' line (an affine invariant) do not.
+      {{{24.43, 21.27}, {34.93, 35.43}, {21.32, 36.86}, {16.91, 23.46}, {13.04, 18.84},
+        {10.61, -10.14}, {35.51, 8.42}, {45.08, 9.14}, {20.28, 15.43}},
+       5.2, 1.6, 0.4},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    SCOPED_TRACE(::testing::Message() << "case " << i);
+    const AffineCase& c = cases[i];
+    Eigen::Matrix2d affine;
+    affine << std::cos(c.angle), -std::sin(c.angle), std::sin(c.angle), std::cos(c.angle);
+    affine = affine * Eigen::Matrix2d{{c.scale, c.scale * c.shear}, {0.0, c.scale}};
+    Points image;
+    for (const Point& p : c.polygon) image.push_back(affine * p + Point(5, -3));
+    absl::StatusOr<Stage> s =
+        Correspond({Drawing{{Outline{c.polygon}}}, Drawing{{Outline{image}}}}, {}, 16, true);
+    ASSERT_TRUE(s.ok()) << s.status();
+    EXPECT_EQ(s->bc.corner_matched_loops, 1);
+    EXPECT_TRUE(CheckAll(s->views));
+    const Points& from = s->bc.shapes[0][0];
+    const Points& to = s->bc.shapes[1][0];
+    for (size_t k = 0; k < c.polygon.size(); ++k) {
+      const auto at = std::find_if(from.begin(), from.end(),
+                                   [&](const Point& p) { return (p - c.polygon[k]).norm() < 1e-9; });
+      ASSERT_NE(at, from.end()) << "polygon vertex " << k;
+      EXPECT_LT((to[at - from.begin()] - image[k]).norm(), 1e-9) << "polygon vertex " << k;
+    }
+  }
+}
+
 // Gentle random cases (see RandomCase) that BuildMultimesh maps, with a coarse interior to keep
 // the test fast: pairs and triples, one or two components, holes, 40..100 or automatic boundary
 // vertices.
