@@ -185,13 +185,19 @@ absl::StatusOr<std::vector<std::vector<Point>>> MarksFromDrawings(
   return marks;
 }
 
-// One attempt of BuildMultimesh, corners matched or not. With require_match, returns ABORTED
-// (not an answer: the caller keeps its first error) when no loop's corners matched, before any
-// meshing.
+// Drawings whose mesh BuildMultimesh tries to map into the others (see `references` in
+// BuildOnce).
+constexpr int kMaxReferences = 3;
+
+// One attempt of BuildMultimesh, corners matched or not, meshing the drawing of the given rank
+// in the order of `references` below (0: the preferred one; *meshed: which drawing that is).
+// Returns ABORTED (not an answer: the caller keeps its first error) with require_match when no
+// loop's corners matched, and when there is no drawing of that rank, before any meshing.
 absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
                                     const MultimeshOptions& options, bool match_corners,
-                                    bool require_match, const CancelToken* cancel,
-                                    const ProgressFn& progress, MultimeshReport* report) {
+                                    bool require_match, int rank, const CancelToken* cancel,
+                                    const ProgressFn& progress, MultimeshReport* report,
+                                    int* meshed) {
   const auto start = std::chrono::steady_clock::now();
   auto notify = [&](const std::string& stage, double fraction, const std::string& detail) {
     if (progress) progress(stage, fraction, detail);
@@ -269,16 +275,26 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
 
   // The drawing meshed first: the one with the most closed cut/opening sides. Opening a slit
   // (mapping out of the closed drawing) only widens angles, while closing a hole onto a slit
-  // asks the mesh for 2*pi at the slit tips; RefineBoundaryFans covers what remains.
-  int ref = 0;
+  // asks the mesh for 2*pi at the slit tips; RefineBoundaryFans covers what remains. The next
+  // ranks (when the first drawing's mesh cannot be mapped into some drawing) follow in that
+  // order, ties in key order, up to kMaxReferences: a mesh of a concave drawing often maps onto
+  // a convex one when the other way round a chord of the convex drawing's mesh has nowhere to go.
+  std::vector<int> references(num_shapes);
+  std::iota(references.begin(), references.end(), 0);
   {
-    int best = -1;
+    std::vector<int> closed(num_shapes);
     for (int d = 0; d < num_shapes; ++d) {
-      const int closed = static_cast<int>(std::count_if(
-          bc->edge_twin[d].begin(), bc->edge_twin[d].end(), [](int f) { return f >= 0; }));
-      if (closed > best) best = closed, ref = d;
+      closed[d] = static_cast<int>(std::count_if(bc->edge_twin[d].begin(), bc->edge_twin[d].end(),
+                                                 [](int f) { return f >= 0; }));
     }
+    std::stable_sort(references.begin(), references.end(),
+                     [&](int a, int b) { return closed[a] > closed[b]; });
   }
+  if (rank >= std::min(num_shapes, kMaxReferences)) {
+    return absl::AbortedError("no other drawing to mesh");
+  }
+  const int ref = references[rank];
+  if (meshed != nullptr) *meshed = ref;
 
   if (Cancelled(cancel)) return absl::CancelledError("BuildMultimesh cancelled");
   notify("triangulate", 0.1,
@@ -549,32 +565,62 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
                                          const MultimeshOptions& options, const CancelToken* cancel,
                                          const ProgressFn& progress, MultimeshReport* report) {
   using CornerMatching = MultimeshOptions::CornerMatching;
-  if (options.corner_matching == CornerMatching::kAlways) {
-    return BuildOnce(drawings, options, /*match_corners=*/true, /*require_match=*/false, cancel,
-                     progress, report);
-  }
-  // Progress stays monotone across the two attempts.
+  // Progress stays monotone across the attempts.
   double reached = 0.0;
   const ProgressFn monotone = [&](const std::string& stage, double fraction,
                                   const std::string& detail) {
     reached = std::max(reached, fraction);
     if (progress) progress(stage, reached, detail);
   };
-  absl::StatusOr<Multimesh> first = BuildOnce(drawings, options, /*match_corners=*/false,
-                                              /*require_match=*/false, cancel, monotone, report);
-  const absl::StatusCode code = first.status().code();
-  if (first.ok() || options.corner_matching == CornerMatching::kNever ||
-      (code != absl::StatusCode::kInvalidArgument &&
-       code != absl::StatusCode::kFailedPrecondition)) {
-    return first;
+  const bool arc_length = options.corner_matching != CornerMatching::kAlways;
+  const bool corners = options.corner_matching != CornerMatching::kNever;
+  // Per reference drawing (rank), arc length and then corners matched; the next reference only
+  // when the first one's meshes could not be mapped (FAILED_PRECONDITION). The first attempt's
+  // error is the answer when nothing builds.
+  absl::StatusOr<Multimesh> first = absl::UnknownError("no attempt");
+  std::string others;  // the drawings meshed after the first, when none of them built
+  int num_others = 0;
+  for (int rank = 0; rank < kMaxReferences; ++rank) {
+    int meshed = -1;
+    auto attempt = [&](bool match_corners,
+                       bool require_match) -> std::optional<absl::StatusOr<Multimesh>> {
+      absl::StatusOr<Multimesh> m = BuildOnce(drawings, options, match_corners, require_match, rank,
+                                              cancel, monotone, report, &meshed);
+      if (m.ok() || absl::IsCancelled(m.status())) return m;
+      if (rank == 0 && first.status().code() == absl::StatusCode::kUnknown) first = m;
+      return std::nullopt;
+    };
+    if (rank > 0) {
+      if (!absl::IsFailedPrecondition(first.status())) break;
+      monotone("triangulate", reached,
+               absl::StrCat(first.status().message(), "; again with another drawing's mesh"));
+    }
+    bool retry_corners = corners;
+    if (arc_length) {
+      if (auto built = attempt(false, false)) return *built;
+      const absl::StatusCode code = rank == 0 ? first.status().code() : absl::StatusCode::kOk;
+      if (rank == 0 && code != absl::StatusCode::kInvalidArgument &&
+          code != absl::StatusCode::kFailedPrecondition) {
+        return first;
+      }
+      if (retry_corners) {
+        monotone("correspondence", reached,
+                 rank == 0 ? absl::StrCat("by arc length: ", first.status().message(),
+                                          "; again with corners matched to corners")
+                           : std::string("again with corners matched to corners"));
+      }
+    }
+    if (retry_corners) {
+      if (auto built = attempt(true, /*require_match=*/arc_length)) return *built;
+    }
+    if (meshed < 0) break;  // no drawing of this rank: nothing was tried
+    if (rank > 0) absl::StrAppend(&others, num_others++ > 0 ? ", " : "", meshed + 1);
   }
-  monotone("correspondence", reached,
-           absl::StrCat("by arc length: ", first.status().message(),
-                        "; again with corners matched to corners"));
-  absl::StatusOr<Multimesh> second = BuildOnce(drawings, options, /*match_corners=*/true,
-                                               /*require_match=*/true, cancel, monotone, report);
-  if (second.ok() || second.status().code() == absl::StatusCode::kCancelled) return second;
-  return first;
+  if (num_others == 0) return first;
+  return absl::FailedPreconditionError(
+      absl::StrCat(first.status().message(),
+                   num_others == 1 ? " (the mesh of drawing " : " (the meshes of drawings ", others,
+                   " did not map either)"));
 }
 
 }  // namespace inbetween::solver

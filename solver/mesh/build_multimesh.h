@@ -66,6 +66,10 @@ struct MultimeshReport {
 // components, cut sides duplicated into cohesive edge pairs), boundary Steiner points mirrored
 // across every cohesive zone, fans widened where a boundary angle must open up to 2*pi
 // (refine_boundary_fans.h), then an injective map of each component into every other drawing.
+// When that drawing's mesh cannot be mapped (FAILED_PRECONDITION, after both correspondences
+// below), the next drawings in the same order are meshed instead, up to 3 in all (random
+// star-shaped pairs: refusals 86 -> 57, 27 -> 6, 5 -> 1 of ~190 each, docs/hardening.md); the
+// error is then the first drawing's, naming the others tried.
 // Drawings are named 1-based in messages ("drawing 2"). Errors: INVALID_ARGUMENT naming the drawing
 // and what is wrong (including drawings of different equivalence class), FAILED_PRECONDITION when a
 // shape cannot be reached, CANCELLED.
