@@ -595,22 +595,21 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       monotone("triangulate", reached,
                absl::StrCat(first.status().message(), "; again with another drawing's mesh"));
     }
-    bool retry_corners = corners;
     if (arc_length) {
       if (auto built = attempt(false, false)) return *built;
-      const absl::StatusCode code = rank == 0 ? first.status().code() : absl::StatusCode::kOk;
-      if (rank == 0 && code != absl::StatusCode::kInvalidArgument &&
-          code != absl::StatusCode::kFailedPrecondition) {
+      if (rank == 0 && !absl::IsInvalidArgument(first.status()) &&
+          !absl::IsFailedPrecondition(first.status())) {
         return first;
       }
-      if (retry_corners) {
+      if (rank > 0 && meshed < 0) break;  // no drawing of this rank
+      if (corners) {
         monotone("correspondence", reached,
                  rank == 0 ? absl::StrCat("by arc length: ", first.status().message(),
                                           "; again with corners matched to corners")
                            : std::string("again with corners matched to corners"));
       }
     }
-    if (retry_corners) {
+    if (corners) {
       if (auto built = attempt(true, /*require_match=*/arc_length)) return *built;
     }
     if (meshed < 0) break;  // no drawing of this rank: nothing was tried
