@@ -230,9 +230,14 @@ TEST(BuildMultimeshTest, MapIterationBudgetIsHonoured) {
   Drawing square;
   square.outlines = {{{Point(0, 0), Point(100, 0), Point(100, 100), Point(0, 100)}}};
   options.max_map_iterations = 1;
-  absl::StatusOr<Multimesh> from_u = BuildMultimesh({square, u}, options);
+  std::vector<std::string> details;
+  absl::StatusOr<Multimesh> from_u = BuildMultimesh(
+      {square, u}, options, nullptr,
+      [&](const std::string&, double, const std::string& d) { details.push_back(d); });
   ASSERT_TRUE(from_u.ok()) << from_u.status();
   ExpectValid({square, u}, *from_u);
+  EXPECT_THAT(details, ::testing::Contains(AllOf(HasSubstr("cannot map drawing 1's mesh"),
+                                                 HasSubstr("again with another drawing's mesh"))));
 }
 
 TEST(BuildMultimeshTest, FineSizeBoundTransfersBoundarySteinerPoints) {
