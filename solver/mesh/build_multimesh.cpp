@@ -577,7 +577,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   // Per reference drawing (rank), arc length and then corners matched; the next reference only
   // when the first one's meshes could not be mapped (FAILED_PRECONDITION). The first attempt's
   // error is the answer when nothing builds.
-  absl::StatusOr<Multimesh> first = absl::UnknownError("no attempt");
+  absl::Status first;  // the first attempt's error (OK until an attempt fails)
   std::string others;  // the drawings meshed after the first, when none of them built
   int num_others = 0;
   for (int rank = 0; rank < kMaxReferences; ++rank) {
@@ -587,24 +587,23 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       absl::StatusOr<Multimesh> m = BuildOnce(drawings, options, match_corners, require_match, rank,
                                               cancel, monotone, report, &meshed);
       if (m.ok() || absl::IsCancelled(m.status())) return m;
-      if (rank == 0 && first.status().code() == absl::StatusCode::kUnknown) first = m;
+      if (rank == 0 && first.ok()) first = m.status();
       return std::nullopt;
     };
     if (rank > 0) {
-      if (!absl::IsFailedPrecondition(first.status())) break;
+      if (!absl::IsFailedPrecondition(first)) break;
       monotone("triangulate", reached,
-               absl::StrCat(first.status().message(), "; again with another drawing's mesh"));
+               absl::StrCat(first.message(), "; again with another drawing's mesh"));
     }
     if (arc_length) {
       if (auto built = attempt(false, false)) return *built;
-      if (rank == 0 && !absl::IsInvalidArgument(first.status()) &&
-          !absl::IsFailedPrecondition(first.status())) {
+      if (rank == 0 && !absl::IsInvalidArgument(first) && !absl::IsFailedPrecondition(first)) {
         return first;
       }
       if (rank > 0 && meshed < 0) break;  // no drawing of this rank
       if (corners) {
         monotone("correspondence", reached,
-                 rank == 0 ? absl::StrCat("by arc length: ", first.status().message(),
+                 rank == 0 ? absl::StrCat("by arc length: ", first.message(),
                                           "; again with corners matched to corners")
                            : std::string("again with corners matched to corners"));
       }
@@ -616,10 +615,9 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     if (rank > 0) absl::StrAppend(&others, num_others++ > 0 ? ", " : "", meshed + 1);
   }
   if (num_others == 0) return first;
-  return absl::FailedPreconditionError(
-      absl::StrCat(first.status().message(),
-                   num_others == 1 ? " (the mesh of drawing " : " (the meshes of drawings ", others,
-                   " did not map either)"));
+  return absl::FailedPreconditionError(absl::StrCat(
+      first.message(), num_others == 1 ? " (the mesh of drawing " : " (the meshes of drawings ",
+      others, " did not map either)"));
 }
 
 }  // namespace inbetween::solver
