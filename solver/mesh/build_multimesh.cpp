@@ -18,6 +18,7 @@
 #include "solver/geometry/graph_flow.h"
 #include "solver/mesh/cgal_triangulate.h"
 #include "solver/mesh/map_to_boundary.h"
+#include "solver/mesh/overlay_mesh.h"
 #include "solver/mesh/refine_boundary_fans.h"
 #include "solver/mesh/split_boundary_chords.h"
 #include "solver/mesh/validate.h"
@@ -195,9 +196,9 @@ constexpr int kMaxReferences = 3;
 // loop's corners matched, and when there is no drawing of that rank, before any meshing.
 absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
                                     const MultimeshOptions& options, bool match_corners,
-                                    bool require_match, int rank, const CancelToken* cancel,
-                                    const ProgressFn& progress, MultimeshReport* report,
-                                    int* meshed) {
+                                    bool require_match, int rank, bool overlay,
+                                    const CancelToken* cancel, const ProgressFn& progress,
+                                    MultimeshReport* report, int* meshed) {
   const auto start = std::chrono::steady_clock::now();
   auto notify = [&](const std::string& stage, double fraction, const std::string& detail) {
     if (progress) progress(stage, fraction, detail);
@@ -401,16 +402,21 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
     RefineBoundaryFans(demand, &cut.vertices, &cut.triangles, &is_boundary);
   }
   mesh.triangles = cut.triangles;
-  const int num_vertices = static_cast<int>(cut.vertices.size());
+  int num_vertices = static_cast<int>(cut.vertices.size());
 
   // Connected components, each mapped on its own.
-  UnionFind components(num_vertices);
-  for (const Triangle& t : mesh.triangles)
-    components.Unite(t[0], t[1]), components.Unite(t[0], t[2]);
+  std::vector<int> component_of(num_vertices);
+  {
+    UnionFind components(num_vertices);
+    for (const Triangle& t : mesh.triangles)
+      components.Unite(t[0], t[1]), components.Unite(t[0], t[2]);
+    for (int v = 0; v < num_vertices; ++v) component_of[v] = components.Find(v);
+  }
   std::map<int, std::vector<int>> loops_of_component;
   for (int g = 0; g < bc->num_loops(); ++g) {
-    loops_of_component[components.Find(mesh.boundary_loops[g][0])].push_back(g);
+    loops_of_component[component_of[mesh.boundary_loops[g][0]]].push_back(g);
   }
+  int overlays = 0;
   mesh.shapes.assign(num_shapes, {});
   mesh.shapes[ref] = targets_of(ref);
   // Drawings are mapped outward from the reference in key order (ref - 1, ref + 1, ref - 2, ...),
@@ -432,7 +438,7 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
       std::vector<int> local(num_vertices, -1), global;
       std::vector<Triangle> triangles;
       for (const Triangle& t : mesh.triangles) {
-        if (components.Find(t[0]) != root) continue;
+        if (component_of[t[0]] != root) continue;
         Triangle lt;
         for (int k = 0; k < 3; ++k) {
           if (local[t[k]] < 0)
@@ -490,6 +496,67 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
         absl::StatusOr<Points> retry =
             injective(MapToBoundary(source, triangles, boundary, target_boundary, chained, cancel));
         if (retry.ok() || final_error(retry.status())) mapped = std::move(retry);
+      }
+      // Last resort (a disk whose boundary in drawing d is a simple polygon): a common
+      // refinement of this mesh and a triangulation of drawing d (overlay_mesh.h). It adds
+      // vertices to the component in every drawing mapped so far.
+      if (!mapped.ok() && overlay && absl::IsFailedPrecondition(mapped.status()) &&
+          loops.size() == 1) {
+        std::vector<int> known = {ref};  // drawings placed so far: the Tutte weights from ref
+        for (int e = 0; e < num_shapes; ++e) {
+          if (e != ref && e != d && !mesh.shapes[e].empty()) known.push_back(e);
+        }
+        std::vector<Points> placed;
+        for (int e : known) {
+          Points local_shape;
+          for (int v : global) local_shape.push_back(mesh.shapes[e][v]);
+          placed.push_back(std::move(local_shape));
+        }
+        notify("map", 0.2 + 0.75 * (done - 1) / (num_shapes - 1),
+               absl::StrCat("drawing ", d + 1, ": ", mapped.status().message(),
+                            "; overlaying the mesh with a triangulation of drawing ", d + 1));
+        absl::StatusOr<OverlayResult> over =
+            OverlayOntoPolygon(triangles, placed, boundary, target_boundary, cancel);
+        if (over.ok()) {
+          // New vertices get global indices after the existing ones, in every placed drawing,
+          // in drawing d and among the reference's points (targets_of reads those).
+          const size_t local_before = global.size();
+          for (int i = 0; i < over->added_vertices; ++i) {
+            global.push_back(num_vertices++);
+            component_of.push_back(root);
+            cut.vertices.push_back(over->shapes[0][global.size() - 1]);
+          }
+          for (size_t k = 0; k < known.size(); ++k) {
+            Points& s = mesh.shapes[known[k]];
+            for (size_t i = local_before; i < global.size(); ++i) s.push_back(over->shapes[k][i]);
+          }
+          shape.resize(num_vertices);
+          std::vector<Triangle> kept;
+          for (const Triangle& t : mesh.triangles) {
+            if (component_of[t[0]] != root) kept.push_back(t);
+          }
+          for (const Triangle& t : over->triangles) {
+            kept.push_back({global[t[0]], global[t[1]], global[t[2]]});
+          }
+          mesh.triangles = std::move(kept);
+          // Polish the map into drawing d from the overlay's placement (boundary already there).
+          Points source_now;
+          for (int v : global) source_now.push_back(mesh.shapes[ref][v]);
+          MapToBoundaryOptions polish = map_options;
+          polish.tutte_when_convex = polish.tutte_first_always = false;
+          polish.start = &over->shapes.back();
+          std::vector<Triangle> local_triangles = over->triangles;
+          absl::StatusOr<Points> polished =
+              MapToBoundary(source_now, local_triangles, boundary, target_boundary, polish, cancel);
+          if (!polished.ok() && absl::IsCancelled(polished.status())) return polished.status();
+          triangles = std::move(local_triangles);
+          mapped =
+              polished.ok() ? std::move(polished) : absl::StatusOr<Points>(over->shapes.back());
+          mapped = injective(std::move(mapped));
+          ++overlays;
+        } else if (absl::IsCancelled(over.status())) {
+          return over.status();
+        }
       }
       if (!mapped.ok()) {
         if (absl::IsCancelled(mapped.status())) return mapped.status();
@@ -549,6 +616,7 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
     report->boundary_loops = static_cast<int>(mesh.boundary_loops.size());
     report->cohesive_edges = static_cast<int>(mesh.cohesive_edges.size());
     report->corner_matched_loops = bc->corner_matched_loops;
+    report->overlays = overlays;
     report->equivalence.clear();
     for (const BoundaryGraph& g : graphs) report->equivalence.push_back(g.equivalence.ToString());
     report->seconds =
@@ -585,7 +653,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     auto attempt = [&](bool match_corners,
                        bool require_match) -> std::optional<absl::StatusOr<Multimesh>> {
       absl::StatusOr<Multimesh> m = BuildOnce(drawings, options, match_corners, require_match, rank,
-                                              cancel, monotone, report, &meshed);
+                                              /*overlay=*/false, cancel, monotone, report, &meshed);
       if (m.ok() || absl::IsCancelled(m.status())) return m;
       if (rank == 0 && first.ok()) first = m.status();
       return std::nullopt;
@@ -613,6 +681,15 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     }
     if (meshed < 0) break;  // no drawing of this rank: nothing was tried
     if (rank > 0) absl::StrAppend(&others, num_others++ > 0 ? ", " : "", meshed + 1);
+  }
+  if (options.overlay && absl::IsFailedPrecondition(first)) {
+    monotone(
+        "map", reached,
+        absl::StrCat(first.message(), "; again, overlaying the mesh where it cannot be mapped"));
+    absl::StatusOr<Multimesh> m =
+        BuildOnce(drawings, options, /*match_corners=*/!arc_length, /*require_match=*/false,
+                  /*rank=*/0, /*overlay=*/true, cancel, monotone, report, nullptr);
+    if (m.ok() || absl::IsCancelled(m.status())) return m;
   }
   if (num_others == 0) return first;
   return absl::FailedPreconditionError(absl::StrCat(

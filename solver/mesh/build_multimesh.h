@@ -45,6 +45,12 @@ struct MultimeshOptions {
   // max_iterations); when they run out the build is FAILED_PRECONDITION. mesh_fuzz lowers it so
   // that an input whose pull never converges does not cost the time of thousands of others.
   int max_map_iterations = 2000;
+  // When no drawing's mesh maps into some drawing (every attempt above FAILED_PRECONDITION), a
+  // last attempt overlays the first drawing's mesh with a triangulation of each drawing it cannot
+  // be mapped into (overlay_mesh.h): a common refinement that maps into both without folding,
+  // for any component bounded by one loop that is a simple polygon in that drawing. Its thin
+  // triangles are left to comesh optimization. false: such inputs stay FAILED_PRECONDITION.
+  bool overlay = true;
 };
 
 struct MultimeshReport {
@@ -58,6 +64,9 @@ struct MultimeshReport {
   // Boundary loops (groups of corresponding loops) whose correspondence matched corners to
   // corners (MultimeshOptions::corner_matching); 0 when arc length (or marks) gave it.
   int corner_matched_loops = 0;
+  // Drawings (components) reached by the overlay of MultimeshOptions::overlay; 0 when every map
+  // was found directly.
+  int overlays = 0;
 };
 
 // Builds one compatible mesh across all drawings (>= 2): S-Alg.1 boundaries of each drawing
@@ -69,7 +78,9 @@ struct MultimeshReport {
 // When that drawing's mesh cannot be mapped (FAILED_PRECONDITION, after both correspondences
 // below), the next drawings in the same order are meshed instead, up to 3 in all (random
 // star-shaped pairs: refusals 86 -> 57, 27 -> 6, 5 -> 1 of ~190 each, docs/hardening.md); the
-// error is then the first drawing's, naming the others tried.
+// error is then the first drawing's, naming the others tried, unless the overlay below builds.
+// Last (MultimeshOptions::overlay), the first drawing's mesh again, refined by overlay with a
+// triangulation of each drawing it cannot be mapped into.
 // Drawings are named 1-based in messages ("drawing 2"). Errors: INVALID_ARGUMENT naming the drawing
 // and what is wrong (including drawings of different equivalence class), FAILED_PRECONDITION when a
 // shape cannot be reached, CANCELLED.

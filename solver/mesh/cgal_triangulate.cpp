@@ -187,10 +187,14 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
     }
 
     const double size = options.max_edge > 0 ? options.max_edge : 0.0;
-    if (absl::Status s =
-            RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices,
-                          kMinRefinementSpacing * Diagonal({boundary}));
-        !s.ok()) {
+    if (!options.refine) {
+      // The mesher's set-up marks the faces inside the polygon and inserts nothing.
+      CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, Criteria(options.shape_bound, size));
+      mesher.init();
+    } else if (absl::Status s =
+                   RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices,
+                                 kMinRefinementSpacing * Diagonal({boundary}));
+               !s.ok()) {
       return s;
     }
 

@@ -19,6 +19,9 @@ struct TriangulateOptions {
   // sliver or spike far thinner than the rest of the drawing needs elements at its own scale
   // all along it: millions of points, i.e. no answer in practice (mesh_fuzz finding).
   int max_vertices = 2'000'000;
+  // false: the constrained Delaunay triangulation of the boundary alone (no Steiner point; the
+  // size and shape bounds are ignored). CgalTriangulate only.
+  bool refine = true;
 };
 
 // A Steiner vertex the mesher put on the polygon boundary, on segment `segment` (from

@@ -149,9 +149,9 @@ TEST(BuildMultimeshTest, AffineCopyOfAConcavePolygonMapsCornerToCorner) {
     if (by_arc_length.ok()) {
       double off = 0.0;
       for (int v : by_arc_length->boundary) {
-        off = std::max(off, (by_arc_length->shapes[1][v] -
-                             (affine * by_arc_length->shapes[0][v] + offset))
-                                .norm());
+        off = std::max(
+            off,
+            (by_arc_length->shapes[1][v] - (affine * by_arc_length->shapes[0][v] + offset)).norm());
       }
       EXPECT_GT(off, 1e-3);
     }
@@ -188,20 +188,50 @@ TEST(BuildMultimeshTest, AnotherDrawingIsMeshedWhenTheFirstMeshCannotBeMapped) {
   EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
 }
 
-// Neither quadrilateral's mesh maps onto the other: the first reference's error, naming the
-// other reference tried.
+// Two concave quadrilaterals neither of whose meshes maps onto the other.
+std::vector<Drawing> UnmappablePair() {
+  return {Drawing{{Outline{{{24.30, 18.73}, {28.52, 28.64}, {23.79, 23.94}, {5.13, -8.66}}}}},
+          Drawing{{Outline{{{30.24, 37.81}, {20.55, 29.14}, {21.83, 44.12}, {-4.56, 6.21}}}}}};
+}
+
+// Without the overlay: the first reference's error, naming the other reference tried.
 TEST(BuildMultimeshTest, EveryReferenceTriedIsNamedWhenNoneMaps) {
-  const std::vector<Drawing> drawings = {
-      Drawing{{Outline{{{24.30, 18.73}, {28.52, 28.64}, {23.79, 23.94}, {5.13, -8.66}}}}},
-      Drawing{{Outline{{{30.24, 37.81}, {20.55, 29.14}, {21.83, 44.12}, {-4.56, 6.21}}}}}};
+  const std::vector<Drawing> drawings = UnmappablePair();
   MultimeshOptions options;
   options.boundary_vertices = 32;
   options.max_map_iterations = 200;  // refused the same way after 2,000, in ~10x the time
+  options.overlay = false;
   const absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, options);
   ASSERT_FALSE(mesh.ok());
   EXPECT_EQ(mesh.status().code(), absl::StatusCode::kFailedPrecondition) << mesh.status();
   EXPECT_THAT(mesh.status().message(), HasSubstr("cannot map drawing 1's mesh into drawing 2"));
   EXPECT_THAT(mesh.status().message(), HasSubstr("(the mesh of drawing 2 did not map either)"));
+}
+
+// With it (the default): drawing 1's mesh overlaid with a triangulation of drawing 2 maps into
+// both, and the progress says how it was built.
+TEST(BuildMultimeshTest, OverlayBuildsWhatNoMeshMaps) {
+  const std::vector<Drawing> drawings = UnmappablePair();
+  MultimeshOptions options;
+  options.boundary_vertices = 32;
+  options.max_map_iterations = 200;
+  std::vector<std::string> details;
+  std::vector<double> fractions;
+  MultimeshReport report;
+  const absl::StatusOr<Multimesh> mesh = BuildMultimesh(
+      drawings, options, nullptr,
+      [&](const std::string&, double fraction, const std::string& d) {
+        details.push_back(d);
+        fractions.push_back(fraction);
+      },
+      &report);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ExpectValid(drawings, *mesh);
+  EXPECT_EQ(report.overlays, 1);
+  EXPECT_EQ(report.vertices, mesh->num_vertices());
+  EXPECT_THAT(details, ::testing::Contains(HasSubstr("overlaying the mesh with a triangulation "
+                                                     "of drawing 2")));
+  EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
 }
 
 TEST(BuildMultimeshTest, MapIterationBudgetIsHonoured) {
@@ -217,10 +247,19 @@ TEST(BuildMultimeshTest, MapIterationBudgetIsHonoured) {
   MultimeshOptions options;
   options.corner_matching = MultimeshOptions::CornerMatching::kNever;  // arc length only
   options.max_map_iterations = 1;
+  options.overlay = false;
   absl::StatusOr<Multimesh> starved = BuildMultimesh(drawings, options);
   ASSERT_FALSE(starved.ok());
   EXPECT_EQ(starved.status().code(), absl::StatusCode::kFailedPrecondition) << starved.status();
   EXPECT_THAT(starved.status().message(), HasSubstr("did not map either"));
+  // The overlay needs no iteration of the pull: it builds.
+  options.overlay = true;
+  MultimeshReport report;
+  absl::StatusOr<Multimesh> overlaid = BuildMultimesh(drawings, options, nullptr, nullptr, &report);
+  ASSERT_TRUE(overlaid.ok()) << overlaid.status();
+  ExpectValid(drawings, *overlaid);
+  EXPECT_EQ(report.overlays, 1);
+  options.overlay = false;
   options = MultimeshOptions();  // corners matched to corners on the second attempt
   absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, options);
   ASSERT_TRUE(mesh.ok()) << mesh.status();

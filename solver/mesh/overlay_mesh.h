@@ -1,0 +1,51 @@
+// A compatible mesh by overlay, for when a mesh cannot be mapped into a drawing without folding.
+//
+// The mesh (one component bounded by one loop: a topological disk) is embedded into a convex
+// polygon by Tutte's method (map_to_boundary.h), its boundary vertices on a circle. The new
+// drawing's boundary polygon, through the same boundary vertices, is triangulated without
+// Steiner points (a constrained Delaunay triangulation: every interior edge a chord between two
+// boundary vertices); placed on the same circle, those chords cut the convex polygon into the
+// same triangles, convex. Overlaying the two triangulations there gives a common refinement: each
+// cell is a triangle of the mesh cut by the chords that cross it, convex, and lies inside one
+// triangle of each, so the affine map of the mesh's triangle carries it into every drawing
+// already mapped and the affine map of the chord triangle carries it into the new drawing, both
+// orientation-preserving. The cells are fanned into triangles; the new vertices are where mesh
+// edges cross chords. Every decision is combinatorial or an exact orientation test
+// (cgal_predicates.h): a crossing's side of another chord is that chord's side of the other
+// (chords of a triangulation do not cross), so the refinement is consistent even where the
+// rounded crossing points are not. A result with a non-positive triangle in some drawing (a cell
+// too thin for doubles) is retried with the boundary spaced differently on the circle.
+//
+// The result maps injectively into every drawing but has thin triangles where chords pass close
+// to mesh vertices: comesh optimization (its collapses and sliver removal) is the cleanup.
+#pragma once
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "solver/core/cancel.h"
+#include "solver/core/types.h"
+
+namespace inbetween::solver {
+
+struct OverlayResult {
+  // Triangles over the input's vertices (same indices) followed by the new ones.
+  std::vector<Triangle> triangles;
+  // The input shapes extended to every vertex, then the new drawing's positions (last).
+  std::vector<Points> shapes;
+  int added_vertices = 0;  // crossings of mesh edges with chords
+};
+
+// `triangles` is a mesh whose vertices 0..n-1 are placed in every shape of `shapes` (>= 1, each
+// with every triangle positive); `boundary` is its only boundary loop in order, interior on the
+// left; `target_boundary[k]` is where boundary[k] lies in the new drawing, a simple polygon of
+// positive area with distinct points. shapes[0] gives the Tutte weights.
+// Errors: INVALID_ARGUMENT (sizes, or a target that is not a simple positive polygon),
+// FAILED_PRECONDITION (no placement on the circle gave a valid overlay), CANCELLED.
+absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& triangles,
+                                                 const std::vector<Points>& shapes,
+                                                 const std::vector<int>& boundary,
+                                                 const Points& target_boundary,
+                                                 const CancelToken* cancel = nullptr);
+
+}  // namespace inbetween::solver

@@ -1,0 +1,177 @@
+// Tests of the overlay (overlay_mesh.h): a mesh that cannot be mapped into a drawing is refined
+// into one that maps into both without folding, the old vertices kept where they were.
+#include "solver/mesh/overlay_mesh.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "solver/geometry/polygon.h"
+#include "solver/mesh/cgal_triangulate.h"
+#include "solver/mesh/validate.h"
+
+namespace inbetween::solver {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A comb with `teeth` teeth, `points` boundary points in all, counter-clockwise from (0, 0).
+Points Comb(int teeth) {
+  Points p = {{0, 0}, {100, 0}};
+  const double w = 100.0 / (2 * teeth - 1);
+  for (int t = teeth - 1; t >= 0; --t) {
+    const double x0 = 2 * t * w;
+    p.emplace_back(x0 + w, 100);
+    p.emplace_back(x0, 100);
+    if (t > 0) p.emplace_back(x0, 20), p.emplace_back(x0 - w, 20);
+  }
+  // The last tooth ends at (0, 100); the comb closes back down to (0, 0).
+  Points out;
+  for (const Point& q : p) {
+    if (out.empty() || (q - out.back()).norm() > 0) out.push_back(q);
+  }
+  return out;
+}
+
+// `n` points around a circle of radius r centred at (50, 50), counter-clockwise.
+Points Circle(int n, double r) {
+  Points p;
+  for (int k = 0; k < n; ++k) {
+    p.emplace_back(50 + r * std::cos(2 * M_PI * k / n), 50 + r * std::sin(2 * M_PI * k / n));
+  }
+  return p;
+}
+
+double Area(const std::vector<Triangle>& triangles, const Points& x) {
+  double a = 0;
+  for (const Triangle& t : triangles) a += 0.5 * SignedArea2(t, x);
+  return a;
+}
+
+// Distance from p to the nearest edge of the mesh (every triangle side).
+double DistanceToEdges(const std::vector<Triangle>& triangles, const Points& x, const Point& p) {
+  double best = INFINITY;
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const Point a = x[t[k]], d = x[t[(k + 1) % 3]] - a;
+      const double s = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      best = std::min(best, (a + s * d - p).norm());
+    }
+  }
+  return best;
+}
+
+// The comb's boundary points, placed in order around a disk: the disk's Delaunay mesh cannot be
+// pulled onto the comb's deep teeth without folding in general, and the overlay maps it.
+TEST(OverlayMeshTest, DiskMeshOntoAComb) {
+  const Points comb = Comb(4);
+  const int corners = static_cast<int>(comb.size());
+  TriangulateOptions options;
+  options.max_edge = 12;
+  absl::StatusOr<PolygonTriangulation> disk = CgalTriangulate(Circle(corners, 50), options);
+  ASSERT_TRUE(disk.ok()) << disk.status();
+  // The boundary in order (the mesher's boundary points after their segment's start), and the
+  // comb's points at the same segment parameters.
+  std::vector<int> boundary;
+  Points target;
+  for (int k = 0, next = 0; k < corners; ++k) {
+    boundary.push_back(k);
+    target.push_back(comb[k]);
+    for (; next < static_cast<int>(disk->boundary_steiner.size()) &&
+           disk->boundary_steiner[next].segment == k;
+         ++next) {
+      const BoundarySteiner& b = disk->boundary_steiner[next];
+      boundary.push_back(b.vertex);
+      target.push_back((1 - b.t) * comb[k] + b.t * comb[(k + 1) % corners]);
+    }
+  }
+  const int nb = static_cast<int>(boundary.size());
+  const Points& comb_points = target;
+  const int n = static_cast<int>(disk->vertices.size());
+
+  absl::StatusOr<OverlayResult> over =
+      OverlayOntoPolygon(disk->triangles, {disk->vertices}, boundary, comb_points);
+  ASSERT_TRUE(over.ok()) << over.status();
+  ASSERT_EQ(over->shapes.size(), 2u);
+  const int total = n + over->added_vertices;
+  EXPECT_GT(over->added_vertices, 0);
+  for (const Points& s : over->shapes) {
+    ASSERT_EQ(static_cast<int>(s.size()), total);
+    EXPECT_EQ(CountInverted(over->triangles, s), 0);
+  }
+  // Every vertex is used and the old ones keep their places in the first shape; the new ones
+  // lie on the old mesh's edges there (a refinement), and the areas are the polygons'.
+  std::vector<int> uses(total, 0);
+  for (const Triangle& t : over->triangles)
+    for (int v : t) ++uses[v];
+  EXPECT_EQ(std::count(uses.begin(), uses.end(), 0), 0);
+  for (int v = 0; v < n; ++v) EXPECT_EQ(over->shapes[0][v], disk->vertices[v]);
+  for (int v = n; v < total; ++v) {
+    EXPECT_LT(DistanceToEdges(disk->triangles, disk->vertices, over->shapes[0][v]), 1e-9);
+  }
+  EXPECT_NEAR(Area(over->triangles, over->shapes[0]), Area(disk->triangles, disk->vertices), 1e-6);
+  EXPECT_NEAR(Area(over->triangles, over->shapes[1]), PolygonSignedArea(comb), 1e-6);
+  for (int k = 0; k < nb; ++k) EXPECT_EQ(over->shapes[1][boundary[k]], comb_points[k]);
+  // A valid multimesh: one loop, the same topology in both shapes.
+  Multimesh mesh;
+  mesh.triangles = over->triangles;
+  mesh.shapes = over->shapes;
+  mesh.boundary = boundary;
+  mesh.boundary_loops = {boundary};
+  EXPECT_TRUE(ValidateMultimesh(mesh).ok()) << ValidateMultimesh(mesh);
+}
+
+// Shapes already placed (here a second copy, moved) get the new vertices through the same
+// affine maps; a symmetric case (a fan around the centre, a square target whose diagonal may
+// pass through it) stays valid.
+TEST(OverlayMeshTest, EveryPlacedShapeIsRefinedAlike) {
+  const Points square = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  Points fan = square;
+  fan.emplace_back(5, 5);
+  const std::vector<Triangle> triangles = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  Points moved = fan;
+  for (Point& p : moved) p = Point(2 * p.x() + 3, p.y() - 1);
+  const Points target = {{0, 0}, {10, 0}, {1, 1}, {0, 10}};  // concave at the third point
+  absl::StatusOr<OverlayResult> over =
+      OverlayOntoPolygon(triangles, {fan, moved}, {0, 1, 2, 3}, target);
+  ASSERT_TRUE(over.ok()) << over.status();
+  ASSERT_EQ(over->shapes.size(), 3u);
+  for (const Points& s : over->shapes) EXPECT_EQ(CountInverted(over->triangles, s), 0);
+  for (size_t v = 0; v < over->shapes[0].size(); ++v) {
+    const Point p = over->shapes[0][v];
+    EXPECT_LT((over->shapes[1][v] - Point(2 * p.x() + 3, p.y() - 1)).norm(), 1e-9);
+  }
+  EXPECT_NEAR(Area(over->triangles, over->shapes[2]), PolygonSignedArea(target), 1e-9);
+}
+
+TEST(OverlayMeshTest, ChordTriangulationAddsNoPoint) {
+  const Points comb = Comb(3);
+  TriangulateOptions options;
+  options.refine = false;
+  absl::StatusOr<PolygonTriangulation> cdt = CgalTriangulate(comb, options);
+  ASSERT_TRUE(cdt.ok()) << cdt.status();
+  EXPECT_EQ(cdt->vertices.size(), comb.size());
+  EXPECT_EQ(cdt->triangles.size(), comb.size() - 2);
+  EXPECT_EQ(CountInverted(cdt->triangles, cdt->vertices), 0);
+}
+
+TEST(OverlayMeshTest, BadInputsAreNamed) {
+  const Points square = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  const std::vector<Triangle> triangles = {{0, 1, 2}, {0, 2, 3}};
+  absl::StatusOr<OverlayResult> short_target =
+      OverlayOntoPolygon(triangles, {square}, {0, 1, 2, 3}, {{0, 0}, {1, 0}, {1, 1}});
+  EXPECT_EQ(short_target.status().code(), absl::StatusCode::kInvalidArgument);
+  absl::StatusOr<OverlayResult> clockwise =
+      OverlayOntoPolygon(triangles, {square}, {0, 1, 2, 3}, {{0, 0}, {0, 10}, {10, 10}, {10, 0}});
+  EXPECT_EQ(clockwise.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(clockwise.status().message(), HasSubstr("overlay"));
+  CancelToken cancel;
+  cancel.Cancel();
+  absl::StatusOr<OverlayResult> cancelled =
+      OverlayOntoPolygon(triangles, {square}, {0, 1, 2, 3}, square, &cancel);
+  EXPECT_EQ(cancelled.status().code(), absl::StatusCode::kCancelled);
+}
+
+}  // namespace
+}  // namespace inbetween::solver
