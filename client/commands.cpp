@@ -36,7 +36,11 @@ std::ptrdiff_t FirstInvalidUtf8(const std::string& text) {
   const size_t n = text.size();
   for (size_t i = 0; i < n;) {
     const unsigned char c = p[i];
-    size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    size_t len = c < 0x80           ? 1
+                 : (c >> 5) == 0x6  ? 2
+                 : (c >> 4) == 0xE  ? 3
+                 : (c >> 3) == 0x1E ? 4
+                                    : 0;
     if (len == 0 || (len == 2 && c < 0xC2) || i + len > n) return static_cast<std::ptrdiff_t>(i);
     for (size_t k = 1; k < len; ++k) {
       if ((p[i + k] >> 6) != 0x2) return static_cast<std::ptrdiff_t>(i);
@@ -60,9 +64,9 @@ absl::StatusOr<std::string> ReadSvg(const std::filesystem::path& path) {
   if (!text.ok()) return text;
   if (const std::ptrdiff_t bad = FirstInvalidUtf8(*text); bad >= 0) {
     const auto line = 1 + std::count(text->begin(), text->begin() + bad, '\n');
-    return absl::InvalidArgumentError(absl::StrCat(
-        "not UTF-8 text: byte ", bad, " (line ", line, ") is not part of a UTF-8 character; ",
-        "save the SVG as UTF-8"));
+    return absl::InvalidArgumentError(absl::StrCat("not UTF-8 text: byte ", bad, " (line ", line,
+                                                   ") is not part of a UTF-8 character; ",
+                                                   "save the SVG as UTF-8"));
   }
   return text;
 }
@@ -195,10 +199,10 @@ absl::StatusOr<v1::OptimizeComeshResult> Optimize(const v1::Session& session,
       // messages (the server's stage "comesh"), under one label.
       [&](const v1::ComeshIteration& it) {
         if (ctx.progress) {
-          ctx.progress->Update("optimize", -1.0,
-                               absl::StrFormat("outer %u inner %u map %.4f mesh %.4f vertices %u",
-                                               it.outer(), it.inner(), it.map_energy(),
-                                               it.mesh_energy(), it.vertices()));
+          ctx.progress->Update(
+              "optimize", -1.0,
+              absl::StrFormat("outer %u inner %u map %.4f mesh %.4f vertices %u", it.outer(),
+                              it.inner(), it.map_energy(), it.mesh_energy(), it.vertices()));
         }
       },
       [&](const v1::Progress& p) {
@@ -470,7 +474,8 @@ absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
               {"map_energy", optimized->stats().map_energy()},
               {"mesh_energy", optimized->stats().mesh_energy()},
               {"worst_quality", optimized->stats().worst_quality()},
-              {"corner_matched_loops", built->stats().corner_matched_loops()}};
+              {"corner_matched_loops", built->stats().corner_matched_loops()},
+              {"overlays", built->stats().overlays()}};
   }
   std::error_code ec;
   std::filesystem::create_directories(options.out_dir, ec);
@@ -501,6 +506,12 @@ absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
                    "boundary correspondence: corners matched to corners on %u loop(s) (arc "
                    "length could not be meshed, or project meshing.corner_matching = always)\n",
                    stats.corner_matched_loops());
+    }
+    if (stats.overlays() > 0) {
+      std::fprintf(stderr,
+                   "no drawing's mesh mapped into every drawing: %u overlaid with a triangulation "
+                   "of the drawing (thin triangles; `inbetween optimize` removes them)\n",
+                   stats.overlays());
     }
   }
   std::printf("%s\n", (options.out_dir / "multimesh.json").string().c_str());

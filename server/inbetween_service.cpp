@@ -259,6 +259,7 @@ v1::MultimeshStats StatsOf(const solver::Multimesh& mesh) {
 void KeepBuildFacts(const v1::MultimeshStats& build, v1::MultimeshStats* stats) {
   stats->set_build_seconds(build.build_seconds());
   stats->set_corner_matched_loops(build.corner_matched_loops());
+  stats->set_overlays(build.overlays());
 }
 
 // The status to return once the token tripped: the deadline's, or the client's cancellation.
@@ -874,6 +875,7 @@ grpc::Status InbetweenService::BuildMultimesh(
         v1::MultimeshStats stats = StatsOf(*mesh);
         stats.set_build_seconds(report.seconds > 0 ? report.seconds : seconds);
         stats.set_corner_matched_loops(static_cast<uint32_t>(report.corner_matched_loops));
+        stats.set_overlays(static_cast<uint32_t>(report.overlays));
 
         v1::BuildMultimeshResponse message;
         v1::BuildMultimeshResult* result = message.mutable_result();

@@ -515,8 +515,13 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
         notify("map", 0.2 + 0.75 * (done - 1) / (num_shapes - 1),
                absl::StrCat("drawing ", d + 1, ": ", mapped.status().message(),
                             "; overlaying the mesh with a triangulation of drawing ", d + 1));
+        // The refinement counts against the mesh's vertex bound (the other components' too).
+        const int budget = options.max_mesh_vertices > 0
+                               ? std::max(1, options.max_mesh_vertices -
+                                                 (num_vertices - static_cast<int>(global.size())))
+                               : 0;
         absl::StatusOr<OverlayResult> over =
-            OverlayOntoPolygon(triangles, placed, boundary, target_boundary, cancel);
+            OverlayOntoPolygon(triangles, placed, boundary, target_boundary, cancel, budget);
         if (over.ok()) {
           // New vertices get global indices after the existing ones, in every placed drawing,
           // in drawing d and among the reference's points (targets_of reads those).

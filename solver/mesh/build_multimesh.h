@@ -49,7 +49,8 @@ struct MultimeshOptions {
   // last attempt overlays the first drawing's mesh with a triangulation of each drawing it cannot
   // be mapped into (overlay_mesh.h): a common refinement that maps into both without folding,
   // for any component bounded by one loop that is a simple polygon in that drawing. Its thin
-  // triangles are left to comesh optimization. false: such inputs stay FAILED_PRECONDITION.
+  // triangles are left to comesh optimization. Its vertices count against max_mesh_vertices (an
+  // overlay above it is not made). false: such inputs stay FAILED_PRECONDITION.
   bool overlay = true;
 };
 

@@ -120,10 +120,13 @@ class Overlay {
 
   // Splits every triangle by the chords crossing it; the cells, fanned later, and the chord
   // triangle each cell lies in.
-  absl::Status Run(const CancelToken* cancel) {
-    std::vector<int> candidates;
+  absl::Status Run(const CancelToken* cancel, int max_vertices) {
     for (size_t t = 0; t < triangles_.size(); ++t) {
       if ((t & 1023) == 0 && Cancelled(cancel)) return absl::CancelledError("overlay cancelled");
+      if (max_vertices > 0 && num_vertices() > max_vertices) {
+        return absl::ResourceExhaustedError(
+            absl::StrCat("overlay: the refinement needs more than ", max_vertices, " vertices"));
+      }
       const Triangle& tri = triangles_[t];
       Point lo = disk_[tri[0]], hi = lo;
       for (int k = 1; k < 3; ++k) lo = lo.cwiseMin(disk_[tri[k]]), hi = hi.cwiseMax(disk_[tri[k]]);
@@ -299,7 +302,7 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
                                                  const std::vector<Points>& shapes,
                                                  const std::vector<int>& boundary,
                                                  const Points& target_boundary,
-                                                 const CancelToken* cancel) {
+                                                 const CancelToken* cancel, int max_vertices) {
   if (shapes.empty() || boundary.size() < 3 || boundary.size() != target_boundary.size()) {
     return absl::InvalidArgumentError(absl::StrCat("overlay: ", shapes.size(), " shapes, ",
                                                    boundary.size(), " boundary vertices and ",
@@ -367,7 +370,7 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
     }
 
     Overlay overlay(triangles, boundary, *disk, circle, *chords);
-    if (absl::Status run = overlay.Run(cancel); !run.ok()) return run;
+    if (absl::Status run = overlay.Run(cancel, max_vertices); !run.ok()) return run;
 
     OverlayResult result;
     const int total = overlay.num_vertices();

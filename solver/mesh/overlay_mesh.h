@@ -41,11 +41,13 @@ struct OverlayResult {
 // left; `target_boundary[k]` is where boundary[k] lies in the new drawing, a simple polygon of
 // positive area with distinct points. shapes[0] gives the Tutte weights.
 // Errors: INVALID_ARGUMENT (sizes, or a target that is not a simple positive polygon),
-// FAILED_PRECONDITION (no placement on the circle gave a valid overlay), CANCELLED.
+// FAILED_PRECONDITION (no placement on the circle gave a valid overlay), RESOURCE_EXHAUSTED (the
+// refinement needs more than max_vertices vertices in all; <= 0: no bound), CANCELLED.
 absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& triangles,
                                                  const std::vector<Points>& shapes,
                                                  const std::vector<int>& boundary,
                                                  const Points& target_boundary,
-                                                 const CancelToken* cancel = nullptr);
+                                                 const CancelToken* cancel = nullptr,
+                                                 int max_vertices = 0);
 
 }  // namespace inbetween::solver

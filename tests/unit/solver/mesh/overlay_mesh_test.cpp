@@ -120,6 +120,11 @@ TEST(OverlayMeshTest, DiskMeshOntoAComb) {
   mesh.boundary = boundary;
   mesh.boundary_loops = {boundary};
   EXPECT_TRUE(ValidateMultimesh(mesh).ok()) << ValidateMultimesh(mesh);
+  // A vertex bound below what the refinement needs stops it.
+  absl::StatusOr<OverlayResult> bounded =
+      OverlayOntoPolygon(disk->triangles, {disk->vertices}, boundary, comb_points, nullptr, n + 1);
+  EXPECT_EQ(bounded.status().code(), absl::StatusCode::kResourceExhausted) << bounded.status();
+  EXPECT_THAT(bounded.status().message(), HasSubstr("more than"));
 }
 
 // Shapes already placed (here a second copy, moved) get the new vertices through the same
