@@ -510,7 +510,7 @@ absl::Status RunMesh(const MeshOptions& options, const RunContext& ctx) {
     if (stats.overlays() > 0) {
       std::fprintf(stderr,
                    "no drawing's mesh mapped into every drawing: %u overlaid with a triangulation "
-                   "of the drawing (thin triangles; `inbetween optimize` removes them)\n",
+                   "of the drawing (thin triangles, which comesh optimization removes)\n",
                    stats.overlays());
     }
   }

@@ -47,9 +47,10 @@ python3 - opt_out <<'PY'
 import json, math, os, sys
 report = json.load(open(os.path.join(sys.argv[1], "report.json")))
 for key in ("vertices_before", "vertices_after", "inner", "outer", "seconds", "map_energy",
-            "mesh_energy", "worst_quality", "corner_matched_loops"):
+            "mesh_energy", "worst_quality", "corner_matched_loops", "overlays"):
     assert key in report, (key, report)
 assert report["corner_matched_loops"] == 0, report  # square -> hexagon: arc length meshes it
+assert report["overlays"] == 0, report
 mesh = json.load(open(os.path.join(sys.argv[1], "multimesh.json")))
 worst = 1.0
 for shape in (s["vertices"] for s in mesh["shapes"]):
@@ -76,6 +77,22 @@ python3 - corners_out <<'PY'
 import json, os, sys
 report = json.load(open(os.path.join(sys.argv[1], "report.json")))
 assert report["corner_matched_loops"] == 1, report
+PY
+
+# Two concave quadrilaterals neither of whose meshes maps onto the other: built by the overlay,
+# which stderr and report.json say, and optimized into a valid multimesh.
+for q in "24.30 18.73 L28.52 28.64 L23.79 23.94 L5.13 -8.66" \
+         "30.24 37.81 L20.55 29.14 L21.83 44.12 L-4.56 6.21"; do
+  n=$(( ${n:-0} + 1 ))
+  echo "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"-10 -10 50 60\"><path d=\"M$q Z\"/></svg>" > quad$n.svg
+done
+"$CLI_BIN" optimize quad1.svg quad2.svg --out overlay_out 2> overlay.err >/dev/null
+grep -q "1 overlaid with a triangulation of the drawing" overlay.err || { cat overlay.err; exit 1; }
+python3 - overlay_out <<'PY'
+import json, os, sys
+report = json.load(open(os.path.join(sys.argv[1], "report.json")))
+assert report["overlays"] == 1 and report["worst_quality"] > 0, report
+print(f"overlay: {report['vertices_before']} -> {report['vertices_after']} vertices")
 PY
 
 # -q: no progress output (neither JSON events nor a bar), the result path still on stdout.
