@@ -561,6 +561,8 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
           ++overlays;
         } else if (absl::IsCancelled(over.status())) {
           return over.status();
+        } else {
+          mapped = absl::FailedPreconditionError(over.status().message());
         }
       }
       if (!mapped.ok()) {
@@ -687,6 +689,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     if (meshed < 0) break;  // no drawing of this rank: nothing was tried
     if (rank > 0) absl::StrAppend(&others, num_others++ > 0 ? ", " : "", meshed + 1);
   }
+  std::string overlay_note;  // why the overlay did not build either
   if (options.overlay && absl::IsFailedPrecondition(first)) {
     monotone(
         "map", reached,
@@ -695,11 +698,16 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
         BuildOnce(drawings, options, /*match_corners=*/!arc_length, /*require_match=*/false,
                   /*rank=*/0, /*overlay=*/true, cancel, monotone, report, nullptr);
     if (m.ok() || absl::IsCancelled(m.status())) return m;
+    overlay_note = absl::StrCat("; overlaid: ", m.status().message());
   }
-  if (num_others == 0) return first;
+  if (num_others == 0) {
+    return overlay_note.empty()
+               ? first
+               : absl::Status(first.code(), absl::StrCat(first.message(), overlay_note));
+  }
   return absl::FailedPreconditionError(absl::StrCat(
       first.message(), num_others == 1 ? " (the mesh of drawing " : " (the meshes of drawings ",
-      others, " did not map either)"));
+      others, " did not map either)", overlay_note));
 }
 
 }  // namespace inbetween::solver

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <tuple>
 
 #include "absl/strings/str_cat.h"
@@ -327,18 +328,24 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
     arc[k + 1] = arc[k] + (shapes[0][boundary[(k + 1) % nb]] - shapes[0][boundary[k]]).norm();
   }
   absl::Status last = absl::FailedPreconditionError("overlay: no attempt");
-  constexpr double kBlends[] = {0.9, 0.5, 0.0, 0.7, 0.3, 0.6};
-  for (int attempt = 0; attempt < 6; ++attempt) {
+  // Placements tried in turn, the first whose worst triangle is at least kGoodQuality kept, else
+  // the best: the spacing (even, or partly by arc length) decides where chords pass close to
+  // mesh vertices and cut thin pieces. Even spacing first: arc length crowds short boundary
+  // edges, whose chords then graze the vertices between them.
+  constexpr double kBlends[] = {0.0, 0.5, 0.9, 0.25, 0.75, 0.6};
+  constexpr double kGoodQuality = 1e-3;
+  std::optional<OverlayResult> best;
+  double best_quality = 0.0;
+  for (int attempt = 0; attempt < 6 && best_quality < kGoodQuality; ++attempt) {
     if (Cancelled(cancel)) return absl::CancelledError("overlay cancelled");
-    // After the first attempt, each point also moves by a pseudo-random fraction of under a
-    // quarter of the even step (symmetric drawings put mesh vertices on chords otherwise).
+    // Each point also moves by a pseudo-random fraction of under a quarter of the even step
+    // (symmetric drawings put mesh vertices on chords otherwise).
     const double blend = arc[nb] > 0 ? kBlends[attempt] : 0.0;
     std::uint64_t state = 0x9E3779B97F4A7C15ull * (attempt + 1);
     Points circle(nb);
     for (int k = 0; k < nb; ++k) {
       state = state * 6364136223846793005ull + 1442695040888963407ull;
-      const double jitter =
-          attempt == 0 ? 0.0 : 0.2 * ((state >> 11) * 0x1.0p-53 - 0.5) * (1.0 - blend) / nb;
+      const double jitter = 0.2 * ((state >> 11) * 0x1.0p-53 - 0.5) * (1.0 - blend) / nb;
       const double share =
           (arc[nb] > 0 ? blend * arc[k] / arc[nb] : 0.0) + (1.0 - blend) * k / nb + jitter;
       const double angle = 2.0 * std::numbers::pi * share;
@@ -432,22 +439,25 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
                                     cell.vertices[(best + i + 1) % m]});
       }
     }
-    bool positive = true;
+    // Positive in doubles, as every later stage judges a triangle (validate.h's CountInverted),
+    // and how thin the thinnest is (4 sqrt(3) area / sum of squared edges: 1 equilateral).
+    double worst = std::numeric_limits<double>::infinity();
     for (const Points& s : result.shapes) {
       for (const Triangle& t : result.triangles) {
-        // In doubles, as every later stage judges a triangle (validate.h's CountInverted).
-        positive &= SignedArea2(t, s) > 0;
-        if (!positive) break;
+        const double area2 = SignedArea2(t, s);
+        const double edges = (s[t[1]] - s[t[0]]).squaredNorm() +
+                             (s[t[2]] - s[t[1]]).squaredNorm() + (s[t[0]] - s[t[2]]).squaredNorm();
+        worst = std::min(worst, area2 > 0 ? 2.0 * std::sqrt(3.0) * area2 / edges : -1.0);
       }
-      if (!positive) break;
     }
-    if (!positive) {
+    if (!(worst > 0)) {
       last = absl::FailedPreconditionError(
           "overlay: a cell is too thin for double precision in some drawing");
       continue;
     }
-    return result;
+    if (worst > best_quality) best_quality = worst, best = std::move(result);
   }
+  if (best.has_value()) return *std::move(best);
   return last;
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "absl/strings/str_cat.h"
 #include "solver/geometry/polygon.h"
 #include "solver/io/svg_import.h"
 #include "solver/mesh/validate.h"
@@ -232,6 +233,16 @@ TEST(BuildMultimeshTest, OverlayBuildsWhatNoMeshMaps) {
   EXPECT_THAT(details, ::testing::Contains(HasSubstr("overlaying the mesh with a triangulation "
                                                      "of drawing 2")));
   EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+  // The overlay's vertices count against the mesh's bound: above it, the error says so after
+  // the map's.
+  options.max_mesh_vertices = mesh->num_vertices() / 2;
+  const absl::StatusOr<Multimesh> bounded = BuildMultimesh(drawings, options);
+  ASSERT_FALSE(bounded.ok());
+  EXPECT_EQ(bounded.status().code(), absl::StatusCode::kFailedPrecondition) << bounded.status();
+  EXPECT_THAT(bounded.status().message(), HasSubstr("cannot map drawing 1's mesh into drawing 2"));
+  EXPECT_THAT(bounded.status().message(), HasSubstr("; overlaid: "));
+  EXPECT_THAT(bounded.status().message(),
+              HasSubstr(absl::StrCat("needs more than ", options.max_mesh_vertices, " vertices")));
 }
 
 TEST(BuildMultimeshTest, MapIterationBudgetIsHonoured) {
