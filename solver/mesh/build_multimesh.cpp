@@ -190,6 +190,7 @@ absl::StatusOr<std::vector<std::vector<Point>>> MarksFromDrawings(
 // BuildOnce).
 constexpr int kMaxReferences = 3;
 
+
 // One attempt of BuildMultimesh, corners matched or not, meshing the drawing of the given rank
 // in the order of `references` below (0: the preferred one; *meshed: which drawing that is).
 // Returns ABORTED (not an answer: the caller keeps its first error) with require_match when no
@@ -497,6 +498,21 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
             injective(MapToBoundary(source, triangles, boundary, target_boundary, chained, cancel));
         if (retry.ok() || final_error(retry.status())) mapped = std::move(retry);
       }
+      // A map with a nearly flat triangle (the pull can end with one: quality down to 1e-16 on
+      // random star-shaped pairs) is no better than none while the overlay may still build: it
+      // counts as not found, and is kept only if the overlay (the last attempt) fails.
+      std::optional<Points> flat_map;
+      if (mapped.ok() && options.overlay) {
+        int where = -1;
+        const double worst = WorstTriangleQuality(triangles, *mapped, &where);
+        if (worst < options.min_map_quality) {
+          flat_map = *mapped;
+          mapped = absl::FailedPreconditionError(
+              absl::StrCat("the map leaves a triangle nearly flat (quality ", worst, " near (",
+                           (*flat_map)[triangles[where][0]].x(), ", ",
+                           (*flat_map)[triangles[where][0]].y(), "))"));
+        }
+      }
       // Last resort (a disk whose boundary in drawing d is a simple polygon): a common
       // refinement of this mesh and a triangulation of drawing d (overlay_mesh.h). It adds
       // vertices to the component in every drawing mapped so far.
@@ -564,6 +580,9 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
         } else {
           mapped = absl::FailedPreconditionError(over.status().message());
         }
+      }
+      if (!mapped.ok() && overlay && flat_map.has_value() && !absl::IsCancelled(mapped.status())) {
+        mapped = *std::move(flat_map);  // the overlay did not build: the flat map is all there is
       }
       if (!mapped.ok()) {
         if (absl::IsCancelled(mapped.status())) return mapped.status();

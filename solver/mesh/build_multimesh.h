@@ -52,6 +52,11 @@ struct MultimeshOptions {
   // triangles are left to comesh optimization. Its vertices count against max_mesh_vertices (an
   // overlay above it is not made). false: such inputs stay FAILED_PRECONDITION.
   bool overlay = true;
+  // With the overlay on, a map whose worst triangle quality (4 sqrt(3) area / sum of squared
+  // edges, validate.h's WorstTriangleQuality) is below this does not count as found: the
+  // boundary pull can end with a triangle nearly flat (1e-16 on random star-shaped pairs) where
+  // the overlay gives ~1e-4. Such a map is still used when the overlay does not build either.
+  double min_map_quality = 1e-8;
 };
 
 struct MultimeshReport {

@@ -443,12 +443,9 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
     // and how thin the thinnest is (4 sqrt(3) area / sum of squared edges: 1 equilateral).
     double worst = std::numeric_limits<double>::infinity();
     for (const Points& s : result.shapes) {
-      for (const Triangle& t : result.triangles) {
-        const double area2 = SignedArea2(t, s);
-        const double edges = (s[t[1]] - s[t[0]]).squaredNorm() +
-                             (s[t[2]] - s[t[1]]).squaredNorm() + (s[t[0]] - s[t[2]]).squaredNorm();
-        worst = std::min(worst, area2 > 0 ? 2.0 * std::sqrt(3.0) * area2 / edges : -1.0);
-      }
+      worst = std::min(worst, CountInverted(result.triangles, s) == 0
+                                  ? WorstTriangleQuality(result.triangles, s)
+                                  : -1.0);
     }
     if (!(worst > 0)) {
       last = absl::FailedPreconditionError(

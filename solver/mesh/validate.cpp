@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -25,6 +26,21 @@ int CountInverted(const std::vector<Triangle>& triangles, const Points& x, doubl
     if (!(a > min_area2)) ++count;  // NaN counts as inverted
   }
   return count;
+}
+
+double WorstTriangleQuality(const std::vector<Triangle>& triangles, const Points& x, int* where) {
+  double worst = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < triangles.size(); ++k) {
+    const Triangle& t = triangles[k];
+    const double edges = (x[t[1]] - x[t[0]]).squaredNorm() + (x[t[2]] - x[t[1]]).squaredNorm() +
+                         (x[t[0]] - x[t[2]]).squaredNorm();
+    const double q = edges > 0 ? 2.0 * std::sqrt(3.0) * SignedArea2(t, x) / edges : 0.0;
+    if (q < worst) {
+      worst = q;
+      if (where != nullptr) *where = static_cast<int>(k);
+    }
+  }
+  return worst;
 }
 
 namespace {

@@ -16,13 +16,18 @@ double SignedArea2(const Triangle& t, const Points& x);
 // Number of triangles with signed area <= min_area2 / 2 (inverted or degenerate).
 int CountInverted(const std::vector<Triangle>& triangles, const Points& x, double min_area2 = 0.0);
 
+// The smallest triangle quality 4 sqrt(3) area / (sum of squared edge lengths) over `triangles`
+// in geometry x: 1 for an equilateral triangle, 0 flat, negative inverted (+inf without
+// triangles). Sets *where (if given) to the index of that triangle.
+double WorstTriangleQuality(const std::vector<Triangle>& triangles, const Points& x,
+                            int* where = nullptr);
+
 // No two boundary edges of the mesh cross in geometry x (a proper crossing, decided with exact
 // predicates; touching and collinear overlap, as of the collocated sides of a closed cut, are
 // allowed). With every triangle positive this is what is left of injectivity: a map can fold the
 // boundary over itself with no triangle inverted. InvalidArgument naming the two edges and where.
 // Expects valid indices. O(B) for B boundary edges of about equal length (a uniform grid).
-absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles,
-                                          const Points& x);
+absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles, const Points& x);
 
 // Checks shared topology (indices in range, every shape has the same vertex count, each directed
 // edge in one triangle only: no repeated or overlapping triangle), `boundary` vertices on the
