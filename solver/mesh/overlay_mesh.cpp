@@ -248,7 +248,7 @@ class Overlay {
         Polygon& p = piece[h];
         if (sa > 0 || (sa == 0 && sb >= 0)) {
           p.vertices.push_back(a);
-          p.supports.push_back(sa == 0 && sb == 0 ? edge : edge);
+          p.supports.push_back(edge);
         } else if (sa == 0) {  // sb < 0: this piece leaves a along the chord
           p.vertices.push_back(a);
           p.supports.push_back(along);
