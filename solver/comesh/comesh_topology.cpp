@@ -493,8 +493,8 @@ class Editor {
     Terms(old_tris, &odt_old, &mips_old);
     if (ok) Terms(new_tris, &odt_new, &mips_new);
     const double before = Objective();
-    const double after = Objective(t_ + on_edge, odt_sum_ - odt_old + odt_new,
-                                   mips_sum_ - mips_old + mips_new);
+    const double after =
+        Objective(t_ + on_edge, odt_sum_ - odt_old + odt_new, mips_sum_ - mips_old + mips_new);
     if (!ok || !(after < before - 1e-12 * std::abs(before))) {
       for (Points& x : shapes_) x.pop_back();
       return false;
@@ -898,7 +898,7 @@ class Editor {
 
   const ComeshObjective& objective_;
   const std::vector<ShapeOutline>* outlines_ = nullptr;  // may be null
-  const std::vector<Points>* anchors_ = nullptr;        // RemoveSlivers' anchors; may be null
+  const std::vector<Points>* anchors_ = nullptr;         // RemoveSlivers' anchors; may be null
   const TopologyOptions& options_;
   std::vector<Triangle> triangles_;
   std::vector<char> alive_;
@@ -972,18 +972,10 @@ bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& a
       cancel);
 }
 
-double TriangleQuality(const Point& a, const Point& b, const Point& c) {
-  const double edges = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
-  return edges > 0.0 ? 2.0 * std::sqrt(3.0) * Area2(a, b, c) / edges : 0.0;
-}
-
 double WorstQuality(const Multimesh& mesh) {
   double worst = 1.0;
-  for (const Points& x : mesh.shapes) {
-    for (const Triangle& t : mesh.triangles) {
-      worst = std::min(worst, TriangleQuality(x[t[0]], x[t[1]], x[t[2]]));
-    }
-  }
+  for (const Points& x : mesh.shapes)
+    worst = std::min(worst, WorstTriangleQuality(mesh.triangles, x));
   return worst;
 }
 

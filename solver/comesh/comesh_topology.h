@@ -31,6 +31,7 @@
 #include "solver/comesh/comesh_outline.h"
 #include "solver/core/cancel.h"
 #include "solver/mesh/multimesh.h"
+#include "solver/mesh/validate.h"
 
 namespace inbetween::solver {
 
@@ -85,9 +86,7 @@ std::vector<std::pair<std::pair<int, int>, int>> EdgeUses(const std::vector<Tria
 bool EdgeUses(const std::vector<Triangle>& triangles, const std::vector<char>& alive,
               const CancelToken* cancel, std::vector<std::pair<std::pair<int, int>, int>>* uses);
 
-// Triangle quality 4 sqrt(3) A / (sum of squared edge lengths), A the signed area: 1 for an
-// equilateral triangle, 0 for a flat one, negative if inverted.
-double TriangleQuality(const Point& a, const Point& b, const Point& c);
+// TriangleQuality (4 sqrt(3) A / sum of squared edge lengths) is validate.h's.
 // The smallest TriangleQuality over every triangle of every shape (1 without triangles).
 double WorstQuality(const Multimesh& mesh);
 

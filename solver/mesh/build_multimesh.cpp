@@ -566,11 +566,10 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
           MapToBoundaryOptions polish = map_options;
           polish.tutte_when_convex = polish.tutte_first_always = false;
           polish.start = &over->shapes.back();
-          std::vector<Triangle> local_triangles = over->triangles;
+          triangles = over->triangles;
           absl::StatusOr<Points> polished =
-              MapToBoundary(source_now, local_triangles, boundary, target_boundary, polish, cancel);
+              MapToBoundary(source_now, triangles, boundary, target_boundary, polish, cancel);
           if (!polished.ok() && absl::IsCancelled(polished.status())) return polished.status();
-          triangles = std::move(local_triangles);
           mapped =
               polished.ok() ? std::move(polished) : absl::StatusOr<Points>(over->shapes.back());
           mapped = injective(std::move(mapped));

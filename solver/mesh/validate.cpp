@@ -28,13 +28,18 @@ int CountInverted(const std::vector<Triangle>& triangles, const Points& x, doubl
   return count;
 }
 
+double TriangleQuality(const Point& a, const Point& b, const Point& c) {
+  const Point ab = b - a, ac = c - a;
+  const double area2 = ab.x() * ac.y() - ab.y() * ac.x();  // as SignedArea2
+  const double edges = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
+  return edges > 0.0 ? 2.0 * std::sqrt(3.0) * area2 / edges : 0.0;
+}
+
 double WorstTriangleQuality(const std::vector<Triangle>& triangles, const Points& x, int* where) {
   double worst = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < triangles.size(); ++k) {
     const Triangle& t = triangles[k];
-    const double edges = (x[t[1]] - x[t[0]]).squaredNorm() + (x[t[2]] - x[t[1]]).squaredNorm() +
-                         (x[t[0]] - x[t[2]]).squaredNorm();
-    const double q = edges > 0 ? 2.0 * std::sqrt(3.0) * SignedArea2(t, x) / edges : 0.0;
+    const double q = TriangleQuality(x[t[0]], x[t[1]], x[t[2]]);
     if (q < worst) {
       worst = q;
       if (where != nullptr) *where = static_cast<int>(k);

@@ -16,9 +16,12 @@ double SignedArea2(const Triangle& t, const Points& x);
 // Number of triangles with signed area <= min_area2 / 2 (inverted or degenerate).
 int CountInverted(const std::vector<Triangle>& triangles, const Points& x, double min_area2 = 0.0);
 
-// The smallest triangle quality 4 sqrt(3) area / (sum of squared edge lengths) over `triangles`
-// in geometry x: 1 for an equilateral triangle, 0 flat, negative inverted (+inf without
-// triangles). Sets *where (if given) to the index of that triangle.
+// Triangle quality 4 sqrt(3) A / (sum of squared edge lengths), A the signed area: 1 for an
+// equilateral triangle, 0 for a flat one (or one with coincident corners), negative if inverted.
+double TriangleQuality(const Point& a, const Point& b, const Point& c);
+
+// The smallest TriangleQuality over `triangles` in geometry x (+inf without triangles). Sets
+// *where (if given) to the index of that triangle.
 double WorstTriangleQuality(const std::vector<Triangle>& triangles, const Points& x,
                             int* where = nullptr);
 
