@@ -80,7 +80,6 @@ class Overlay {
   Overlay(const std::vector<Triangle>& triangles, const std::vector<int>& boundary,
           const Points& disk, const Points& circle, const Chords& chords)
       : triangles_(triangles),
-        boundary_(boundary),
         disk_(disk),
         circle_(circle),
         chords_(chords),
@@ -162,6 +161,8 @@ class Overlay {
   }
 
   int num_vertices() const { return n_ + static_cast<int>(crossings_.size()); }
+  // Input vertex v's position along the boundary loop (-1: interior).
+  int LoopPosition(int v) const { return loop_position_[v]; }
   const std::vector<Crossing>& crossings() const { return crossings_; }
   struct Cell {
     std::vector<int> vertices;  // counter-clockwise
@@ -259,7 +260,6 @@ class Overlay {
           }
           const int x = CrossingOf(edge, c);
           if (sa > 0) {  // leaving this side: the next edge runs along the chord
-            p.supports.back() = edge;
             p.vertices.push_back(x);
             p.supports.push_back(along);
           } else {  // entering: from x along the rest of the edge
@@ -276,7 +276,6 @@ class Overlay {
   }
 
   const std::vector<Triangle>& triangles_;
-  const std::vector<int>& boundary_;
   const Points& disk_;
   const Points& circle_;
   const Chords& chords_;
@@ -385,11 +384,9 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
     result.shapes = shapes;
     for (Points& s : result.shapes) s.resize(total);
     Points target(total);
-    std::vector<int> loop_position(n, -1);
-    for (int k = 0; k < nb; ++k) loop_position[boundary[k]] = k;
     for (int v = 0; v < n; ++v) {
-      if (loop_position[v] >= 0) {
-        target[v] = target_boundary[loop_position[v]];
+      if (const int k = overlay.LoopPosition(v); k >= 0) {
+        target[v] = target_boundary[k];
         continue;
       }
       const auto& corners = chords->corners[overlay.LocateVertex(v)];
