@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "solver/mesh/cgal_predicates.h"
 #include "solver/mesh/cgal_triangulate.h"
+#include "solver/mesh/collapse_vertices.h"
 #include "solver/mesh/map_to_boundary.h"
 #include "solver/mesh/validate.h"
 
@@ -435,6 +436,17 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
         result.triangles.push_back({cell.vertices[best], cell.vertices[(best + i) % m],
                                     cell.vertices[(best + i + 1) % m]});
       }
+    }
+    // Crossings that cut slivers off a mesh triangle (a chord passing near one of its
+    // vertices) merge into a neighbour where that leaves every drawing's thinnest triangle no
+    // thinner (collapse_vertices.h); the input's vertices stay.
+    {
+      absl::StatusOr<CollapseResult> coarse =
+          CollapseVertices(result.triangles, result.shapes, n, CollapseOptions{}, cancel);
+      if (!coarse.ok()) return coarse.status();
+      result.triangles = std::move(coarse->triangles);
+      result.shapes = std::move(coarse->shapes);
+      result.added_vertices -= coarse->removed;
     }
     // Positive in doubles, as every later stage judges a triangle (validate.h's CountInverted),
     // and how thin the thinnest is (4 sqrt(3) area / sum of squared edges: 1 equilateral).

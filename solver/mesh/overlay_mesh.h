@@ -16,8 +16,10 @@
 // rounded crossing points are not. A result with a non-positive triangle in some drawing (a cell
 // too thin for doubles) is retried with the boundary spaced differently on the circle.
 //
-// The result maps injectively into every drawing but has thin triangles where chords pass close
-// to mesh vertices: comesh optimization (its collapses and sliver removal) is the cleanup.
+// Chords passing close to mesh vertices cut thin pieces; every crossing whose merge into a
+// neighbour leaves the thinnest triangle around it no thinner in any drawing is merged away
+// (collapse_vertices.h), which removes most of them. What remains maps injectively into every
+// drawing and may still have thin triangles: comesh optimization is the rest of the cleanup.
 #pragma once
 
 #include <vector>
@@ -33,7 +35,7 @@ struct OverlayResult {
   std::vector<Triangle> triangles;
   // The input shapes extended to every vertex, then the new drawing's positions (last).
   std::vector<Points> shapes;
-  int added_vertices = 0;  // crossings of mesh edges with chords
+  int added_vertices = 0;  // crossings of mesh edges with chords (those not merged away)
 };
 
 // `triangles` is a mesh whose vertices 0..n-1 are placed in every shape of `shapes` (>= 1, each
@@ -42,7 +44,8 @@ struct OverlayResult {
 // positive area with distinct points. shapes[0] gives the Tutte weights.
 // Errors: INVALID_ARGUMENT (sizes, or a target that is not a simple positive polygon),
 // FAILED_PRECONDITION (no placement on the circle gave a valid overlay), RESOURCE_EXHAUSTED (the
-// refinement needs more than max_vertices vertices in all; <= 0: no bound), CANCELLED.
+// refinement, before any merge, needs more than max_vertices vertices in all; <= 0: no bound),
+// CANCELLED.
 absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& triangles,
                                                  const std::vector<Points>& shapes,
                                                  const std::vector<int>& boundary,

@@ -9,6 +9,7 @@
 
 #include "solver/geometry/polygon.h"
 #include "solver/mesh/cgal_triangulate.h"
+#include "solver/mesh/collapse_vertices.h"
 #include "solver/mesh/validate.h"
 
 namespace inbetween::solver {
@@ -120,6 +121,10 @@ TEST(OverlayMeshTest, DiskMeshOntoAComb) {
   mesh.boundary = boundary;
   mesh.boundary_loops = {boundary};
   EXPECT_TRUE(ValidateMultimesh(mesh).ok()) << ValidateMultimesh(mesh);
+  // Crossings that a merge would take without thinning any drawing's triangles are gone.
+  absl::StatusOr<CollapseResult> again = CollapseVertices(over->triangles, over->shapes, n);
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_EQ(again->removed, 0);
   // A vertex bound below what the refinement needs stops it.
   absl::StatusOr<OverlayResult> bounded =
       OverlayOntoPolygon(disk->triangles, {disk->vertices}, boundary, comb_points, nullptr, n + 1);
