@@ -186,10 +186,189 @@ absl::StatusOr<std::vector<std::vector<Point>>> MarksFromDrawings(
   return marks;
 }
 
+// One connected component of the mesh under construction, numbered locally, and where its
+// boundary lies in the drawing being mapped.
+struct Component {
+  std::vector<int> global;          // local vertex -> mesh vertex
+  std::vector<Triangle> triangles;  // over local vertices
+  std::vector<int> boundary;        // its boundary loops, concatenated (local vertices)
+  Points target_boundary;           // boundary[k]'s place in the drawing being mapped
+  int num_loops = 0;
+};
+
+Component ExtractComponent(const Multimesh& mesh, const std::vector<int>& component_of, int root,
+                           const std::vector<int>& loops, const Points& target) {
+  Component c;
+  std::vector<int> local(component_of.size(), -1);
+  for (const Triangle& t : mesh.triangles) {
+    if (component_of[t[0]] != root) continue;
+    Triangle lt;
+    for (int k = 0; k < 3; ++k) {
+      if (local[t[k]] < 0)
+        local[t[k]] = static_cast<int>(c.global.size()), c.global.push_back(t[k]);
+      lt[k] = local[t[k]];
+    }
+    c.triangles.push_back(lt);
+  }
+  for (int g : loops) {
+    for (int v : mesh.boundary_loops[g]) {
+      c.boundary.push_back(local[v]);
+      c.target_boundary.push_back(target[v]);
+    }
+  }
+  c.num_loops = static_cast<int>(loops.size());
+  return c;
+}
+
+// The component's vertices in one shape of the mesh.
+Points Restrict(const Points& shape, const std::vector<int>& global) {
+  Points out;
+  out.reserve(global.size());
+  for (int v : global) out.push_back(shape[v]);
+  return out;
+}
+
+MapToBoundaryOptions MapOptions(const Component& c, const MultimeshOptions& options) {
+  MapToBoundaryOptions map_options;
+  map_options.tutte_when_convex = c.num_loops == 1;
+  map_options.max_iterations = options.max_map_iterations;
+  return map_options;
+}
+
+// Every triangle positive does not make a map injective: the boundary may fold over itself
+// (seen on a real icon's cusp). Such a map counts as not found.
+absl::StatusOr<Points> Injective(const std::vector<Triangle>& triangles, absl::StatusOr<Points> m) {
+  if (!m.ok()) return m;
+  if (absl::Status s = ValidateBoundaryDoesNotCross(triangles, *m); !s.ok()) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("the map folds the boundary over itself: ", s.message()));
+  }
+  return m;
+}
+
+// Out of memory is not a map that was not found: neither retried nor reworded as one.
+bool FinalError(const absl::Status& s) {
+  return absl::IsCancelled(s) || absl::IsResourceExhausted(s);
+}
+
+// Maps component c of the reference drawing's mesh into drawing d: pulled onto d's boundary
+// directly, else from the maps into drawings already placed. With the overlay to fall back on
+// (options.overlay), a map with a nearly flat triangle counts as not found and is handed back in
+// *flat_map instead.
+absl::StatusOr<Points> MapComponent(const Component& c, const Multimesh& mesh, int ref, int d,
+                                    const MultimeshOptions& options, const CancelToken* cancel,
+                                    std::optional<Points>* flat_map) {
+  const Points source = Restrict(mesh.shapes[ref], c.global);
+  const MapToBoundaryOptions map_options = MapOptions(c, options);
+  absl::StatusOr<Points> mapped = Injective(
+      c.triangles,
+      MapToBoundary(source, c.triangles, c.boundary, c.target_boundary, map_options, cancel));
+  // A pose far from the reference drawing may not be reachable by pulling the reference's
+  // boundary directly; start instead from the map into an already mapped drawing, nearest in key
+  // order first (neighbouring keys are usually similar poses).
+  const int num_shapes = static_cast<int>(mesh.shapes.size());
+  std::vector<int> mapped_before;
+  for (int e = 0; e < num_shapes; ++e) {
+    if (e != ref && e != d && !mesh.shapes[e].empty()) mapped_before.push_back(e);
+  }
+  std::stable_sort(mapped_before.begin(), mapped_before.end(),
+                   [d](int a, int b) { return std::abs(a - d) < std::abs(b - d); });
+  for (size_t k = 0;
+       k < mapped_before.size() && k < 3 && !mapped.ok() && !FinalError(mapped.status()); ++k) {
+    const Points start = Restrict(mesh.shapes[mapped_before[k]], c.global);
+    MapToBoundaryOptions chained = map_options;
+    chained.tutte_when_convex = chained.tutte_first_always = false;
+    chained.start = &start;
+    absl::StatusOr<Points> retry = Injective(
+        c.triangles,
+        MapToBoundary(source, c.triangles, c.boundary, c.target_boundary, chained, cancel));
+    if (retry.ok() || FinalError(retry.status())) mapped = std::move(retry);
+  }
+  // A map with a nearly flat triangle (the pull can end with one: quality down to 1e-16 on
+  // random star-shaped pairs) is no better than none while the overlay may still build.
+  if (mapped.ok() && options.overlay) {
+    int where = -1;
+    const double worst = WorstTriangleQuality(c.triangles, *mapped, &where);
+    if (worst < options.min_map_quality) {
+      const Point at = (*mapped)[c.triangles[where][0]];
+      *flat_map = *std::move(mapped);
+      return absl::FailedPreconditionError(
+          absl::StrCat("the map leaves a triangle nearly flat (quality ", worst, " near (", at.x(),
+                       ", ", at.y(), "))"));
+    }
+  }
+  return mapped;
+}
+
+// The mesh under construction, as the overlay extends it.
+struct Growing {
+  Multimesh* mesh;                 // triangles, and the shapes placed so far
+  std::vector<int>* component_of;  // per mesh vertex
+  Points* reference_points;        // the reference drawing's points (targets read them)
+  int* num_vertices;
+};
+
+// Last resort for component c (a disk whose boundary in drawing d is a simple polygon): a common
+// refinement of it and a triangulation of drawing d (overlay_mesh.h), which adds vertices to the
+// component in every drawing placed so far; c is renumbered to match. Returns the map into d.
+absl::StatusOr<Points> OverlayComponent(Component* c, int root, int ref, int d,
+                                        const MultimeshOptions& options, const Growing& g,
+                                        const CancelToken* cancel) {
+  Multimesh& mesh = *g.mesh;
+  const int num_shapes = static_cast<int>(mesh.shapes.size());
+  std::vector<int> known = {ref};  // drawings placed so far: the Tutte weights from ref
+  for (int e = 0; e < num_shapes; ++e) {
+    if (e != ref && e != d && !mesh.shapes[e].empty()) known.push_back(e);
+  }
+  std::vector<Points> placed;
+  for (int e : known) placed.push_back(Restrict(mesh.shapes[e], c->global));
+  // The refinement counts against the mesh's vertex bound (the other components' too).
+  const int budget = options.max_mesh_vertices > 0
+                         ? std::max(1, options.max_mesh_vertices -
+                                           (*g.num_vertices - static_cast<int>(c->global.size())))
+                         : 0;
+  absl::StatusOr<OverlayResult> over =
+      OverlayOntoPolygon(c->triangles, placed, c->boundary, c->target_boundary, cancel, budget);
+  if (!over.ok()) {
+    if (absl::IsCancelled(over.status())) return over.status();
+    return absl::FailedPreconditionError(over.status().message());
+  }
+  // New vertices get mesh indices after the existing ones, in every placed drawing and among the
+  // reference's points.
+  const size_t local_before = c->global.size();
+  for (int i = 0; i < over->added_vertices; ++i) {
+    c->global.push_back((*g.num_vertices)++);
+    g.component_of->push_back(root);
+    g.reference_points->push_back(over->shapes[0][c->global.size() - 1]);
+  }
+  for (size_t k = 0; k < known.size(); ++k) {
+    Points& s = mesh.shapes[known[k]];
+    for (size_t i = local_before; i < c->global.size(); ++i) s.push_back(over->shapes[k][i]);
+  }
+  std::vector<Triangle> kept;
+  for (const Triangle& t : mesh.triangles) {
+    if ((*g.component_of)[t[0]] != root) kept.push_back(t);
+  }
+  for (const Triangle& t : over->triangles) {
+    kept.push_back({c->global[t[0]], c->global[t[1]], c->global[t[2]]});
+  }
+  mesh.triangles = std::move(kept);
+  c->triangles = over->triangles;
+  // Polish the map into drawing d from the overlay's placement (boundary already there).
+  MapToBoundaryOptions polish = MapOptions(*c, options);
+  polish.tutte_when_convex = polish.tutte_first_always = false;
+  polish.start = &over->shapes.back();
+  absl::StatusOr<Points> polished =
+      MapToBoundary(Restrict(mesh.shapes[ref], c->global), c->triangles, c->boundary,
+                    c->target_boundary, polish, cancel);
+  if (!polished.ok() && absl::IsCancelled(polished.status())) return polished.status();
+  return Injective(c->triangles, polished.ok() ? std::move(polished)
+                                               : absl::StatusOr<Points>(over->shapes.back()));
+}
+
 // Drawings whose mesh BuildMultimesh tries to map into the others (see `references` in
 // BuildOnce).
 constexpr int kMaxReferences = 3;
-
 
 // One attempt of BuildMultimesh, corners matched or not, meshing the drawing of the given rank
 // in the order of `references` below (0: the preferred one; *meshed: which drawing that is).
@@ -436,149 +615,19 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
     Points shape = targets_of(d);
     const Points target = shape;
     for (const auto& [root, loops] : loops_of_component) {
-      std::vector<int> local(num_vertices, -1), global;
-      std::vector<Triangle> triangles;
-      for (const Triangle& t : mesh.triangles) {
-        if (component_of[t[0]] != root) continue;
-        Triangle lt;
-        for (int k = 0; k < 3; ++k) {
-          if (local[t[k]] < 0)
-            local[t[k]] = static_cast<int>(global.size()), global.push_back(t[k]);
-          lt[k] = local[t[k]];
-        }
-        triangles.push_back(lt);
-      }
-      Points source;
-      for (int v : global) source.push_back(mesh.shapes[ref][v]);
-      std::vector<int> boundary;
-      Points target_boundary;
-      for (int g : loops) {
-        for (int v : mesh.boundary_loops[g]) {
-          boundary.push_back(local[v]);
-          target_boundary.push_back(target[v]);
-        }
-      }
-      MapToBoundaryOptions map_options;
-      map_options.tutte_when_convex = loops.size() == 1;
-      map_options.max_iterations = options.max_map_iterations;
-      // Every triangle positive does not make a map injective: the boundary may fold over
-      // itself (seen on a real icon's cusp). Such a map counts as not found.
-      auto injective = [&](absl::StatusOr<Points> m) -> absl::StatusOr<Points> {
-        if (!m.ok()) return m;
-        if (absl::Status s = ValidateBoundaryDoesNotCross(triangles, *m); !s.ok()) {
-          return absl::FailedPreconditionError(
-              absl::StrCat("the map folds the boundary over itself: ", s.message()));
-        }
-        return m;
-      };
-      absl::StatusOr<Points> mapped = injective(
-          MapToBoundary(source, triangles, boundary, target_boundary, map_options, cancel));
-      // A pose far from the reference drawing may not be reachable by pulling the reference's
-      // boundary directly; start instead from the map into an already mapped drawing, nearest
-      // in key order first (neighbouring keys are usually similar poses).
-      std::vector<int> mapped_before;
-      for (int e = 0; e < num_shapes; ++e) {
-        if (e != ref && e != d && !mesh.shapes[e].empty()) mapped_before.push_back(e);
-      }
-      std::stable_sort(mapped_before.begin(), mapped_before.end(),
-                       [d](int a, int b) { return std::abs(a - d) < std::abs(b - d); });
-      // Out of memory is not a map that was not found: neither retried nor reworded as one.
-      auto final_error = [](const absl::Status& s) {
-        return absl::IsCancelled(s) || absl::IsResourceExhausted(s);
-      };
-      for (size_t k = 0;
-           k < mapped_before.size() && k < 3 && !mapped.ok() && !final_error(mapped.status());
-           ++k) {
-        Points start;
-        for (int v : global) start.push_back(mesh.shapes[mapped_before[k]][v]);
-        MapToBoundaryOptions chained = map_options;
-        chained.tutte_when_convex = chained.tutte_first_always = false;
-        chained.start = &start;
-        absl::StatusOr<Points> retry =
-            injective(MapToBoundary(source, triangles, boundary, target_boundary, chained, cancel));
-        if (retry.ok() || final_error(retry.status())) mapped = std::move(retry);
-      }
-      // A map with a nearly flat triangle (the pull can end with one: quality down to 1e-16 on
-      // random star-shaped pairs) is no better than none while the overlay may still build: it
-      // counts as not found, and is kept only if the overlay (the last attempt) fails.
+      Component c = ExtractComponent(mesh, component_of, root, loops, target);
       std::optional<Points> flat_map;
-      if (mapped.ok() && options.overlay) {
-        int where = -1;
-        const double worst = WorstTriangleQuality(triangles, *mapped, &where);
-        if (worst < options.min_map_quality) {
-          flat_map = *mapped;
-          mapped = absl::FailedPreconditionError(
-              absl::StrCat("the map leaves a triangle nearly flat (quality ", worst, " near (",
-                           (*flat_map)[triangles[where][0]].x(), ", ",
-                           (*flat_map)[triangles[where][0]].y(), "))"));
-        }
-      }
-      // Last resort (a disk whose boundary in drawing d is a simple polygon): a common
-      // refinement of this mesh and a triangulation of drawing d (overlay_mesh.h). It adds
-      // vertices to the component in every drawing mapped so far.
+      absl::StatusOr<Points> mapped = MapComponent(c, mesh, ref, d, options, cancel, &flat_map);
       if (!mapped.ok() && overlay && absl::IsFailedPrecondition(mapped.status()) &&
-          loops.size() == 1) {
-        std::vector<int> known = {ref};  // drawings placed so far: the Tutte weights from ref
-        for (int e = 0; e < num_shapes; ++e) {
-          if (e != ref && e != d && !mesh.shapes[e].empty()) known.push_back(e);
-        }
-        std::vector<Points> placed;
-        for (int e : known) {
-          Points local_shape;
-          for (int v : global) local_shape.push_back(mesh.shapes[e][v]);
-          placed.push_back(std::move(local_shape));
-        }
+          c.num_loops == 1) {
         notify("map", 0.2 + 0.75 * (done - 1) / (num_shapes - 1),
                absl::StrCat("drawing ", d + 1, ": ", mapped.status().message(),
                             "; overlaying the mesh with a triangulation of drawing ", d + 1));
-        // The refinement counts against the mesh's vertex bound (the other components' too).
-        const int budget = options.max_mesh_vertices > 0
-                               ? std::max(1, options.max_mesh_vertices -
-                                                 (num_vertices - static_cast<int>(global.size())))
-                               : 0;
-        absl::StatusOr<OverlayResult> over =
-            OverlayOntoPolygon(triangles, placed, boundary, target_boundary, cancel, budget);
-        if (over.ok()) {
-          // New vertices get global indices after the existing ones, in every placed drawing,
-          // in drawing d and among the reference's points (targets_of reads those).
-          const size_t local_before = global.size();
-          for (int i = 0; i < over->added_vertices; ++i) {
-            global.push_back(num_vertices++);
-            component_of.push_back(root);
-            cut.vertices.push_back(over->shapes[0][global.size() - 1]);
-          }
-          for (size_t k = 0; k < known.size(); ++k) {
-            Points& s = mesh.shapes[known[k]];
-            for (size_t i = local_before; i < global.size(); ++i) s.push_back(over->shapes[k][i]);
-          }
-          shape.resize(num_vertices);
-          std::vector<Triangle> kept;
-          for (const Triangle& t : mesh.triangles) {
-            if (component_of[t[0]] != root) kept.push_back(t);
-          }
-          for (const Triangle& t : over->triangles) {
-            kept.push_back({global[t[0]], global[t[1]], global[t[2]]});
-          }
-          mesh.triangles = std::move(kept);
-          // Polish the map into drawing d from the overlay's placement (boundary already there).
-          Points source_now;
-          for (int v : global) source_now.push_back(mesh.shapes[ref][v]);
-          MapToBoundaryOptions polish = map_options;
-          polish.tutte_when_convex = polish.tutte_first_always = false;
-          polish.start = &over->shapes.back();
-          triangles = over->triangles;
-          absl::StatusOr<Points> polished =
-              MapToBoundary(source_now, triangles, boundary, target_boundary, polish, cancel);
-          if (!polished.ok() && absl::IsCancelled(polished.status())) return polished.status();
-          mapped =
-              polished.ok() ? std::move(polished) : absl::StatusOr<Points>(over->shapes.back());
-          mapped = injective(std::move(mapped));
-          ++overlays;
-        } else if (absl::IsCancelled(over.status())) {
-          return over.status();
-        } else {
-          mapped = absl::FailedPreconditionError(over.status().message());
-        }
+        const Growing growing{&mesh, &component_of, &cut.vertices, &num_vertices};
+        mapped = OverlayComponent(&c, root, ref, d, options, growing, cancel);
+        if (absl::IsCancelled(mapped.status())) return mapped.status();
+        if (mapped.ok()) ++overlays;
+        shape.resize(num_vertices);
       }
       if (!mapped.ok() && overlay && flat_map.has_value() && !absl::IsCancelled(mapped.status())) {
         mapped = *std::move(flat_map);  // the overlay did not build: the flat map is all there is
@@ -594,7 +643,7 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
                                                           "'s mesh into drawing ", d + 1, ": ",
                                                           mapped.status().message()));
       }
-      for (size_t i = 0; i < global.size(); ++i) shape[global[i]] = (*mapped)[i];
+      for (size_t i = 0; i < c.global.size(); ++i) shape[c.global[i]] = (*mapped)[i];
     }
     mesh.shapes[d] = std::move(shape);
   }
