@@ -370,13 +370,26 @@ absl::StatusOr<Points> OverlayComponent(Component* c, int root, int ref, int d,
 // BuildOnce).
 constexpr int kMaxReferences = 3;
 
+// The component maps one attempt made, (drawing, component) -> MapComponent's answer. The
+// overlay attempt meshes the same drawing with the same correspondence as the first attempt, so
+// until it first overlays, every map it asks for is one the first attempt already made (the
+// construction is deterministic): it replays them instead of pulling again.
+struct MapMemo {
+  struct Entry {
+    absl::StatusOr<Points> mapped;
+    std::optional<Points> flat_map;
+  };
+  std::map<std::pair<int, int>, Entry> entries;
+};
+
 // One attempt of BuildMultimesh, corners matched or not, meshing the drawing of the given rank
 // in the order of `references` below (0: the preferred one; *meshed: which drawing that is).
 // Returns ABORTED (not an answer: the caller keeps its first error) with require_match when no
-// loop's corners matched, and when there is no drawing of that rank, before any meshing.
+// loop's corners matched, and when there is no drawing of that rank, before any meshing. With
+// `memo`, an attempt without overlay records its maps there, one with overlay replays them.
 absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
                                     const MultimeshOptions& options, bool match_corners,
-                                    bool require_match, int rank, bool overlay,
+                                    bool require_match, int rank, bool overlay, MapMemo* memo,
                                     const CancelToken* cancel, const ProgressFn& progress,
                                     MultimeshReport* report, int* meshed) {
   const auto start = std::chrono::steady_clock::now();
@@ -617,7 +630,21 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
     for (const auto& [root, loops] : loops_of_component) {
       Component c = ExtractComponent(mesh, component_of, root, loops, target);
       std::optional<Points> flat_map;
-      absl::StatusOr<Points> mapped = MapComponent(c, mesh, ref, d, options, cancel, &flat_map);
+      absl::StatusOr<Points> mapped = absl::UnknownError("not mapped");
+      const std::pair<int, int> key(d, root);
+      const MapMemo::Entry* replay = nullptr;
+      if (memo != nullptr && overlay && overlays == 0) {
+        if (auto it = memo->entries.find(key); it != memo->entries.end()) replay = &it->second;
+      }
+      if (replay != nullptr) {
+        mapped = replay->mapped;
+        flat_map = replay->flat_map;
+      } else {
+        mapped = MapComponent(c, mesh, ref, d, options, cancel, &flat_map);
+        if (memo != nullptr && !overlay && !absl::IsCancelled(mapped.status())) {
+          memo->entries[key] = {mapped, flat_map};
+        }
+      }
       if (!mapped.ok() && overlay && absl::IsFailedPrecondition(mapped.status()) &&
           c.num_loops == 1) {
         notify("map", 0.2 + 0.75 * (done - 1) / (num_shapes - 1),
@@ -720,14 +747,18 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   // when the first one's meshes could not be mapped (FAILED_PRECONDITION). The first attempt's
   // error is the answer when nothing builds.
   absl::Status first;  // the first attempt's error (OK until an attempt fails)
+  MapMemo memo;        // the first attempt's maps, for the overlay attempt
   std::string others;  // the drawings meshed after the first, when none of them built
   int num_others = 0;
   for (int rank = 0; rank < kMaxReferences; ++rank) {
     int meshed = -1;
     auto attempt = [&](bool match_corners,
                        bool require_match) -> std::optional<absl::StatusOr<Multimesh>> {
-      absl::StatusOr<Multimesh> m = BuildOnce(drawings, options, match_corners, require_match, rank,
-                                              /*overlay=*/false, cancel, monotone, report, &meshed);
+      // The first attempt (rank 0, the first correspondence) is the one the overlay repeats.
+      const bool first_attempt = rank == 0 && match_corners == !arc_length && !require_match;
+      absl::StatusOr<Multimesh> m = BuildOnce(
+          drawings, options, match_corners, require_match, rank, /*overlay=*/false,
+          first_attempt && options.overlay ? &memo : nullptr, cancel, monotone, report, &meshed);
       if (m.ok() || absl::IsCancelled(m.status())) return m;
       if (rank == 0 && first.ok()) first = m.status();
       return std::nullopt;
@@ -763,7 +794,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
         absl::StrCat(first.message(), "; again, overlaying the mesh where it cannot be mapped"));
     absl::StatusOr<Multimesh> m =
         BuildOnce(drawings, options, /*match_corners=*/!arc_length, /*require_match=*/false,
-                  /*rank=*/0, /*overlay=*/true, cancel, monotone, report, nullptr);
+                  /*rank=*/0, /*overlay=*/true, &memo, cancel, monotone, report, nullptr);
     if (m.ok() || absl::IsCancelled(m.status())) return m;
     overlay_note = absl::StrCat("; overlaid: ", m.status().message());
   }
