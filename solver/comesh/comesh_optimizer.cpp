@@ -573,9 +573,11 @@ class HessianPreconditioner {
   static absl::StatusOr<HessianPreconditioner> Create(
       const std::vector<Triangle>& triangles, const Layout& layout,
       const ComeshObjective& objective, const std::vector<Points>& shapes, int background_analysis,
-      bool float_substitutions, const CancelToken* cancel, SharedFactors* factors) {
+      bool float_substitutions, double mips_damping, const CancelToken* cancel,
+      SharedFactors* factors) {
     HessianPreconditioner h;
     h.background_analysis_ = background_analysis;
+    h.mips_damping_ = mips_damping;
     h.triangles_ = &triangles;
     h.layout_ = &layout;
     h.objective_ = &objective;
@@ -901,6 +903,10 @@ class HessianPreconditioner {
         Matrix4 hp, hq;
         MipsEdgeHessians(e, EdgeMatrix(shapes[next], t), &hp, nullptr);
         MipsEdgeHessians(EdgeMatrix(shapes[prev], t), e, nullptr, &hq);
+        if (mips_damping_ > 0.0) {  // ComeshOptions::mips_damping; Gershgorin bounds
+          hp.diagonal().array() += mips_damping_ * hp.cwiseAbs().rowwise().sum().maxCoeff();
+          hq.diagonal().array() += mips_damping_ * hq.cwiseAbs().rowwise().sum().maxCoeff();
+        }
         h4 += (w / obj.rest_area(s)) * hp + (w / obj.rest_area(prev)) * hq;
       }
       const Matrix6 h6 = CornerHessian(ProjectPositiveDefinite(h4, 1e-8));
@@ -944,6 +950,7 @@ class HessianPreconditioner {
   std::vector<Block> blocks_;
   int threads_ = 1;
   int background_analysis_ = 0;  // ComeshOptions::background_analysis_unknowns
+  double mips_damping_ = 0.0;    // ComeshOptions::mips_damping
 };
 
 // BCQN-style curing of a search direction: for every triangle of every shape, the linearised
@@ -1061,10 +1068,9 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   std::optional<HessianPreconditioner> hessian;
   std::optional<InitialHessian> laplacian;
   if (options.hessian_preconditioner && mesh->num_shapes() <= options.hessian_max_shapes) {
-    absl::StatusOr<HessianPreconditioner> h =
-        HessianPreconditioner::Create(mesh->triangles, layout, *objective, shapes,
-                                      options.background_analysis_unknowns,
-                                      options.float_substitutions, cancel, factors);
+    absl::StatusOr<HessianPreconditioner> h = HessianPreconditioner::Create(
+        mesh->triangles, layout, *objective, shapes, options.background_analysis_unknowns,
+        options.float_substitutions, options.mips_damping, cancel, factors);
     if (absl::IsCancelled(h.status())) return cancelled_at(0);
     if (!h.ok()) return h.status();
     hessian.emplace(*std::move(h));
@@ -1367,13 +1373,15 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   if (options.max_iterations < 0 || options.history < 0 || !(options.max_step_fraction > 0.0) ||
       !(options.max_step_fraction < 1.0) || options.max_outer < 0 ||
       !(options.cure_keep >= 0.0 && options.cure_keep < 1.0) || !(options.blend >= 0.0) ||
+      !(options.mips_damping >= 0.0 && std::isfinite(options.mips_damping)) ||
       std::isnan(options.relax_fraction) || !(options.relax_over_mean >= 0.0) ||
       options.relax_max_vertices < 0 || options.relax_steps < 0 ||
       !(options.outline_corner_degrees >= 0.0 && options.outline_corner_degrees <= 180.0)) {
     return absl::InvalidArgumentError(
         "comesh options: max_iterations, history, max_outer, relax_max_vertices and relax_steps "
         "must be >= 0, max_step_fraction in (0, 1), cure_keep in [0, 1), blend and "
-        "relax_over_mean >= 0, relax_fraction a number, outline_corner_degrees in [0, 180]");
+        "relax_over_mean >= 0, mips_damping finite and >= 0, relax_fraction a number, "
+        "outline_corner_degrees in [0, 180]");
   }
   const int threads = ResolveThreads(options.threads);
   const absl::Status not_started = absl::CancelledError("comesh optimization cancelled at start");

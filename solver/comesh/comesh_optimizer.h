@@ -132,6 +132,19 @@ struct ComeshOptions {
   // bound by reading L, were ~27% faster per iteration at 165k vertices. Small meshes get
   // simplicial factors, which stay double.
   bool float_substitutions = true;
+  // In the shape-block Hessian, each triangle's MIPS blocks (its source side and its target
+  // side, comesh_hessian.h) get mips_damping times their own Gershgorin bound added on the
+  // diagonal before the sum is projected: a per-triangle Levenberg-Marquardt term relative to that
+  // triangle's curvature. sigma* is invariant under scaling a triangle in one shape, so the block
+  // has no curvature along that scaling, and without the damping the model asks triangles
+  // crushed in one shape (the fans at the square's corners opened onto the hexagon's sides, S-Table
+  // 2) to move many times their size; the inversion bound then cuts the step of the whole mesh,
+  // iteration after iteration. Measured on S-Table 2 (docs/benchmarks.md): 1.0 against 0 cut
+  // the 165k row's inner iterations 168 -> 94 and the 311k row's 260 (the cap) -> 123, the
+  // smaller rows and S-Tables 1, 3 and 4 about unchanged. Both sides are damped: the target side
+  // alone left S-Table 4's hard5/hard6 at 103/201 inner iterations against 62/102. 0: the plain
+  // projected Hessian; finite and >= 0 (else INVALID_ARGUMENT).
+  double mips_damping = 1.0;
   int hessian_max_shapes = 2;
   int hessian_refresh = 0;
   bool scaling_by_inverse = false;  // beta = y^T H0 y / s^T y (else s^T y / s^T B0 s)
@@ -164,8 +177,8 @@ struct ComeshOptions {
   double relax_over_mean = 100.0;
   int relax_max_vertices = 256;
   int relax_steps = 3;
-  double max_step_fraction = 0.8;   // line search starts at this fraction of the inversion bound
-  double armijo = 1e-4;             // sufficient decrease constant c1
+  double max_step_fraction = 0.8;  // line search starts at this fraction of the inversion bound
+  double armijo = 1e-4;            // sufficient decrease constant c1
   int max_backtracks = 50;
   int threads = 0;  // <= 0: hardware concurrency; results do not depend on it
   // Hessian blocks of at least this many unknowns are analysed (AMD + CHOLMOD's symbolic

@@ -35,7 +35,8 @@ struct ComeshBenchArgs {
 // --no-corner-swaps, --no-boundary-splits (TopologyOptions::corner_swaps, boundary_splits off),
 // --no-outline-sliding (ComeshOptions::slide_outline off), --outline-corner DEGREES,
 // --min-quality Q (ComeshOptions::min_quality; 0: no sliver removal),
-// --double-substitutions (ComeshOptions::float_substitutions off),
+// --double-substitutions (ComeshOptions::float_substitutions off), --mips-damping D
+// (ComeshOptions::mips_damping; 0: the plain projected Hessian),
 // --cure-keep C, --step-fraction F, --scale-by-inverse, --history M, --tolerance R, --laplacian
 // (BCQN's H0), --refresh K, --relax F (0: no local relaxation), --relax-over-mean M,
 // --relax-max K, --relax-steps S, --outer-inner K, --repeat N, --verbose, --malloc-defaults and
@@ -51,7 +52,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
                  "[--no-corner-swaps] [--no-boundary-splits] [--no-outline-sliding] "
                  "[--outline-corner DEGREES] [--min-quality Q] "
-                 "[--cure-keep C] [--double-substitutions] [--step-fraction F] [--outer-inner K] "
+                 "[--cure-keep C] [--double-substitutions] [--mips-damping D] [--step-fraction F] "
+                 "[--outer-inner K] "
                  "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
                  "[--relax F] "
                  "[--relax-over-mean M] [--relax-max K] [--relax-steps S] [--repeat N] "
@@ -108,6 +110,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.hessian_refresh = std::atoi(next());
     } else if (a == "--double-substitutions") {
       args.options.float_substitutions = false;
+    } else if (a == "--mips-damping") {
+      args.options.mips_damping = std::atof(next());
     } else if (a == "--no-corner-swaps") {
       args.options.topology.corner_swaps = false;
     } else if (a == "--no-outline-sliding") {

@@ -84,6 +84,30 @@ TEST(ComeshHessianTest, MipsBlocksMatchDifferencedGradients) {
   }
 }
 
+// sigma* is invariant under scaling a triangle in the target shape (C(P, sQ) = C(P, Q)), so by
+// Euler's identity H_Q u = -grad_Q for u = vec(Q): no curvature along the scaling (u^T H_Q u =
+// 0), the null direction ComeshOptions::mips_damping is for. The source side is homogeneous of
+// degree 2 (an area weight): u^T H_P u = 2 C there.
+TEST(ComeshHessianTest, MipsTargetBlockHasNoCurvatureAlongTheTrianglesScaling) {
+  std::mt19937 rng(14);
+  for (int i = 0; i < 50; ++i) {
+    const Corners xi = RandomTriangle(rng), xj = RandomTriangle(rng);
+    Matrix4 hp, hq;
+    MipsEdgeHessians(EdgeMatrix(xi), EdgeMatrix(xj), &hp, &hq);
+    Corners gi, gj;
+    const double c = MipsTriangleEnergy(xi, xj, &gi, &gj);
+    const Eigen::Matrix2d p = EdgeMatrix(xi), q = EdgeMatrix(xj);
+    const Eigen::Vector4d up(p(0, 0), p(1, 0), p(0, 1), p(1, 1));
+    const Eigen::Vector4d uq(q(0, 0), q(1, 0), q(0, 1), q(1, 1));
+    // Edge-space gradient: the corner gradients of corners 1 and 2 (corner 0 = minus their sum).
+    const Eigen::Vector4d grad_q(gj[1].x(), gj[1].y(), gj[2].x(), gj[2].y());
+    const double scale = hq.cwiseAbs().maxCoeff() * uq.squaredNorm();
+    EXPECT_LE((hq * uq + grad_q).norm(), 1e-9 * (1.0 + scale));
+    EXPECT_LE(std::abs(uq.dot(hq * uq)), 1e-9 * (1.0 + scale));
+    EXPECT_NEAR(up.dot(hp * up), 2.0 * c, 1e-9 * (1.0 + c));
+  }
+}
+
 TEST(ComeshHessianTest, ProjectionClampsOnlyNegativeEigenvalues) {
   std::mt19937 rng(13);
   std::normal_distribution<double> n(0.0, 1.0);

@@ -157,13 +157,17 @@ TEST(ComeshOptimizerTest, SimilarShapesReachConformalMapEnergy) {
 
 TEST(ComeshOptimizerTest, SquareToHexagonImprovesMapAndKeepsMeshSane) {
   const Multimesh m = SquareToHexagon(12);
-  for (bool laplacian : {true, false}) {
+  // The Hessian model with and without its MIPS damping, and BCQN's Laplacian (with and without
+  // the Laplacian itself).
+  for (int variant = 0; variant < 4; ++variant) {
     ComeshOptions options;
-    options.laplacian_preconditioner = laplacian;
+    options.hessian_preconditioner = variant < 2;
+    options.mips_damping = variant == 1 ? 0.0 : options.mips_damping;
+    options.laplacian_preconditioner = variant != 3;
     ComeshReport report;
     auto out = OptimizeComesh(m, options, nullptr, nullptr, &report);
     ASSERT_TRUE(out.ok()) << out.status();
-    EXPECT_LT(report.map_energy, report.map_energy_before - 0.01) << "laplacian " << laplacian;
+    EXPECT_LT(report.map_energy, report.map_energy_before - 0.01) << "variant " << variant;
     EXPECT_LT(report.mesh_energy, 1.5);
     for (const Points& x : out->shapes) EXPECT_EQ(testing::CountNonPositive(out->triangles, x), 0);
   }
@@ -506,6 +510,17 @@ TEST(ComeshOptimizerTest, RejectsBadOuterOptions) {
   options.max_outer = -1;
   EXPECT_EQ(OptimizeComesh(m, options, nullptr, nullptr, nullptr).status().code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+TEST(ComeshOptimizerTest, RejectsBadMipsDamping) {
+  const Multimesh m = SquareToHexagon(4);
+  for (double damping : {-0.5, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    ComeshOptions options;
+    options.mips_damping = damping;
+    const absl::Status st = OptimizeComesh(m, options, nullptr, nullptr, nullptr).status();
+    EXPECT_EQ(st.code(), absl::StatusCode::kInvalidArgument) << damping;
+    EXPECT_NE(st.message().find("mips_damping"), std::string::npos) << st;
+  }
 }
 
 TEST(ComeshOptimizerTest, RejectsBadRelaxOptions) {
@@ -867,9 +882,8 @@ TEST(ComeshOptimizerTest, CorrespondenceMarksStayPinned) {
   build.max_edge_relative = 0.08;
   const double h = 0.6 * std::sin(std::numbers::pi / 3.0);
   build.marks = {{Point(0.5, 0.0), Point(0.5, 0.5 - h)}, {Point(0.5, 1.0), Point(0.5, 0.5 + h)}};
-  absl::StatusOr<Multimesh> built =
-      BuildMultimesh({testing::UnitSquare(), testing::RegularPolygon(6, 0.6, Point(0.5, 0.5))},
-                     build);
+  absl::StatusOr<Multimesh> built = BuildMultimesh(
+      {testing::UnitSquare(), testing::RegularPolygon(6, 0.6, Point(0.5, 0.5))}, build);
   ASSERT_TRUE(built.ok()) << built.status();
   ASSERT_EQ(built->pinned.size(), 2u);
   std::vector<std::vector<Point>> at(2);
@@ -905,4 +919,3 @@ TEST(ComeshOptimizerTest, CorrespondenceMarksStayPinned) {
 
 }  // namespace
 }  // namespace inbetween::solver
-
