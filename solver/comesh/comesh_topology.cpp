@@ -15,6 +15,7 @@
 
 #include "solver/comesh/comesh_objective.h"
 #include "solver/mesh/validate.h"
+#include "solver/mesh/vertex_star.h"
 
 namespace inbetween::solver {
 namespace {
@@ -849,17 +850,7 @@ class Editor {
     return false;
   }
 
-  std::vector<int> Neighbours(int v) const {
-    std::vector<int> out;
-    for (int t : incident_[v]) {
-      for (int u : triangles_[t]) {
-        if (u != v) out.push_back(u);
-      }
-    }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
-  }
+  std::vector<int> Neighbours(int v) const { return StarNeighbours(triangles_, incident_[v], v); }
 
   void MarkDirty(int v) {
     if (v >= static_cast<int>(dirty_.size())) dirty_.resize(v + 1, 0);

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "solver/mesh/validate.h"
+#include "solver/mesh/vertex_star.h"
 
 namespace inbetween::solver {
 namespace {
@@ -91,18 +92,7 @@ class Collapser {
     return worst;
   }
 
-  // v's neighbours, sorted, each once.
-  std::vector<int> Neighbours(int v) const {
-    std::vector<int> out;
-    for (int t : star_[v]) {
-      for (int x : triangles_[t]) {
-        if (x != v) out.push_back(x);
-      }
-    }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
-  }
+  std::vector<int> Neighbours(int v) const { return StarNeighbours(triangles_, star_[v], v); }
 
   // Every edge at v borders two triangles: each neighbour appears in exactly two of its triangles.
   bool Interior(int v) const {
