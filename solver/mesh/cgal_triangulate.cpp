@@ -108,6 +108,21 @@ constexpr double kMinRefinementSpacing = 1e-7;
 // before a point closer than `min_spacing` to its neighbours.
 absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices,
                            double min_spacing) {
+  // Input points already that close (a needle folded back on itself, two boundaries nearly
+  // touching) get the same answer before the mesher sees them: its edge refinement can fail an
+  // internal assertion on them before the first point is inserted (mesh_fuzz finding,
+  // build/fuzz/artifacts/mesh_fuzz/crash-5252cc03…: two corners 2.75e-9 apart).
+  for (auto e = cdt.finite_edges_begin(); e != cdt.finite_edges_end(); ++e) {
+    const CgalPoint& a = e->first->vertex(Cdt::ccw(e->second))->point();
+    const CgalPoint& b = e->first->vertex(Cdt::cw(e->second))->point();
+    const double d = std::sqrt(CGAL::to_double(CGAL::squared_distance(a, b)));
+    if (d < min_spacing) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("triangulate: the drawing has a cusp or boundaries that nearly touch near (",
+                       a.x(), ", ", a.y(), "): two of its points are ", d, " apart (less than ",
+                       min_spacing, "); widen the cusp or separate the boundaries"));
+    }
+  }
   CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, criteria);
   mesher.init();
   Cdt::Face_handle hint;

@@ -6,6 +6,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "solver/mesh/build_multimesh.h"
 #include "solver/mesh/cgal_triangulate.h"
 
@@ -33,6 +36,45 @@ TEST(CgalTriangulateBoundedTest, ThinSpikeIsRefusedInsteadOfRefinedForever) {
                         "touch near ("));
 }
 
+// Another fuzzer input (build/fuzz/artifacts/mesh_fuzz/crash-5252cc03…, decoded): a needle from
+// (24, 0) whose two far corners are 2.75e-9 apart. CGAL's edge refinement failed an internal
+// assertion on it ("n == zone.fh"), which came back as INTERNAL; the input's spacing is now
+// checked first.
+TEST(CgalTriangulateBoundedTest, CornersNearlyTouchingAreRefusedBeforeTheMesherSeesThem) {
+  Points a = {{24 + 2.75e-9, 24 + 2.75e-9}, {24, 0}, {24 + 2.75e-9, 24}, {30, 3}};
+  double area2 = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const Point p = a[i], q = a[(i + 1) % a.size()];
+    area2 += p.x() * q.y() - p.y() * q.x();
+  }
+  if (area2 < 0) std::reverse(a.begin(), a.end());
+  Points b;
+  for (const Point& p : a) {
+    const Point s(0.6 * (p.x() - 0.5 * p.y()), 0.6 * p.y());
+    b.emplace_back(std::cos(0.5) * s.x() - std::sin(0.5) * s.y() + 5,
+                   std::sin(0.5) * s.x() + std::cos(0.5) * s.y() - 3);
+  }
+  Drawing da, db;
+  da.outlines = {{a}};
+  db.outlines = {{b}};
+  MultimeshOptions options;  // the harness's
+  options.boundary_vertices = 8;
+  options.max_mesh_vertices = 300;
+  options.max_map_iterations = 200;
+  absl::StatusOr<Multimesh> m = BuildMultimesh({da, db}, options);
+  ASSERT_FALSE(m.ok());
+  EXPECT_EQ(m.status().code(), absl::StatusCode::kInvalidArgument) << m.status();
+  EXPECT_THAT(m.status().message(),
+              HasSubstr("drawing 1: triangulate: the drawing has a cusp or boundaries that nearly "
+                        "touch near ("));
+  EXPECT_THAT(m.status().message(), HasSubstr("apart"));
+  // The polygon alone, by the polygon triangulator: the same answer.
+  TriangulateOptions t;
+  t.max_edge = 2.0;
+  absl::StatusOr<PolygonTriangulation> p = CgalTriangulate(a, t);
+  EXPECT_EQ(p.status().code(), absl::StatusCode::kInvalidArgument) << p.status();
+}
+
 TEST(CgalTriangulateBoundedTest, OrdinaryPolygonMeshesWithinTheBound) {
   const Points square = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
   TriangulateOptions options;
@@ -42,8 +84,7 @@ TEST(CgalTriangulateBoundedTest, OrdinaryPolygonMeshesWithinTheBound) {
   ASSERT_TRUE(t.ok()) << t.status();
   EXPECT_GT(t->vertices.size(), 50u);
   options.max_vertices = 20;  // the same refinement needs more
-  EXPECT_EQ(CgalTriangulate(square, options).status().code(),
-            absl::StatusCode::kResourceExhausted);
+  EXPECT_EQ(CgalTriangulate(square, options).status().code(), absl::StatusCode::kResourceExhausted);
 }
 
 }  // namespace
