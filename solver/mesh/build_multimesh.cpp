@@ -235,6 +235,24 @@ MapToBoundaryOptions MapOptions(const Component& c, const MultimeshOptions& opti
   return map_options;
 }
 
+// The same, pulling from a placement `start` (no Tutte start).
+MapToBoundaryOptions MapOptionsFrom(const Component& c, const MultimeshOptions& options,
+                                    const Points* start) {
+  MapToBoundaryOptions map_options = MapOptions(c, options);
+  map_options.tutte_when_convex = map_options.tutte_first_always = false;
+  map_options.start = start;
+  return map_options;
+}
+
+// The drawings other than ref and d that have been placed already, in key order.
+std::vector<int> PlacedOthers(const Multimesh& mesh, int ref, int d) {
+  std::vector<int> placed;
+  for (int e = 0; e < static_cast<int>(mesh.shapes.size()); ++e) {
+    if (e != ref && e != d && !mesh.shapes[e].empty()) placed.push_back(e);
+  }
+  return placed;
+}
+
 // Every triangle positive does not make a map injective: the boundary may fold over itself
 // (seen on a real icon's cusp). Such a map counts as not found.
 absl::StatusOr<Points> Injective(const std::vector<Triangle>& triangles, absl::StatusOr<Points> m) {
@@ -266,19 +284,13 @@ absl::StatusOr<Points> MapComponent(const Component& c, const Multimesh& mesh, i
   // A pose far from the reference drawing may not be reachable by pulling the reference's
   // boundary directly; start instead from the map into an already mapped drawing, nearest in key
   // order first (neighbouring keys are usually similar poses).
-  const int num_shapes = static_cast<int>(mesh.shapes.size());
-  std::vector<int> mapped_before;
-  for (int e = 0; e < num_shapes; ++e) {
-    if (e != ref && e != d && !mesh.shapes[e].empty()) mapped_before.push_back(e);
-  }
+  std::vector<int> mapped_before = PlacedOthers(mesh, ref, d);
   std::stable_sort(mapped_before.begin(), mapped_before.end(),
                    [d](int a, int b) { return std::abs(a - d) < std::abs(b - d); });
   for (size_t k = 0;
        k < mapped_before.size() && k < 3 && !mapped.ok() && !FinalError(mapped.status()); ++k) {
     const Points start = Restrict(mesh.shapes[mapped_before[k]], c.global);
-    MapToBoundaryOptions chained = map_options;
-    chained.tutte_when_convex = chained.tutte_first_always = false;
-    chained.start = &start;
+    const MapToBoundaryOptions chained = MapOptionsFrom(c, options, &start);
     absl::StatusOr<Points> retry = Injective(
         c.triangles,
         MapToBoundary(source, c.triangles, c.boundary, c.target_boundary, chained, cancel));
@@ -315,11 +327,8 @@ absl::StatusOr<Points> OverlayComponent(Component* c, int root, int ref, int d,
                                         const MultimeshOptions& options, const Growing& g,
                                         const CancelToken* cancel) {
   Multimesh& mesh = *g.mesh;
-  const int num_shapes = static_cast<int>(mesh.shapes.size());
   std::vector<int> known = {ref};  // drawings placed so far: the Tutte weights from ref
-  for (int e = 0; e < num_shapes; ++e) {
-    if (e != ref && e != d && !mesh.shapes[e].empty()) known.push_back(e);
-  }
+  for (int e : PlacedOthers(mesh, ref, d)) known.push_back(e);
   std::vector<Points> placed;
   for (int e : known) placed.push_back(Restrict(mesh.shapes[e], c->global));
   // The refinement counts against the mesh's vertex bound (the other components' too).
@@ -355,9 +364,7 @@ absl::StatusOr<Points> OverlayComponent(Component* c, int root, int ref, int d,
   mesh.triangles = std::move(kept);
   c->triangles = over->triangles;
   // Polish the map into drawing d from the overlay's placement (boundary already there).
-  MapToBoundaryOptions polish = MapOptions(*c, options);
-  polish.tutte_when_convex = polish.tutte_first_always = false;
-  polish.start = &over->shapes.back();
+  const MapToBoundaryOptions polish = MapOptionsFrom(*c, options, &over->shapes.back());
   absl::StatusOr<Points> polished =
       MapToBoundary(Restrict(mesh.shapes[ref], c->global), c->triangles, c->boundary,
                     c->target_boundary, polish, cancel);

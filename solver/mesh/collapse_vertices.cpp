@@ -40,8 +40,9 @@ class Collapser {
     const double bar = quality_floor > 0 ? std::min(before, quality_floor) : before;
     int best_u = -1;
     double best = -kInf;
-    for (int u : Neighbours(v)) {
-      if (!LinkCondition(v, u)) continue;
+    const std::vector<int> nv = Neighbours(v);
+    for (int u : nv) {
+      if (!LinkCondition(v, nv, u)) continue;
       double after = kInf;
       for (int t : star_[v]) {
         Triangle tri = triangles_[t];
@@ -111,9 +112,9 @@ class Collapser {
     return true;
   }
 
-  // u and v share exactly the two neighbours opposite their edge.
-  bool LinkCondition(int v, int u) const {
-    const std::vector<int> nv = Neighbours(v), nu = Neighbours(u);
+  // u and v (whose neighbours are nv) share exactly the two neighbours opposite their edge.
+  bool LinkCondition(int v, const std::vector<int>& nv, int u) const {
+    const std::vector<int> nu = Neighbours(u);
     std::vector<int> common;
     std::set_intersection(nv.begin(), nv.end(), nu.begin(), nu.end(), std::back_inserter(common));
     int across = 0;
