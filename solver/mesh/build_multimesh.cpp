@@ -194,6 +194,7 @@ struct Component {
   std::vector<int> boundary;        // its boundary loops, concatenated (local vertices)
   Points target_boundary;           // boundary[k]'s place in the drawing being mapped
   int num_loops = 0;
+  std::vector<int> loop_sizes;      // how many of `boundary` each loop has, in order
 };
 
 Component ExtractComponent(const Multimesh& mesh, const std::vector<int>& component_of, int root,
@@ -215,6 +216,7 @@ Component ExtractComponent(const Multimesh& mesh, const std::vector<int>& compon
       c.boundary.push_back(local[v]);
       c.target_boundary.push_back(target[v]);
     }
+    c.loop_sizes.push_back(static_cast<int>(mesh.boundary_loops[g].size()));
   }
   c.num_loops = static_cast<int>(loops.size());
   return c;
@@ -320,9 +322,10 @@ struct Growing {
   int* num_vertices;
 };
 
-// Last resort for component c (a disk whose boundary in drawing d is a simple polygon): a common
-// refinement of it and a triangulation of drawing d (overlay_mesh.h), which adds vertices to the
-// component in every drawing placed so far; c is renumbered to match. Returns the map into d.
+// Last resort for component c: a common refinement of it and a triangulation of drawing d
+// (overlay_mesh.h; a component with holes is cut open into a disk for it and glued back), which
+// adds vertices to the component in every drawing placed so far; c is renumbered to match.
+// Returns the map into d.
 absl::StatusOr<Points> OverlayComponent(Component* c, int root, int ref, int d,
                                         const MultimeshOptions& options, const Growing& g,
                                         const CancelToken* cancel) {
@@ -336,8 +339,16 @@ absl::StatusOr<Points> OverlayComponent(Component* c, int root, int ref, int d,
                          ? std::max(1, options.max_mesh_vertices -
                                            (*g.num_vertices - static_cast<int>(c->global.size())))
                          : 0;
+  std::vector<std::vector<int>> loops;
+  std::vector<Points> target_loops;
+  for (size_t l = 0, at = 0; l < c->loop_sizes.size(); at += c->loop_sizes[l++]) {
+    const auto first = static_cast<std::ptrdiff_t>(at), last = first + c->loop_sizes[l];
+    loops.emplace_back(c->boundary.begin() + first, c->boundary.begin() + last);
+    target_loops.emplace_back(c->target_boundary.begin() + first,
+                              c->target_boundary.begin() + last);
+  }
   absl::StatusOr<OverlayResult> over =
-      OverlayOntoPolygon(c->triangles, placed, c->boundary, c->target_boundary, cancel, budget);
+      OverlayOntoDomain(c->triangles, placed, loops, target_loops, cancel, budget);
   if (!over.ok()) {
     if (absl::IsCancelled(over.status())) return over.status();
     return absl::FailedPreconditionError(over.status().message());
@@ -652,8 +663,7 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
           memo->entries[key] = {mapped, flat_map};
         }
       }
-      if (!mapped.ok() && overlay && absl::IsFailedPrecondition(mapped.status()) &&
-          c.num_loops == 1) {
+      if (!mapped.ok() && overlay && absl::IsFailedPrecondition(mapped.status())) {
         notify("map", 0.2 + 0.75 * (done - 1) / (num_shapes - 1),
                absl::StrCat("drawing ", d + 1, ": ", mapped.status().message(),
                             "; overlaying the mesh with a triangulation of drawing ", d + 1));

@@ -307,10 +307,14 @@ absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Poin
     // fills holes: marking the domain ourselves made the 5.5 mesher loop on concave shapes),
     // then faces kept by the even-odd rule at their centroid.
     const double size = options.max_edge > 0 ? options.max_edge : 0.0;
-    if (absl::Status s =
-            RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices,
-                          kMinRefinementSpacing * Diagonal(loops));
-        !s.ok()) {
+    if (!options.refine) {
+      // The mesher's set-up marks the enclosed faces and inserts nothing.
+      CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, Criteria(options.shape_bound, size));
+      mesher.init();
+    } else if (absl::Status s =
+                   RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices,
+                                 kMinRefinementSpacing * Diagonal(loops));
+               !s.ok()) {
       return s;
     }
     auto in_domain = [&](const Point& q) {

@@ -20,7 +20,7 @@ struct TriangulateOptions {
   // all along it: millions of points, i.e. no answer in practice (mesh_fuzz finding).
   int max_vertices = 2'000'000;
   // false: the constrained Delaunay triangulation of the boundary alone (no Steiner point; the
-  // size and shape bounds are ignored). CgalTriangulate only.
+  // size and shape bounds are ignored).
   bool refine = true;
 };
 

@@ -8,6 +8,8 @@
 #include <map>
 #include <numbers>
 #include <optional>
+#include <queue>
+#include <set>
 #include <tuple>
 
 #include "absl/strings/str_cat.h"
@@ -30,20 +32,14 @@ struct Chords {
   std::vector<std::array<int, 3>> side_chord;  // triangle -> chord opposite corner k (-1: rim)
 };
 
-absl::StatusOr<Chords> TriangulatePolygon(const Points& polygon) {
-  TriangulateOptions options;
-  options.refine = false;
-  absl::StatusOr<PolygonTriangulation> cdt = CgalTriangulate(polygon, options);
-  if (!cdt.ok()) return cdt.status();
-  const int nb = static_cast<int>(polygon.size());
-  if (static_cast<int>(cdt->vertices.size()) != nb) {
-    return absl::InternalError("overlay: the polygon's triangulation added points");
-  }
+// The chords of a triangulation of the loop's polygon without interior points, its triangles
+// given by loop position.
+Chords ChordsOf(const std::vector<std::array<int, 3>>& by_position, int nb) {
   Chords chords;
   std::map<std::pair<int, int>, int> id;
-  for (size_t t = 0; t < cdt->triangles.size(); ++t) {
-    const Triangle& tri = cdt->triangles[t];
-    chords.corners.push_back({tri[0], tri[1], tri[2]});
+  for (size_t t = 0; t < by_position.size(); ++t) {
+    const std::array<int, 3>& tri = by_position[t];
+    chords.corners.push_back(tri);
     std::array<int, 3> sides{-1, -1, -1};
     for (int k = 0; k < 3; ++k) {
       const int a = tri[(k + 1) % 3], b = tri[(k + 2) % 3];
@@ -61,6 +57,92 @@ absl::StatusOr<Chords> TriangulatePolygon(const Points& polygon) {
     chords.side_chord.push_back(sides);
   }
   return chords;
+}
+
+absl::StatusOr<Chords> TriangulatePolygon(const Points& polygon) {
+  TriangulateOptions options;
+  options.refine = false;
+  absl::StatusOr<PolygonTriangulation> cdt = CgalTriangulate(polygon, options);
+  if (!cdt.ok()) return cdt.status();
+  const int nb = static_cast<int>(polygon.size());
+  if (static_cast<int>(cdt->vertices.size()) != nb) {
+    return absl::InternalError("overlay: the polygon's triangulation added points");
+  }
+  std::vector<std::array<int, 3>> by_position;
+  for (const Triangle& t : cdt->triangles) by_position.push_back({t[0], t[1], t[2]});
+  return ChordsOf(by_position, nb);
+}
+
+// Directed edge a -> b -> the triangle that has it counter-clockwise.
+std::map<std::pair<int, int>, int> LeftOf(const std::vector<Triangle>& triangles) {
+  std::map<std::pair<int, int>, int> left;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      left[{triangles[t][k], triangles[t][(k + 1) % 3]}] = static_cast<int>(t);
+    }
+  }
+  return left;
+}
+
+// The triangles around v counter-clockwise from the one left of v -> from, up to the one whose
+// next edge is v -> to (included), or up to the boundary (to < 0). Empty if v -> from has no
+// triangle on its left or the turn does not end (a broken fan).
+std::vector<int> Turn(const std::vector<Triangle>& triangles,
+                      const std::map<std::pair<int, int>, int>& left, int v, int from, int to) {
+  std::vector<int> fan;
+  for (int w = from; fan.size() <= triangles.size();) {
+    auto it = left.find({v, w});
+    if (it == left.end()) return to < 0 && !fan.empty() ? fan : std::vector<int>{};
+    const Triangle& t = triangles[it->second];
+    fan.push_back(it->second);
+    const int k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+    w = t[(k + 2) % 3];
+    if (w == to) return fan;
+  }
+  return {};
+}
+
+// The triangles of the domain a loop of points bounds, by loop position. Points may repeat (a
+// slit or a closed cut walked both ways): each triangle corner at such a point belongs to the
+// visit whose sector, counter-clockwise from the next point to the previous one, holds it.
+absl::StatusOr<std::vector<std::array<int, 3>>> TriangulateLoop(const Points& loop) {
+  TriangulateOptions options;
+  options.refine = false;
+  absl::StatusOr<DomainTriangulation> cdt = CgalTriangulateDomain({loop}, options);
+  if (!cdt.ok()) return cdt.status();
+  const int nb = static_cast<int>(loop.size());
+  const std::vector<int>& at = cdt->loop_vertex[0];
+  std::vector<std::vector<int>> visits(cdt->vertices.size());
+  for (int k = 0; k < nb; ++k) visits[at[k]].push_back(k);
+  const auto broken = [] {
+    return absl::FailedPreconditionError(
+        "overlay: the drawing's outline, cut open, does not bound one disk");
+  };
+  // A triangulated disk whose vertices are all on its boundary: nb - 2 triangles.
+  if (static_cast<int>(cdt->triangles.size()) != nb - 2) return broken();
+  const std::map<std::pair<int, int>, int> left = LeftOf(cdt->triangles);
+  std::vector<std::array<int, 3>> out(cdt->triangles.size(), {-1, -1, -1});
+  for (size_t t = 0; t < out.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::vector<int>& v = visits[cdt->triangles[t][k]];
+      if (v.empty()) return broken();
+      if (v.size() == 1) out[t][k] = v[0];
+    }
+  }
+  for (int k = 0; k < nb; ++k) {
+    const int v = at[k];
+    if (visits[v].size() == 1) continue;
+    for (int t : Turn(cdt->triangles, left, v, at[(k + 1) % nb], at[(k + nb - 1) % nb])) {
+      const Triangle& tri = cdt->triangles[t];
+      const int c = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
+      if (out[t][c] >= 0) return broken();
+      out[t][c] = k;
+    }
+  }
+  for (const auto& t : out) {
+    if (t[0] < 0 || t[1] < 0 || t[2] < 0) return broken();
+  }
+  return out;
 }
 
 // What a polygon edge lies on during the splitting: a mesh edge u -> v, or a chord.
@@ -297,29 +379,99 @@ bool StrictlyConvex(const Points& polygon) {
   return true;
 }
 
-}  // namespace
+// The mesh cut open along paths into a disk.
+struct Opened {
+  std::vector<Triangle> triangles;
+  std::vector<int> original;  // vertex of the opened mesh -> the input vertex it stands for
+  std::vector<int> loop;      // its one boundary loop, from `start`, interior on the left
+};
 
-absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& triangles,
-                                                 const std::vector<Points>& shapes,
-                                                 const std::vector<int>& boundary,
-                                                 const Points& target_boundary,
-                                                 const CancelToken* cancel, int max_vertices) {
-  if (shapes.empty() || boundary.size() < 3 || boundary.size() != target_boundary.size()) {
-    return absl::InvalidArgumentError(absl::StrCat("overlay: ", shapes.size(), " shapes, ",
-                                                   boundary.size(), " boundary vertices and ",
-                                                   target_boundary.size(), " target points"));
+// Cuts the mesh (vertices 0..n-1, counter-clockwise triangles) along each path (vertex-disjoint
+// paths of edges between two boundary vertices, interior vertices between them): every vertex
+// of a path gets a copy (n, n + 1, ... in path order), used by the triangles on the path's
+// right. FAILED_PRECONDITION unless the result is one disk.
+absl::StatusOr<Opened> CutOpen(const std::vector<Triangle>& triangles, int n,
+                               const std::vector<std::vector<int>>& paths, int start) {
+  const auto broken = [] {
+    return absl::FailedPreconditionError("overlay: cutting the holes open did not give a disk");
+  };
+
+  const std::map<std::pair<int, int>, int> left = LeftOf(triangles);
+  std::vector<std::vector<int>> around(n);
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (int v : triangles[t]) around[v].push_back(static_cast<int>(t));
   }
-  const int n = static_cast<int>(shapes[0].size());
-  for (const Points& s : shapes) {
-    if (static_cast<int>(s.size()) != n) {
-      return absl::InvalidArgumentError("overlay: shapes of different sizes");
+  Opened o;
+  o.triangles = triangles;
+  for (int v = 0; v < n; ++v) o.original.push_back(v);
+  for (const std::vector<int>& path : paths) {
+    const int m = static_cast<int>(path.size()) - 1;
+    if (m < 1) return broken();
+    for (int i = 0; i <= m; ++i) {
+      const int v = path[i];
+      std::vector<int> right;
+      if (i == 0) {  // right of the path: all but the turn from it to the boundary
+        const std::vector<int> l = Turn(triangles, left, v, path[1], -1);
+        if (l.empty()) return broken();
+        for (int t : around[v]) {
+          if (std::find(l.begin(), l.end(), t) == l.end()) right.push_back(t);
+        }
+      } else {
+        right = Turn(triangles, left, v, path[i - 1], i < m ? path[i + 1] : -1);
+      }
+      if (right.empty()) return broken();
+      const int copy = static_cast<int>(o.original.size());
+      o.original.push_back(v);
+      for (int t : right) {
+        for (int& x : o.triangles[t]) {
+          if (x == v) x = copy;
+        }
+      }
     }
   }
-  absl::StatusOr<Chords> chords = TriangulatePolygon(target_boundary);
+  // One boundary loop, and Euler's characteristic of a disk.
+  std::set<std::pair<int, int>> edges;
+  for (const Triangle& t : o.triangles) {
+    for (int k = 0; k < 3; ++k) edges.emplace(t[k], t[(k + 1) % 3]);
+  }
+  std::map<int, int> next;
+  for (const auto& [a, b] : edges) {
+    if (!edges.count({b, a}) && !next.emplace(a, b).second) return broken();
+  }
+  for (int v = start; o.loop.size() <= next.size();) {
+    o.loop.push_back(v);
+    auto it = next.find(v);
+    if (it == next.end()) return broken();
+    if ((v = it->second) == start) break;
+  }
+  const long long faces = static_cast<long long>(o.triangles.size());
+  std::set<int> used;
+  for (const Triangle& t : o.triangles) used.insert(t.begin(), t.end());
+  const long long vertices = static_cast<long long>(used.size());
+  const long long boundary_edges = static_cast<long long>(next.size());
+  if (o.loop.size() != next.size() ||
+      vertices - (3 * faces + boundary_edges) / 2 + faces != 1) {
+    return broken();
+  }
+  return o;
+}
+
+// The overlay proper: the disk mesh (vertices 0..m-1 in every shape, boundary loop `boundary`)
+// with the chord triangulation of the new drawing (target[k]: where loop position k lies).
+// original[v] (empty: v itself) is the input vertex disk vertex v stands for: copies made by a
+// cut are glued back to it, so the result's vertices are the n input ones, then the crossings.
+absl::StatusOr<OverlayResult> OverlayDisk(const std::vector<Triangle>& triangles,
+                                          const std::vector<Points>& shapes,
+                                          const std::vector<int>& boundary,
+                                          const Points& target_boundary,
+                                          const absl::StatusOr<Chords>& chords,
+                                          const std::vector<int>& original, int n,
+                                          const CancelToken* cancel, int max_vertices) {
   if (!chords.ok()) {
     return absl::Status(chords.status().code(),
                         absl::StrCat("overlay: ", chords.status().message()));
   }
+  const int m = static_cast<int>(shapes[0].size());
   const int nb = static_cast<int>(boundary.size());
   // Loop positions on the circle: arc length of the first shape blended with even spacing (the
   // blend changes between attempts; some even share keeps every step positive).
@@ -381,11 +533,11 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
 
     OverlayResult result;
     const int total = overlay.num_vertices();
-    result.added_vertices = total - n;
+    result.added_vertices = total - m;
     result.shapes = shapes;
     for (Points& s : result.shapes) s.resize(total);
     Points target(total);
-    for (int v = 0; v < n; ++v) {
+    for (int v = 0; v < m; ++v) {
       if (const int k = overlay.LoopPosition(v); k >= 0) {
         target[v] = target_boundary[k];
         continue;
@@ -402,7 +554,7 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
     }
     for (size_t i = 0; i < overlay.crossings().size(); ++i) {
       const Crossing& x = overlay.crossings()[i];
-      const int v = n + static_cast<int>(i);
+      const int v = m + static_cast<int>(i);
       for (Points& s : result.shapes) s[v] = (1.0 - x.t) * s[x.u] + x.t * s[x.v];
       const auto& e = chords->ends[x.chord];
       target[v] = (1.0 - x.s) * target_boundary[e[0]] + x.s * target_boundary[e[1]];
@@ -437,6 +589,17 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
                                     cell.vertices[(best + i + 1) % m]});
       }
     }
+    if (!original.empty()) {  // the cut's copies glued back, crossings renumbered after n
+      const auto glued = [&](int v) { return v < m ? original[v] : n + (v - m); };
+      for (Triangle& t : result.triangles) {
+        for (int& v : t) v = glued(v);
+      }
+      for (Points& s : result.shapes) {
+        Points kept(s.begin(), s.begin() + n);
+        kept.insert(kept.end(), s.begin() + m, s.end());
+        s = std::move(kept);
+      }
+    }
     // Crossings that cut slivers off a mesh triangle (a chord passing near one of its
     // vertices) merge into a neighbour where that leaves every drawing's thinnest triangle no
     // thinner (collapse_vertices.h); the input's vertices stay.
@@ -465,6 +628,229 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
   }
   if (best.has_value()) return *std::move(best);
   return last;
+}
+
+bool HasRepeatedPoints(const Points& points) {
+  std::set<std::pair<double, double>> seen;
+  for (const Point& p : points) {
+    if (!seen.emplace(p.x(), p.y()).second) return true;
+  }
+  return false;
+}
+
+absl::Status CheckShapes(const std::vector<Points>& shapes, int* n) {
+  if (shapes.empty()) return absl::InvalidArgumentError("overlay: no shape");
+  *n = static_cast<int>(shapes[0].size());
+  for (const Points& s : shapes) {
+    if (static_cast<int>(s.size()) != *n) {
+      return absl::InvalidArgumentError("overlay: shapes of different sizes");
+    }
+  }
+  return absl::OkStatus();
+}
+
+// The shortest path (lengths in `source`) from boundary vertex `from` to boundary vertex `to`
+// through interior vertices not yet used; empty if there is none.
+std::vector<int> InteriorPath(const std::vector<std::vector<int>>& adjacent,
+                              const std::vector<int>& loop_of, const std::vector<char>& used,
+                              const Points& source, int from, int to) {
+  const int n = static_cast<int>(source.size());
+  std::vector<double> dist(n, std::numeric_limits<double>::infinity());
+  std::vector<int> prev(n, -1);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  dist[from] = 0.0;
+  queue.emplace(0.0, from);
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > dist[v]) continue;
+    if (v == to) break;
+    if (v != from && loop_of[v] >= 0) continue;
+    for (int w : adjacent[v]) {
+      if (w != to && (loop_of[w] >= 0 || used[w])) continue;
+      const double nd = d + (source[w] - source[v]).norm();
+      if (nd < dist[w]) dist[w] = nd, prev[w] = v, queue.emplace(nd, w);
+    }
+  }
+  if (prev[to] < 0) return {};
+  std::vector<int> path;
+  for (int v = to; v >= 0; v = prev[v]) path.push_back(v);
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+// Paths of mesh edges that join every loop to loop 0 (a tree of cuts): each between boundary
+// vertices of two loops whose points in the new drawing are joined by an edge of the chord
+// triangulation of its loops (so the cut is a straight segment inside that drawing), shortest
+// such edges first, through interior vertices, no two paths sharing a vertex.
+constexpr int kMaxSlitTries = 256;
+
+absl::StatusOr<std::vector<std::vector<int>>> Slits(const std::vector<Triangle>& triangles,
+                                                    const Points& source,
+                                                    const std::vector<std::vector<int>>& loops,
+                                                    const std::vector<Points>& target_loops,
+                                                    const CancelToken* cancel) {
+  TriangulateOptions options;
+  options.refine = false;
+  absl::StatusOr<DomainTriangulation> cdt = CgalTriangulateDomain(target_loops, options);
+  if (!cdt.ok()) {
+    return absl::Status(cdt.status().code(), absl::StrCat("overlay: ", cdt.status().message()));
+  }
+  // Triangulation vertex -> input vertex (-1: several share the point, e.g. a closed cut).
+  std::vector<int> vertex_of(cdt->vertices.size(), -2);
+  for (size_t l = 0; l < loops.size(); ++l) {
+    for (size_t k = 0; k < loops[l].size(); ++k) {
+      int& v = vertex_of[cdt->loop_vertex[l][k]];
+      v = v == -2 || v == loops[l][k] ? loops[l][k] : -1;
+    }
+  }
+  const int n = static_cast<int>(source.size());
+  std::vector<int> loop_of(n, -1);
+  for (size_t l = 0; l < loops.size(); ++l) {
+    for (int v : loops[l]) loop_of[v] = static_cast<int>(l);
+  }
+  struct Candidate {
+    double length;
+    int a, b;
+    bool operator<(const Candidate& o) const { return std::tie(length, a, b) < std::tie(o.length, o.a, o.b); }
+  };
+  std::set<Candidate> candidates;
+  for (const Triangle& t : cdt->triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int ca = t[k], cb = t[(k + 1) % 3];
+      if (ca >= static_cast<int>(vertex_of.size()) || cb >= static_cast<int>(vertex_of.size())) {
+        continue;
+      }
+      const int a = vertex_of[ca], b = vertex_of[cb];
+      if (a < 0 || b < 0 || loop_of[a] == loop_of[b]) continue;
+      candidates.insert({(cdt->vertices[ca] - cdt->vertices[cb]).norm(), std::min(a, b),
+                         std::max(a, b)});
+    }
+  }
+  std::vector<std::vector<int>> adjacent(n);
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) adjacent[t[k]].push_back(t[(k + 1) % 3]);
+    for (int k = 0; k < 3; ++k) adjacent[t[(k + 1) % 3]].push_back(t[k]);
+  }
+  for (std::vector<int>& a : adjacent) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+  }
+  std::vector<char> used(n, 0), joined(loops.size(), 0);
+  joined[0] = 1;
+  std::vector<std::vector<int>> paths;
+  int tries = 0;
+  while (paths.size() + 1 < loops.size()) {
+    bool found = false;
+    for (const Candidate& c : candidates) {
+      const int la = loop_of[c.a], lb = loop_of[c.b];
+      if (joined[la] == joined[lb] || used[c.a] || used[c.b]) continue;
+      if (Cancelled(cancel)) return absl::CancelledError("overlay cancelled");
+      if (++tries > kMaxSlitTries) break;
+      std::vector<int> path = InteriorPath(adjacent, loop_of, used, source, c.a, c.b);
+      if (path.empty()) continue;
+      for (int v : path) used[v] = 1;
+      joined[la] = joined[lb] = 1;
+      paths.push_back(std::move(path));
+      found = true;
+      break;
+    }
+    if (!found) {
+      int lonely = 0;
+      while (joined[lonely]) ++lonely;
+      return absl::FailedPreconditionError(
+          absl::StrCat("overlay: no cut through the mesh joins boundary loop ", lonely + 1,
+                       " to the others"));
+    }
+  }
+  return paths;
+}
+
+}  // namespace
+
+absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& triangles,
+                                                 const std::vector<Points>& shapes,
+                                                 const std::vector<int>& boundary,
+                                                 const Points& target_boundary,
+                                                 const CancelToken* cancel, int max_vertices) {
+  if (shapes.empty() || boundary.size() < 3 || boundary.size() != target_boundary.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("overlay: ", shapes.size(), " shapes, ",
+                                                   boundary.size(), " boundary vertices and ",
+                                                   target_boundary.size(), " target points"));
+  }
+  int n = 0;
+  if (absl::Status s = CheckShapes(shapes, &n); !s.ok()) return s;
+  return OverlayDisk(triangles, shapes, boundary, target_boundary,
+                     TriangulatePolygon(target_boundary), {}, n, cancel, max_vertices);
+}
+
+absl::StatusOr<OverlayResult> OverlayOntoDomain(const std::vector<Triangle>& triangles,
+                                                const std::vector<Points>& shapes,
+                                                const std::vector<std::vector<int>>& loops,
+                                                const std::vector<Points>& target_loops,
+                                                const CancelToken* cancel, int max_vertices) {
+  int n = 0;
+  if (absl::Status s = CheckShapes(shapes, &n); !s.ok()) return s;
+  if (loops.empty() || loops.size() != target_loops.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("overlay: ", loops.size(), " loops and ",
+                                                   target_loops.size(), " target loops"));
+  }
+  for (size_t l = 0; l < loops.size(); ++l) {
+    if (loops[l].size() < 2 || loops[l].size() != target_loops[l].size()) {
+      return absl::InvalidArgumentError(absl::StrCat("overlay: loop ", l + 1, " has ",
+                                                     loops[l].size(), " vertices and ",
+                                                     target_loops[l].size(), " target points"));
+    }
+    for (int v : loops[l]) {
+      if (v < 0 || v >= n) {
+        return absl::InvalidArgumentError(absl::StrCat("overlay: loop ", l + 1, " names vertex ",
+                                                       v, " of ", n));
+      }
+    }
+  }
+  if (loops.size() == 1 && !HasRepeatedPoints(target_loops[0])) {
+    return OverlayOntoPolygon(triangles, shapes, loops[0], target_loops[0], cancel, max_vertices);
+  }
+  std::vector<std::vector<int>> paths;
+  if (loops.size() > 1) {
+    absl::StatusOr<std::vector<std::vector<int>>> slits =
+        Slits(triangles, shapes[0], loops, target_loops, cancel);
+    if (!slits.ok()) return slits.status();
+    paths = *std::move(slits);
+  }
+  absl::StatusOr<Opened> opened = CutOpen(triangles, n, paths, loops[0][0]);
+  if (!opened.ok()) return opened.status();
+  // Where each vertex of the cut loop lies in the new drawing: its own point, or for a cut's
+  // inner vertex, on the straight cut in the proportion of its arc length along the path.
+  std::map<int, Point> where;
+  for (size_t l = 0; l < loops.size(); ++l) {
+    for (size_t k = 0; k < loops[l].size(); ++k) where[loops[l][k]] = target_loops[l][k];
+  }
+  for (const std::vector<int>& path : paths) {
+    std::vector<double> arc(path.size(), 0.0);
+    for (size_t i = 1; i < path.size(); ++i) {
+      arc[i] = arc[i - 1] + (shapes[0][path[i]] - shapes[0][path[i - 1]]).norm();
+    }
+    const Point a = where.at(path.front()), b = where.at(path.back());
+    for (size_t i = 1; i + 1 < path.size(); ++i) {
+      const double s = arc[i] / arc.back();
+      where[path[i]] = (1.0 - s) * a + s * b;
+    }
+  }
+  Points loop_points;
+  for (int v : opened->loop) loop_points.push_back(where.at(opened->original[v]));
+  absl::StatusOr<std::vector<std::array<int, 3>>> by_position = TriangulateLoop(loop_points);
+  absl::StatusOr<Chords> chords =
+      by_position.ok() ? absl::StatusOr<Chords>(
+                             ChordsOf(*by_position, static_cast<int>(loop_points.size())))
+                       : absl::StatusOr<Chords>(by_position.status());
+  std::vector<Points> extended = shapes;
+  for (Points& s : extended) {
+    for (size_t v = n; v < opened->original.size(); ++v) s.push_back(s[opened->original[v]]);
+  }
+  return OverlayDisk(opened->triangles, extended, opened->loop, loop_points, chords,
+                     opened->original, n, cancel, max_vertices);
 }
 
 }  // namespace inbetween::solver

@@ -1,6 +1,7 @@
 // A compatible mesh by overlay, for when a mesh cannot be mapped into a drawing without folding.
 //
-// The mesh (one component bounded by one loop: a topological disk) is embedded into a convex
+// The mesh (one component bounded by one loop: a topological disk; OverlayOntoDomain below cuts
+// a mesh with holes open into one first) is embedded into a convex
 // polygon by Tutte's method (map_to_boundary.h), its boundary vertices on a circle. The new
 // drawing's boundary polygon, through the same boundary vertices, is triangulated without
 // Steiner points (a constrained Delaunay triangulation: every interior edge a chord between two
@@ -52,5 +53,21 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
                                                  const Points& target_boundary,
                                                  const CancelToken* cancel = nullptr,
                                                  int max_vertices = 0);
+
+// The same for a mesh bounded by several loops (loops[0] and the others, e.g. an outline and
+// its holes; each in order with the interior on its left), target_loops[l][k] being where
+// loops[l][k] lies in the new drawing; points may repeat there (a closed cut walked both ways).
+// The mesh is first cut open into a disk along paths of its edges through interior vertices
+// that join every loop to loop 0, each between two vertices whose points in the new drawing
+// an edge of that drawing's constrained Delaunay triangulation joins (a straight segment inside
+// it, where the path's inner vertices are placed by arc length); the copies the cut makes are
+// glued back in the result, whose vertices are the input's, then the new ones. One loop with
+// distinct points is OverlayOntoPolygon. FAILED_PRECONDITION also when no such cut is found.
+absl::StatusOr<OverlayResult> OverlayOntoDomain(const std::vector<Triangle>& triangles,
+                                                const std::vector<Points>& shapes,
+                                                const std::vector<std::vector<int>>& loops,
+                                                const std::vector<Points>& target_loops,
+                                                const CancelToken* cancel = nullptr,
+                                                int max_vertices = 0);
 
 }  // namespace inbetween::solver

@@ -166,6 +166,145 @@ TEST(OverlayMeshTest, ChordTriangulationAddsNoPoint) {
   EXPECT_EQ(CountInverted(cdt->triangles, cdt->vertices), 0);
 }
 
+// A square loop of side `side` centred at c, counter-clockwise (clockwise: a hole's order).
+Points Square(const Point& c, double side, bool clockwise) {
+  const double h = side / 2;
+  Points p = {c + Point(-h, -h), c + Point(h, -h), c + Point(h, h), c + Point(-h, h)};
+  if (clockwise) std::reverse(p.begin(), p.end());
+  return p;
+}
+
+// A mesh of the domain `loops` bound (CgalTriangulateDomain), its boundary loops with the
+// mesher's points on them, and those loops placed onto `targets` (the same number of corners
+// per loop) at the same edge parameters.
+struct DomainCase {
+  DomainTriangulation mesh;
+  std::vector<std::vector<int>> loops;
+  std::vector<Points> targets;
+};
+
+DomainCase MeshDomain(const std::vector<Points>& loops, const std::vector<Points>& targets,
+                      double max_edge) {
+  TriangulateOptions options;
+  options.max_edge = max_edge;
+  absl::StatusOr<DomainTriangulation> mesh = CgalTriangulateDomain(loops, options);
+  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  // Without the points the mesher put inside the holes (no triangle uses them).
+  std::vector<int> index(mesh->vertices.size(), -1);
+  Points used;
+  for (Triangle& t : mesh->triangles) {
+    for (int& v : t) {
+      if (index[v] < 0) index[v] = static_cast<int>(used.size()), used.push_back(mesh->vertices[v]);
+      v = index[v];
+    }
+  }
+  for (auto& loop : mesh->loop_vertex)
+    for (int& v : loop) v = index[v];
+  for (auto& loop : mesh->edge_chain)
+    for (auto& chain : loop)
+      for (int& v : chain) v = index[v];
+  mesh->vertices = used;
+  DomainCase c{*mesh, {}, {}};
+  for (size_t l = 0; l < loops.size(); ++l) {
+    std::vector<int> loop;
+    Points target;
+    const size_t m = loops[l].size();
+    for (size_t k = 0; k < m; ++k) {
+      const Point a = loops[l][k], b = loops[l][(k + 1) % m];
+      const Point ta = targets[l][k], tb = targets[l][(k + 1) % m];
+      loop.push_back(c.mesh.loop_vertex[l][k]);
+      target.push_back(ta);
+      for (int v : c.mesh.edge_chain[l][k]) {
+        const double t = (c.mesh.vertices[v] - a).norm() / (b - a).norm();
+        loop.push_back(v);
+        target.push_back((1 - t) * ta + t * tb);
+      }
+    }
+    c.loops.push_back(loop);
+    c.targets.push_back(target);
+  }
+  return c;
+}
+
+// Checks an overlay of case c: valid in every drawing, the input vertices kept where they were
+// in the first, the loops on their targets, the areas the domains', one multimesh.
+void ExpectValidDomainOverlay(const DomainCase& c, const OverlayResult& over, double target_area) {
+  const int n = static_cast<int>(c.mesh.vertices.size());
+  ASSERT_EQ(over.shapes.size(), 2u);
+  const int total = n + over.added_vertices;
+  for (const Points& s : over.shapes) {
+    ASSERT_EQ(static_cast<int>(s.size()), total);
+    EXPECT_EQ(CountInverted(over.triangles, s), 0);
+  }
+  for (int v = 0; v < n; ++v) EXPECT_EQ(over.shapes[0][v], c.mesh.vertices[v]);
+  EXPECT_NEAR(Area(over.triangles, over.shapes[0]), Area(c.mesh.triangles, c.mesh.vertices),
+              1e-6);
+  EXPECT_NEAR(Area(over.triangles, over.shapes[1]), target_area, 1e-6);
+  Multimesh mesh;
+  mesh.triangles = over.triangles;
+  mesh.shapes = over.shapes;
+  for (size_t l = 0; l < c.loops.size(); ++l) {
+    for (size_t k = 0; k < c.loops[l].size(); ++k) {
+      EXPECT_EQ(over.shapes[1][c.loops[l][k]], c.targets[l][k]);
+    }
+    mesh.boundary.insert(mesh.boundary.end(), c.loops[l].begin(), c.loops[l].end());
+    mesh.boundary_loops.push_back(c.loops[l]);
+  }
+  EXPECT_TRUE(ValidateMultimesh(mesh).ok()) << ValidateMultimesh(mesh);
+}
+
+// A square with a hole in the middle onto a comb whose hole sits in its first tooth: the mesh is
+// cut open from the hole to the outline, overlaid, and glued back.
+TEST(OverlayMeshTest, MeshWithAHoleOntoADrawingWhoseHoleMoved) {
+  const Points comb = Comb(2);  // 8 corners: (0,0) (100,0) (100,100) (66.7,100) ...
+  Points outer;  // a square with the comb's corner count, its points spread along the sides
+  for (int k = 0; k < static_cast<int>(comb.size()); ++k) {
+    const double a = 2 * M_PI * (k + 0.5) / comb.size() - 0.75 * M_PI;
+    const double r = 50 / std::max(std::abs(std::cos(a)), std::abs(std::sin(a)));
+    outer.emplace_back(50 + r * std::cos(a), 50 + r * std::sin(a));
+  }
+  const Points hole = Square({50, 50}, 20, true);
+  const Points moved_hole = Square({16, 70}, 12, true);  // inside the comb's left tooth
+  const DomainCase c = MeshDomain({outer, hole}, {comb, moved_hole}, 8);
+  absl::StatusOr<OverlayResult> over =
+      OverlayOntoDomain(c.mesh.triangles, {c.mesh.vertices}, c.loops, c.targets);
+  ASSERT_TRUE(over.ok()) << over.status();
+  EXPECT_GT(over->added_vertices, 0);
+  ExpectValidDomainOverlay(c, *over, PolygonSignedArea(comb) + PolygonSignedArea(moved_hole));
+}
+
+// Three holes, each cut to the rest along its own path; the holes trade places.
+TEST(OverlayMeshTest, EveryHoleIsCutOpenAndGluedBack) {
+  const Points outer = Square({50, 50}, 100, false);
+  const std::vector<Point> at = {{25, 25}, {75, 30}, {50, 75}};
+  std::vector<Points> loops = {outer}, targets = {outer};
+  for (int h = 0; h < 3; ++h) {
+    loops.push_back(Square(at[h], 14, true));
+    targets.push_back(Square(at[(h + 1) % 3], 10, true));
+  }
+  const DomainCase c = MeshDomain(loops, targets, 10);
+  absl::StatusOr<OverlayResult> over =
+      OverlayOntoDomain(c.mesh.triangles, {c.mesh.vertices}, c.loops, c.targets);
+  ASSERT_TRUE(over.ok()) << over.status();
+  ExpectValidDomainOverlay(c, *over, 100 * 100 - 3 * 10 * 10);
+}
+
+// A drawing whose outline is cut shut (a slit walked both ways, its two sides on the same
+// points) is triangulated on both sides of the slit.
+TEST(OverlayMeshTest, ClosedCutInTheNewDrawing) {
+  // The source: a square with a notch (two sides of a cut, apart); the target: the notch shut.
+  const Points notched = {{0, 0}, {40, 0}, {50, 30}, {60, 0}, {100, 0}, {100, 100}, {0, 100}};
+  const Points shut = {{0, 0}, {50, 0}, {50, 30}, {50, 0}, {100, 0}, {100, 100}, {0, 100}};
+  const DomainCase c = MeshDomain({notched}, {shut}, 12);
+  absl::StatusOr<OverlayResult> over =
+      OverlayOntoDomain(c.mesh.triangles, {c.mesh.vertices}, c.loops, c.targets);
+  ASSERT_TRUE(over.ok()) << over.status();
+  const int n = static_cast<int>(c.mesh.vertices.size());
+  for (const Points& s : over->shapes) EXPECT_EQ(CountInverted(over->triangles, s), 0);
+  for (int v = 0; v < n; ++v) EXPECT_EQ(over->shapes[0][v], c.mesh.vertices[v]);
+  EXPECT_NEAR(Area(over->triangles, over->shapes[1]), 100 * 100, 1e-6);
+}
+
 TEST(OverlayMeshTest, BadInputsAreNamed) {
   const Points square = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
   const std::vector<Triangle> triangles = {{0, 1, 2}, {0, 2, 3}};
