@@ -194,7 +194,7 @@ struct Component {
   std::vector<int> boundary;        // its boundary loops, concatenated (local vertices)
   Points target_boundary;           // boundary[k]'s place in the drawing being mapped
   int num_loops = 0;
-  std::vector<int> loop_sizes;      // how many of `boundary` each loop has, in order
+  std::vector<int> loop_sizes;  // how many of `boundary` each loop has, in order
 };
 
 Component ExtractComponent(const Multimesh& mesh, const std::vector<int>& component_of, int root,

@@ -449,12 +449,14 @@ absl::StatusOr<Opened> CutOpen(const std::vector<Triangle>& triangles, int n,
   for (const Triangle& t : o.triangles) used.insert(t.begin(), t.end());
   const long long vertices = static_cast<long long>(used.size());
   const long long boundary_edges = static_cast<long long>(next.size());
-  if (o.loop.size() != next.size() ||
-      vertices - (3 * faces + boundary_edges) / 2 + faces != 1) {
+  if (o.loop.size() != next.size() || vertices - (3 * faces + boundary_edges) / 2 + faces != 1) {
     return broken();
   }
   return o;
 }
+
+constexpr long long kPreMergeFactor = 4;
+constexpr long long kMaxPreMergeVertices = 2'000'000;
 
 // The overlay proper: the disk mesh (vertices 0..m-1 in every shape, boundary loop `boundary`)
 // with the chord triangulation of the new drawing (target[k]: where loop position k lies).
@@ -473,6 +475,19 @@ absl::StatusOr<OverlayResult> OverlayDisk(const std::vector<Triangle>& triangles
   }
   const int m = static_cast<int>(shapes[0].size());
   const int nb = static_cast<int>(boundary.size());
+  // The bound is on the result, after the merges (which take about two in three crossings); the
+  // refinement before them may have kPreMergeFactor times as many vertices.
+  const int refine_bound =
+      max_vertices <= 0
+          ? 0
+          : static_cast<int>(std::max<long long>(
+                max_vertices,
+                std::min<long long>(kPreMergeFactor * static_cast<long long>(max_vertices),
+                                    kMaxPreMergeVertices)));
+  const auto too_many = [max_vertices] {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("overlay: the refinement needs more than ", max_vertices, " vertices"));
+  };
   // Loop positions on the circle: arc length of the first shape blended with even spacing (the
   // blend changes between attempts; some even share keeps every step positive).
   std::vector<double> arc(nb + 1, 0.0);
@@ -529,7 +544,9 @@ absl::StatusOr<OverlayResult> OverlayDisk(const std::vector<Triangle>& triangles
     }
 
     Overlay overlay(triangles, boundary, *disk, circle, *chords);
-    if (absl::Status run = overlay.Run(cancel, max_vertices); !run.ok()) return run;
+    if (absl::Status run = overlay.Run(cancel, refine_bound); !run.ok()) {
+      return absl::IsResourceExhausted(run) ? too_many() : run;
+    }
 
     OverlayResult result;
     const int total = overlay.num_vertices();
@@ -610,6 +627,10 @@ absl::StatusOr<OverlayResult> OverlayDisk(const std::vector<Triangle>& triangles
       result.triangles = std::move(coarse->triangles);
       result.shapes = std::move(coarse->shapes);
       result.added_vertices -= coarse->removed;
+    }
+    if (max_vertices > 0 && n + result.added_vertices > max_vertices) {
+      last = too_many();  // another placement may cut fewer pieces
+      continue;
     }
     // Positive in doubles, as every later stage judges a triangle (validate.h's CountInverted),
     // and how thin the thinnest is (4 sqrt(3) area / sum of squared edges: 1 equilateral).
@@ -713,7 +734,9 @@ absl::StatusOr<std::vector<std::vector<int>>> Slits(const std::vector<Triangle>&
   struct Candidate {
     double length;
     int a, b;
-    bool operator<(const Candidate& o) const { return std::tie(length, a, b) < std::tie(o.length, o.a, o.b); }
+    bool operator<(const Candidate& o) const {
+      return std::tie(length, a, b) < std::tie(o.length, o.a, o.b);
+    }
   };
   std::set<Candidate> candidates;
   for (const Triangle& t : cdt->triangles) {
@@ -724,8 +747,8 @@ absl::StatusOr<std::vector<std::vector<int>>> Slits(const std::vector<Triangle>&
       }
       const int a = vertex_of[ca], b = vertex_of[cb];
       if (a < 0 || b < 0 || loop_of[a] == loop_of[b]) continue;
-      candidates.insert({(cdt->vertices[ca] - cdt->vertices[cb]).norm(), std::min(a, b),
-                         std::max(a, b)});
+      candidates.insert(
+          {(cdt->vertices[ca] - cdt->vertices[cb]).norm(), std::min(a, b), std::max(a, b)});
     }
   }
   std::vector<std::vector<int>> adjacent(n);
@@ -759,9 +782,8 @@ absl::StatusOr<std::vector<std::vector<int>>> Slits(const std::vector<Triangle>&
     if (!found) {
       int lonely = 0;
       while (joined[lonely]) ++lonely;
-      return absl::FailedPreconditionError(
-          absl::StrCat("overlay: no cut through the mesh joins boundary loop ", lonely + 1,
-                       " to the others"));
+      return absl::FailedPreconditionError(absl::StrCat(
+          "overlay: no cut through the mesh joins boundary loop ", lonely + 1, " to the others"));
     }
   }
   return paths;
@@ -804,8 +826,8 @@ absl::StatusOr<OverlayResult> OverlayOntoDomain(const std::vector<Triangle>& tri
     }
     for (int v : loops[l]) {
       if (v < 0 || v >= n) {
-        return absl::InvalidArgumentError(absl::StrCat("overlay: loop ", l + 1, " names vertex ",
-                                                       v, " of ", n));
+        return absl::InvalidArgumentError(
+            absl::StrCat("overlay: loop ", l + 1, " names vertex ", v, " of ", n));
       }
     }
   }
@@ -842,9 +864,9 @@ absl::StatusOr<OverlayResult> OverlayOntoDomain(const std::vector<Triangle>& tri
   for (int v : opened->loop) loop_points.push_back(where.at(opened->original[v]));
   absl::StatusOr<std::vector<std::array<int, 3>>> by_position = TriangulateLoop(loop_points);
   absl::StatusOr<Chords> chords =
-      by_position.ok() ? absl::StatusOr<Chords>(
-                             ChordsOf(*by_position, static_cast<int>(loop_points.size())))
-                       : absl::StatusOr<Chords>(by_position.status());
+      by_position.ok()
+          ? absl::StatusOr<Chords>(ChordsOf(*by_position, static_cast<int>(loop_points.size())))
+          : absl::StatusOr<Chords>(by_position.status());
   std::vector<Points> extended = shapes;
   for (Points& s : extended) {
     for (size_t v = n; v < opened->original.size(); ++v) s.push_back(s[opened->original[v]]);

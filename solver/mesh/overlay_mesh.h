@@ -45,8 +45,8 @@ struct OverlayResult {
 // positive area with distinct points. shapes[0] gives the Tutte weights.
 // Errors: INVALID_ARGUMENT (sizes, or a target that is not a simple positive polygon),
 // FAILED_PRECONDITION (no placement on the circle gave a valid overlay), RESOURCE_EXHAUSTED (the
-// refinement, before any merge, needs more than max_vertices vertices in all; <= 0: no bound),
-// CANCELLED.
+// result, after the merges, needs more than max_vertices vertices in all, or the refinement
+// before them 4 times as many (at most 2,000,000); <= 0: no bound), CANCELLED.
 absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& triangles,
                                                  const std::vector<Points>& shapes,
                                                  const std::vector<int>& boundary,

@@ -250,11 +250,21 @@ TEST(BuildMultimeshTest, OverlayBuildsWhatNoMeshMaps) {
 // its outline, overlays it and glues the cut back.
 TEST(BuildMultimeshTest, OverlayBuildsAroundAHole) {
   const std::vector<Drawing> drawings = {
-      Drawing{{Outline{{{9.19, 38.11}, {-14.05, 15.40}, {6.77, -12.77}}},
-               Outline{{{6.35, 19.62}, {6.41, 19.17}, {5.55, 19.20}, {5.33, 19.14}, {3.56, 17.79},
-                        {3.78, 21.23}, {4.82, 21.10}}}}},
-      Drawing{{Outline{{{20.94, 9.26}, {17.11, 15.36}, {18.39, 22.22}, {-11.34, 32.70},
-                        {-14.49, 7.26}, {-7.04, -17.03}, {10.70, -6.90}}},
+      Drawing{
+          {Outline{{{9.19, 38.11}, {-14.05, 15.40}, {6.77, -12.77}}}, Outline{{{6.35, 19.62},
+                                                                               {6.41, 19.17},
+                                                                               {5.55, 19.20},
+                                                                               {5.33, 19.14},
+                                                                               {3.56, 17.79},
+                                                                               {3.78, 21.23},
+                                                                               {4.82, 21.10}}}}},
+      Drawing{{Outline{{{20.94, 9.26},
+                        {17.11, 15.36},
+                        {18.39, 22.22},
+                        {-11.34, 32.70},
+                        {-14.49, 7.26},
+                        {-7.04, -17.03},
+                        {10.70, -6.90}}},
                Outline{{{-3.27, 7.39}, {-3.96, 9.11}, {-3.55, 10.55}, {-2.53, 10.40}}}}}};
   MultimeshOptions options;
   options.boundary_vertices = 48;

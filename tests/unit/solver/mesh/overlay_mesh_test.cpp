@@ -237,8 +237,7 @@ void ExpectValidDomainOverlay(const DomainCase& c, const OverlayResult& over, do
     EXPECT_EQ(CountInverted(over.triangles, s), 0);
   }
   for (int v = 0; v < n; ++v) EXPECT_EQ(over.shapes[0][v], c.mesh.vertices[v]);
-  EXPECT_NEAR(Area(over.triangles, over.shapes[0]), Area(c.mesh.triangles, c.mesh.vertices),
-              1e-6);
+  EXPECT_NEAR(Area(over.triangles, over.shapes[0]), Area(c.mesh.triangles, c.mesh.vertices), 1e-6);
   EXPECT_NEAR(Area(over.triangles, over.shapes[1]), target_area, 1e-6);
   Multimesh mesh;
   mesh.triangles = over.triangles;
