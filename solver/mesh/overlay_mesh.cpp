@@ -460,14 +460,15 @@ constexpr long long kMaxPreMergeVertices = 2'000'000;
 
 // The overlay proper: the disk mesh (vertices 0..m-1 in every shape, boundary loop `boundary`)
 // with the chord triangulation of the new drawing (target[k]: where loop position k lies).
-// original[v] (empty: v itself) is the input vertex disk vertex v stands for: copies made by a
-// cut are glued back to it, so the result's vertices are the n input ones, then the crossings.
+// original[v] (empty: v itself) is the vertex (< kept) disk vertex v stands for: copies made by
+// a cut are glued back to it, so the result's vertices are the kept ones, then the crossings.
+// Vertices from `fixed` on (the crossings, and vertices the caller added) may be merged away.
 absl::StatusOr<OverlayResult> OverlayDisk(const std::vector<Triangle>& triangles,
                                           const std::vector<Points>& shapes,
                                           const std::vector<int>& boundary,
                                           const Points& target_boundary,
                                           const absl::StatusOr<Chords>& chords,
-                                          const std::vector<int>& original, int n,
+                                          const std::vector<int>& original, int kept, int fixed,
                                           const CancelToken* cancel, int max_vertices) {
   if (!chords.ok()) {
     return absl::Status(chords.status().code(),
@@ -550,7 +551,6 @@ absl::StatusOr<OverlayResult> OverlayDisk(const std::vector<Triangle>& triangles
 
     OverlayResult result;
     const int total = overlay.num_vertices();
-    result.added_vertices = total - m;
     result.shapes = shapes;
     for (Points& s : result.shapes) s.resize(total);
     Points target(total);
@@ -606,29 +606,30 @@ absl::StatusOr<OverlayResult> OverlayDisk(const std::vector<Triangle>& triangles
                                     cell.vertices[(best + i + 1) % m]});
       }
     }
-    if (!original.empty()) {  // the cut's copies glued back, crossings renumbered after n
-      const auto glued = [&](int v) { return v < m ? original[v] : n + (v - m); };
+    if (!original.empty()) {  // the cut's copies glued back, crossings renumbered after them
+      const auto glued = [&](int v) { return v < m ? original[v] : kept + (v - m); };
       for (Triangle& t : result.triangles) {
         for (int& v : t) v = glued(v);
       }
       for (Points& s : result.shapes) {
-        Points kept(s.begin(), s.begin() + n);
-        kept.insert(kept.end(), s.begin() + m, s.end());
-        s = std::move(kept);
+        Points g(s.begin(), s.begin() + kept);
+        g.insert(g.end(), s.begin() + m, s.end());
+        s = std::move(g);
       }
     }
+    result.added_vertices = static_cast<int>(result.shapes[0].size()) - fixed;
     // Crossings that cut slivers off a mesh triangle (a chord passing near one of its
     // vertices) merge into a neighbour where that leaves every drawing's thinnest triangle no
     // thinner (collapse_vertices.h); the input's vertices stay.
     {
       absl::StatusOr<CollapseResult> coarse =
-          CollapseVertices(result.triangles, result.shapes, n, CollapseOptions{}, cancel);
+          CollapseVertices(result.triangles, result.shapes, fixed, CollapseOptions{}, cancel);
       if (!coarse.ok()) return coarse.status();
       result.triangles = std::move(coarse->triangles);
       result.shapes = std::move(coarse->shapes);
       result.added_vertices -= coarse->removed;
     }
-    if (max_vertices > 0 && n + result.added_vertices > max_vertices) {
+    if (max_vertices > 0 && fixed + result.added_vertices > max_vertices) {
       last = too_many();  // another placement may cut fewer pieces
       continue;
     }
@@ -670,6 +671,8 @@ absl::Status CheckShapes(const std::vector<Points>& shapes, int* n) {
   return absl::OkStatus();
 }
 
+constexpr double kCrowdedCost = 10.0;
+
 // The shortest path (lengths in `source`) from boundary vertex `from` to boundary vertex `to`
 // through interior vertices not yet used; empty if there is none.
 std::vector<int> InteriorPath(const std::vector<std::vector<int>>& adjacent,
@@ -690,7 +693,12 @@ std::vector<int> InteriorPath(const std::vector<std::vector<int>>& adjacent,
     if (v != from && loop_of[v] >= 0) continue;
     for (int w : adjacent[v]) {
       if (w != to && (loop_of[w] >= 0 || used[w])) continue;
-      const double nd = d + (source[w] - source[v]).norm();
+      // A path next to a boundary or another path would leave no interior vertex between them
+      // for later paths to pass through: such steps cost kCrowdedCost times their length.
+      bool crowded = false;
+      for (int x : adjacent[w]) crowded |= x != from && x != to && (loop_of[x] >= 0 || used[x]);
+      const double nd =
+          d + (crowded && w != to ? kCrowdedCost : 1.0) * (source[w] - source[v]).norm();
       if (nd < dist[w]) dist[w] = nd, prev[w] = v, queue.emplace(nd, w);
     }
   }
@@ -701,11 +709,69 @@ std::vector<int> InteriorPath(const std::vector<std::vector<int>>& adjacent,
   return path;
 }
 
+// Splits every interior edge of the mesh (an edge of two triangles) with at least
+// `ends_on_boundary` of its ends on the boundary at its midpoint in every shape, the new
+// vertices appended, each triangle divided accordingly (into 2, 3 or 4, all positive where it
+// was): in a thin part of a drawing, where few interior vertices separate the boundary loops,
+// the cuts then find their ways between each other.
+void SplitInteriorEdges(std::vector<Triangle>* triangles, std::vector<Points>* shapes,
+                        const std::vector<char>& on_boundary, int ends_on_boundary) {
+  std::map<std::pair<int, int>, int> uses;
+  for (const Triangle& t : *triangles) {
+    for (int k = 0; k < 3; ++k)
+      ++uses[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
+  }
+  std::map<std::pair<int, int>, int> midpoint;
+  for (const auto& [edge, count] : uses) {
+    if (count != 2 || on_boundary[edge.first] + on_boundary[edge.second] < ends_on_boundary) {
+      continue;
+    }
+    const int v = static_cast<int>((*shapes)[0].size());
+    for (Points& s : *shapes) s.push_back(0.5 * (s[edge.first] + s[edge.second]));
+    midpoint[edge] = v;
+  }
+  std::vector<Triangle> out;
+  for (const Triangle& t : *triangles) {
+    std::array<int, 3> mid;  // mid[k]: midpoint of the edge t[k] -> t[k + 1], or -1
+    int splits = 0, whole = -1;
+    for (int k = 0; k < 3; ++k) {
+      auto it = midpoint.find({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+      mid[k] = it == midpoint.end() ? -1 : it->second;
+      if (mid[k] >= 0)
+        ++splits;
+      else
+        whole = k;
+    }
+    if (splits == 0) {
+      out.push_back(t);
+    } else if (splits == 3) {
+      out.push_back({t[0], mid[0], mid[2]});
+      out.push_back({mid[0], t[1], mid[1]});
+      out.push_back({mid[2], mid[1], t[2]});
+      out.push_back({mid[0], mid[1], mid[2]});
+    } else if (splits == 1) {
+      int k = 0;
+      while (mid[k] < 0) ++k;
+      out.push_back({t[k], mid[k], t[(k + 2) % 3]});
+      out.push_back({mid[k], t[(k + 1) % 3], t[(k + 2) % 3]});
+    } else {  // edges whole + 1 and whole + 2 split: a corner at t[whole + 2], then the trapezoid
+      const int a = t[(whole + 1) % 3], b = t[(whole + 2) % 3], c = t[whole];
+      const int m1 = mid[(whole + 1) % 3], m2 = mid[(whole + 2) % 3];
+      out.push_back({m1, b, m2});
+      out.push_back({a, m1, m2});
+      out.push_back({a, m2, c});
+    }
+  }
+  *triangles = std::move(out);
+}
+
 // Paths of mesh edges that join every loop to loop 0 (a tree of cuts): each between boundary
 // vertices of two loops whose points in the new drawing are joined by an edge of the chord
 // triangulation of its loops (so the cut is a straight segment inside that drawing), shortest
 // such edges first, through interior vertices, no two paths sharing a vertex.
-constexpr int kMaxSlitTries = 256;
+constexpr int kMaxSlitTries = 2048;
+constexpr int kMaxSlitRestarts = 8;
+constexpr int kMaxSplitLevels = 2;
 
 absl::StatusOr<std::vector<std::vector<int>>> Slits(const std::vector<Triangle>& triangles,
                                                     const Points& source,
@@ -760,33 +826,45 @@ absl::StatusOr<std::vector<std::vector<int>>> Slits(const std::vector<Triangle>&
     std::sort(a.begin(), a.end());
     a.erase(std::unique(a.begin(), a.end()), a.end());
   }
-  std::vector<char> used(n, 0), joined(loops.size(), 0);
-  joined[0] = 1;
-  std::vector<std::vector<int>> paths;
-  int tries = 0;
-  while (paths.size() + 1 < loops.size()) {
-    bool found = false;
-    for (const Candidate& c : candidates) {
-      const int la = loop_of[c.a], lb = loop_of[c.b];
-      if (joined[la] == joined[lb] || used[c.a] || used[c.b]) continue;
-      if (Cancelled(cancel)) return absl::CancelledError("overlay cancelled");
-      if (++tries > kMaxSlitTries) break;
-      std::vector<int> path = InteriorPath(adjacent, loop_of, used, source, c.a, c.b);
-      if (path.empty()) continue;
-      for (int v : path) used[v] = 1;
-      joined[la] = joined[lb] = 1;
-      paths.push_back(std::move(path));
-      found = true;
-      break;
+  // Greedy, shortest first; when some loops are left that no path reaches any more (earlier
+  // paths walled them off), again with their cuts routed first.
+  std::vector<char> first(loops.size(), 0);
+  int tries = 0, lonely = 0;
+  for (int round = 0; round <= kMaxSlitRestarts; ++round) {
+    std::vector<char> used(n, 0), joined(loops.size(), 0);
+    joined[0] = 1;
+    std::vector<std::vector<int>> paths;
+    bool found = true;
+    while (found && paths.size() + 1 < loops.size()) {
+      found = false;
+      for (int pass = 0; pass < 2 && !found; ++pass) {
+        for (const Candidate& c : candidates) {
+          const int la = loop_of[c.a], lb = loop_of[c.b];
+          if (joined[la] == joined[lb] || used[c.a] || used[c.b]) continue;
+          if (pass == 0 && !first[la] && !first[lb]) continue;
+          if (Cancelled(cancel)) return absl::CancelledError("overlay cancelled");
+          if (++tries > kMaxSlitTries) break;
+          std::vector<int> path = InteriorPath(adjacent, loop_of, used, source, c.a, c.b);
+          if (path.empty()) continue;
+          for (int v : path) used[v] = 1;
+          joined[la] = joined[lb] = 1;
+          paths.push_back(std::move(path));
+          found = true;
+          break;
+        }
+      }
     }
-    if (!found) {
-      int lonely = 0;
-      while (joined[lonely]) ++lonely;
-      return absl::FailedPreconditionError(absl::StrCat(
-          "overlay: no cut through the mesh joins boundary loop ", lonely + 1, " to the others"));
+    if (found) return paths;
+    lonely = 0;
+    while (joined[lonely]) ++lonely;
+    bool again = false;
+    for (size_t l = 0; l < loops.size(); ++l) {
+      if (!joined[l] && !first[l]) first[l] = 1, again = true;
     }
+    if (!again || tries > kMaxSlitTries) break;
   }
-  return paths;
+  return absl::FailedPreconditionError(absl::StrCat(
+      "overlay: no cut through the mesh joins boundary loop ", lonely + 1, " to the others"));
 }
 
 }  // namespace
@@ -804,7 +882,7 @@ absl::StatusOr<OverlayResult> OverlayOntoPolygon(const std::vector<Triangle>& tr
   int n = 0;
   if (absl::Status s = CheckShapes(shapes, &n); !s.ok()) return s;
   return OverlayDisk(triangles, shapes, boundary, target_boundary,
-                     TriangulatePolygon(target_boundary), {}, n, cancel, max_vertices);
+                     TriangulatePolygon(target_boundary), {}, n, n, cancel, max_vertices);
 }
 
 absl::StatusOr<OverlayResult> OverlayOntoDomain(const std::vector<Triangle>& triangles,
@@ -834,14 +912,30 @@ absl::StatusOr<OverlayResult> OverlayOntoDomain(const std::vector<Triangle>& tri
   if (loops.size() == 1 && !HasRepeatedPoints(target_loops[0])) {
     return OverlayOntoPolygon(triangles, shapes, loops[0], target_loops[0], cancel, max_vertices);
   }
+  // The cuts; where they cannot pass each other, again on the mesh with the interior edges
+  // between two boundary vertices split, then also those with one end on the boundary; those
+  // vertices are new ones of the result (merged away where they may be).
+  std::vector<Triangle> mesh = triangles;
+  std::vector<Points> placed = shapes;
   std::vector<std::vector<int>> paths;
-  if (loops.size() > 1) {
+  for (int level = 0; loops.size() > 1; ++level) {
     absl::StatusOr<std::vector<std::vector<int>>> slits =
-        Slits(triangles, shapes[0], loops, target_loops, cancel);
-    if (!slits.ok()) return slits.status();
-    paths = *std::move(slits);
+        Slits(mesh, placed[0], loops, target_loops, cancel);
+    if (slits.ok()) {
+      paths = *std::move(slits);
+      break;
+    }
+    if (!absl::IsFailedPrecondition(slits.status()) || level == kMaxSplitLevels) {
+      return slits.status();
+    }
+    std::vector<char> on_boundary(placed[0].size(), 0);
+    for (const std::vector<int>& loop : loops) {
+      for (int v : loop) on_boundary[v] = 1;
+    }
+    SplitInteriorEdges(&mesh, &placed, on_boundary, kMaxSplitLevels - level);
   }
-  absl::StatusOr<Opened> opened = CutOpen(triangles, n, paths, loops[0][0]);
+  const int kept = static_cast<int>(placed[0].size());
+  absl::StatusOr<Opened> opened = CutOpen(mesh, kept, paths, loops[0][0]);
   if (!opened.ok()) return opened.status();
   // Where each vertex of the cut loop lies in the new drawing: its own point, or for a cut's
   // inner vertex, on the straight cut in the proportion of its arc length along the path.
@@ -852,7 +946,7 @@ absl::StatusOr<OverlayResult> OverlayOntoDomain(const std::vector<Triangle>& tri
   for (const std::vector<int>& path : paths) {
     std::vector<double> arc(path.size(), 0.0);
     for (size_t i = 1; i < path.size(); ++i) {
-      arc[i] = arc[i - 1] + (shapes[0][path[i]] - shapes[0][path[i - 1]]).norm();
+      arc[i] = arc[i - 1] + (placed[0][path[i]] - placed[0][path[i - 1]]).norm();
     }
     const Point a = where.at(path.front()), b = where.at(path.back());
     for (size_t i = 1; i + 1 < path.size(); ++i) {
@@ -867,12 +961,11 @@ absl::StatusOr<OverlayResult> OverlayOntoDomain(const std::vector<Triangle>& tri
       by_position.ok()
           ? absl::StatusOr<Chords>(ChordsOf(*by_position, static_cast<int>(loop_points.size())))
           : absl::StatusOr<Chords>(by_position.status());
-  std::vector<Points> extended = shapes;
-  for (Points& s : extended) {
-    for (size_t v = n; v < opened->original.size(); ++v) s.push_back(s[opened->original[v]]);
+  for (Points& s : placed) {
+    for (size_t v = kept; v < opened->original.size(); ++v) s.push_back(s[opened->original[v]]);
   }
-  return OverlayDisk(opened->triangles, extended, opened->loop, loop_points, chords,
-                     opened->original, n, cancel, max_vertices);
+  return OverlayDisk(opened->triangles, placed, opened->loop, loop_points, chords, opened->original,
+                     kept, n, cancel, max_vertices);
 }
 
 }  // namespace inbetween::solver

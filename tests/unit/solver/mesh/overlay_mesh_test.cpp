@@ -184,9 +184,10 @@ struct DomainCase {
 };
 
 DomainCase MeshDomain(const std::vector<Points>& loops, const std::vector<Points>& targets,
-                      double max_edge) {
+                      double max_edge, bool refine = true) {
   TriangulateOptions options;
   options.max_edge = max_edge;
+  options.refine = refine;
   absl::StatusOr<DomainTriangulation> mesh = CgalTriangulateDomain(loops, options);
   EXPECT_TRUE(mesh.ok()) << mesh.status();
   // Without the points the mesher put inside the holes (no triangle uses them).
@@ -286,6 +287,25 @@ TEST(OverlayMeshTest, EveryHoleIsCutOpenAndGluedBack) {
       OverlayOntoDomain(c.mesh.triangles, {c.mesh.vertices}, c.loops, c.targets);
   ASSERT_TRUE(over.ok()) << over.status();
   ExpectValidDomainOverlay(c, *over, 100 * 100 - 3 * 10 * 10);
+}
+
+// An octagonal ring meshed without interior points: no path of interior vertices joins the
+// loops, and in the new drawing the hole's points are turned half way round, so no edge of the mesh
+// joins two points that an edge of the new drawing's triangulation joins: the cut needs the
+// edges between boundary vertices split first.
+TEST(OverlayMeshTest, CutsFindTheirWayWhereNoInteriorVertexSeparatesTheLoops) {
+  const Points outer = Circle(8, 50);
+  Points hole = Circle(8, 20);
+  std::reverse(hole.begin(), hole.end());
+  Points turned(8);
+  for (int k = 0; k < 8; ++k) turned[k] = hole[(k + 4) % 8];
+  const DomainCase c = MeshDomain({outer, hole}, {outer, turned}, 0, /*refine=*/false);
+  ASSERT_EQ(c.mesh.vertices.size(), 16u);
+  absl::StatusOr<OverlayResult> over =
+      OverlayOntoDomain(c.mesh.triangles, {c.mesh.vertices}, c.loops, c.targets);
+  ASSERT_TRUE(over.ok()) << over.status();
+  EXPECT_GT(over->added_vertices, 0);
+  ExpectValidDomainOverlay(c, *over, PolygonSignedArea(outer) + PolygonSignedArea(hole));
 }
 
 // A drawing whose outline is cut shut (a slit walked both ways, its two sides on the same
