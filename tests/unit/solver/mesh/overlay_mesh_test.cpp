@@ -227,9 +227,15 @@ DomainCase MeshDomain(const std::vector<Points>& loops, const std::vector<Points
   return c;
 }
 
-// Checks an overlay of case c: valid in every drawing, the input vertices kept where they were
-// in the first, the loops on their targets, the areas the domains', one multimesh.
-void ExpectValidDomainOverlay(const DomainCase& c, const OverlayResult& over, double target_area) {
+// Overlays case c and checks the result: new vertices, valid in every drawing, the input
+// vertices kept where they were in the first, the loops on their targets, the areas the
+// domains', one multimesh.
+void ExpectValidDomainOverlay(const DomainCase& c, double target_area) {
+  absl::StatusOr<OverlayResult> overlaid =
+      OverlayOntoDomain(c.mesh.triangles, {c.mesh.vertices}, c.loops, c.targets);
+  ASSERT_TRUE(overlaid.ok()) << overlaid.status();
+  const OverlayResult& over = *overlaid;
+  EXPECT_GT(over.added_vertices, 0);
   const int n = static_cast<int>(c.mesh.vertices.size());
   ASSERT_EQ(over.shapes.size(), 2u);
   const int total = n + over.added_vertices;
@@ -266,11 +272,7 @@ TEST(OverlayMeshTest, MeshWithAHoleOntoADrawingWhoseHoleMoved) {
   const Points hole = Square({50, 50}, 20, true);
   const Points moved_hole = Square({16, 70}, 12, true);  // inside the comb's left tooth
   const DomainCase c = MeshDomain({outer, hole}, {comb, moved_hole}, 8);
-  absl::StatusOr<OverlayResult> over =
-      OverlayOntoDomain(c.mesh.triangles, {c.mesh.vertices}, c.loops, c.targets);
-  ASSERT_TRUE(over.ok()) << over.status();
-  EXPECT_GT(over->added_vertices, 0);
-  ExpectValidDomainOverlay(c, *over, PolygonSignedArea(comb) + PolygonSignedArea(moved_hole));
+  ExpectValidDomainOverlay(c, PolygonSignedArea(comb) + PolygonSignedArea(moved_hole));
 }
 
 // Three holes, each cut to the rest along its own path; the holes trade places.
@@ -283,10 +285,7 @@ TEST(OverlayMeshTest, EveryHoleIsCutOpenAndGluedBack) {
     targets.push_back(Square(at[(h + 1) % 3], 10, true));
   }
   const DomainCase c = MeshDomain(loops, targets, 10);
-  absl::StatusOr<OverlayResult> over =
-      OverlayOntoDomain(c.mesh.triangles, {c.mesh.vertices}, c.loops, c.targets);
-  ASSERT_TRUE(over.ok()) << over.status();
-  ExpectValidDomainOverlay(c, *over, 100 * 100 - 3 * 10 * 10);
+  ExpectValidDomainOverlay(c, 100 * 100 - 3 * 10 * 10);
 }
 
 // An octagonal ring meshed without interior points: no path of interior vertices joins the
@@ -301,11 +300,7 @@ TEST(OverlayMeshTest, CutsFindTheirWayWhereNoInteriorVertexSeparatesTheLoops) {
   for (int k = 0; k < 8; ++k) turned[k] = hole[(k + 4) % 8];
   const DomainCase c = MeshDomain({outer, hole}, {outer, turned}, 0, /*refine=*/false);
   ASSERT_EQ(c.mesh.vertices.size(), 16u);
-  absl::StatusOr<OverlayResult> over =
-      OverlayOntoDomain(c.mesh.triangles, {c.mesh.vertices}, c.loops, c.targets);
-  ASSERT_TRUE(over.ok()) << over.status();
-  EXPECT_GT(over->added_vertices, 0);
-  ExpectValidDomainOverlay(c, *over, PolygonSignedArea(outer) + PolygonSignedArea(hole));
+  ExpectValidDomainOverlay(c, PolygonSignedArea(outer) + PolygonSignedArea(hole));
 }
 
 // A drawing whose outline is cut shut (a slit walked both ways, its two sides on the same
