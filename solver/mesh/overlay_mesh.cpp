@@ -17,6 +17,7 @@
 #include "solver/mesh/cgal_triangulate.h"
 #include "solver/mesh/collapse_vertices.h"
 #include "solver/mesh/map_to_boundary.h"
+#include "solver/mesh/split_boundary_chords.h"
 #include "solver/mesh/validate.h"
 
 namespace inbetween::solver {
@@ -709,62 +710,6 @@ std::vector<int> InteriorPath(const std::vector<std::vector<int>>& adjacent,
   return path;
 }
 
-// Splits every interior edge of the mesh (an edge of two triangles) with at least
-// `ends_on_boundary` of its ends on the boundary at its midpoint in every shape, the new
-// vertices appended, each triangle divided accordingly (into 2, 3 or 4, all positive where it
-// was): in a thin part of a drawing, where few interior vertices separate the boundary loops,
-// the cuts then find their ways between each other.
-void SplitInteriorEdges(std::vector<Triangle>* triangles, std::vector<Points>* shapes,
-                        const std::vector<char>& on_boundary, int ends_on_boundary) {
-  std::map<std::pair<int, int>, int> uses;
-  for (const Triangle& t : *triangles) {
-    for (int k = 0; k < 3; ++k)
-      ++uses[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
-  }
-  std::map<std::pair<int, int>, int> midpoint;
-  for (const auto& [edge, count] : uses) {
-    if (count != 2 || on_boundary[edge.first] + on_boundary[edge.second] < ends_on_boundary) {
-      continue;
-    }
-    const int v = static_cast<int>((*shapes)[0].size());
-    for (Points& s : *shapes) s.push_back(0.5 * (s[edge.first] + s[edge.second]));
-    midpoint[edge] = v;
-  }
-  std::vector<Triangle> out;
-  for (const Triangle& t : *triangles) {
-    std::array<int, 3> mid;  // mid[k]: midpoint of the edge t[k] -> t[k + 1], or -1
-    int splits = 0, whole = -1;
-    for (int k = 0; k < 3; ++k) {
-      auto it = midpoint.find({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
-      mid[k] = it == midpoint.end() ? -1 : it->second;
-      if (mid[k] >= 0)
-        ++splits;
-      else
-        whole = k;
-    }
-    if (splits == 0) {
-      out.push_back(t);
-    } else if (splits == 3) {
-      out.push_back({t[0], mid[0], mid[2]});
-      out.push_back({mid[0], t[1], mid[1]});
-      out.push_back({mid[2], mid[1], t[2]});
-      out.push_back({mid[0], mid[1], mid[2]});
-    } else if (splits == 1) {
-      int k = 0;
-      while (mid[k] < 0) ++k;
-      out.push_back({t[k], mid[k], t[(k + 2) % 3]});
-      out.push_back({mid[k], t[(k + 1) % 3], t[(k + 2) % 3]});
-    } else {  // edges whole + 1 and whole + 2 split: a corner at t[whole + 2], then the trapezoid
-      const int a = t[(whole + 1) % 3], b = t[(whole + 2) % 3], c = t[whole];
-      const int m1 = mid[(whole + 1) % 3], m2 = mid[(whole + 2) % 3];
-      out.push_back({m1, b, m2});
-      out.push_back({a, m1, m2});
-      out.push_back({a, m2, c});
-    }
-  }
-  *triangles = std::move(out);
-}
-
 // Paths of mesh edges that join every loop to loop 0 (a tree of cuts): each between boundary
 // vertices of two loops whose points in the new drawing are joined by an edge of the chord
 // triangulation of its loops (so the cut is a straight segment inside that drawing), shortest
@@ -928,11 +873,13 @@ absl::StatusOr<OverlayResult> OverlayOntoDomain(const std::vector<Triangle>& tri
     if (!absl::IsFailedPrecondition(slits.status()) || level == kMaxSplitLevels) {
       return slits.status();
     }
-    std::vector<char> on_boundary(placed[0].size(), 0);
+    std::vector<bool> on_boundary(placed[0].size(), false);
     for (const std::vector<int>& loop : loops) {
-      for (int v : loop) on_boundary[v] = 1;
+      for (int v : loop) on_boundary[v] = true;
     }
-    SplitInteriorEdges(&mesh, &placed, on_boundary, kMaxSplitLevels - level);
+    std::vector<Points*> each;
+    for (Points& s : placed) each.push_back(&s);
+    SplitInteriorEdges(each, &mesh, &on_boundary, kMaxSplitLevels - level);
   }
   const int kept = static_cast<int>(placed[0].size());
   absl::StatusOr<Opened> opened = CutOpen(mesh, kept, paths, loops[0][0]);

@@ -1,5 +1,5 @@
-// Splits every interior edge joining two boundary vertices at its midpoint (1 -> 2 triangles on
-// each side), so that no triangle is spanned by boundary vertices alone.
+// Splits interior edges with boundary ends at their midpoints (1 -> 2 triangles on each side), e.g.
+// every one joining two boundary vertices, so that no triangle is spanned by them alone.
 #include "solver/mesh/split_boundary_chords.h"
 
 #include <algorithm>
@@ -8,25 +8,25 @@
 
 namespace inbetween::solver {
 
-int SplitBoundaryChords(Points* vertices, std::vector<Triangle>* triangles,
-                        std::vector<bool>* is_boundary) {
+int SplitInteriorEdges(const std::vector<Points*>& shapes, std::vector<Triangle>* triangles,
+                       std::vector<bool>* is_boundary, int min_boundary_ends) {
   using Edge = std::pair<int, int>;
   auto key = [](int a, int b) { return Edge(std::min(a, b), std::max(a, b)); };
   std::map<Edge, int> count;
   for (const Triangle& t : *triangles) {
     for (int k = 0; k < 3; ++k) ++count[key(t[k], t[(k + 1) % 3])];
   }
-  // Chords in a deterministic (sorted) order, each with its new midpoint vertex.
+  // The edges in a deterministic (sorted) order, each with its new midpoint vertex.
   std::map<Edge, int> midpoint;
   for (const auto& [edge, c] : count) {
-    if (c == 2 && (*is_boundary)[edge.first] && (*is_boundary)[edge.second]) {
-      midpoint[edge] = static_cast<int>(vertices->size());
-      vertices->push_back(0.5 * ((*vertices)[edge.first] + (*vertices)[edge.second]));
+    if (c == 2 && (*is_boundary)[edge.first] + (*is_boundary)[edge.second] >= min_boundary_ends) {
+      midpoint[edge] = static_cast<int>(is_boundary->size());
+      for (Points* x : shapes) x->push_back(0.5 * ((*x)[edge.first] + (*x)[edge.second]));
       is_boundary->push_back(false);
     }
   }
   if (midpoint.empty()) return 0;
-  // Split triangles; a triangle may hold several chords, so repeat until none is left.
+  // Split triangles; a triangle may hold several such edges, so repeat until none is left.
   std::vector<Triangle> pending = std::move(*triangles);
   triangles->clear();
   while (!pending.empty()) {
@@ -46,6 +46,11 @@ int SplitBoundaryChords(Points* vertices, std::vector<Triangle>* triangles,
     pending = std::move(next);
   }
   return static_cast<int>(midpoint.size());
+}
+
+int SplitBoundaryChords(Points* vertices, std::vector<Triangle>* triangles,
+                        std::vector<bool>* is_boundary) {
+  return SplitInteriorEdges({vertices}, triangles, is_boundary, 2);
 }
 
 }  // namespace inbetween::solver

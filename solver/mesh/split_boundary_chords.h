@@ -15,4 +15,10 @@ namespace inbetween::solver {
 int SplitBoundaryChords(Points* vertices, std::vector<Triangle>* triangles,
                         std::vector<bool>* is_boundary);
 
+// The same for edges with at least min_boundary_ends (1 or 2) ends on the boundary, the
+// midpoints added to every shape in `shapes` (same sizes as is_boundary). SplitBoundaryChords is
+// this with one shape and 2.
+int SplitInteriorEdges(const std::vector<Points*>& shapes, std::vector<Triangle>* triangles,
+                       std::vector<bool>* is_boundary, int min_boundary_ends);
+
 }  // namespace inbetween::solver
