@@ -808,8 +808,10 @@ absl::StatusOr<std::vector<std::vector<int>>> Slits(const std::vector<Triangle>&
     }
     if (!again || tries > kMaxSlitTries) break;
   }
-  return absl::FailedPreconditionError(absl::StrCat(
-      "overlay: no cut through the mesh joins boundary loop ", lonely + 1, " to the others"));
+  const Point& at = target_loops[lonely][0];
+  return absl::FailedPreconditionError(
+      absl::StrCat("overlay: no cut through the mesh joins the boundary loop through (", at.x(),
+                   ", ", at.y(), ") in the new drawing to the others"));
 }
 
 }  // namespace

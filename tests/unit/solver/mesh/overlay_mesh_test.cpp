@@ -329,6 +329,17 @@ TEST(OverlayMeshTest, BadInputsAreNamed) {
       OverlayOntoPolygon(triangles, {square}, {0, 1, 2, 3}, {{0, 0}, {0, 10}, {10, 10}, {10, 0}});
   EXPECT_EQ(clockwise.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(clockwise.status().message(), HasSubstr("overlay"));
+  // Two loops no path of the mesh joins (two separate squares): the error says where the loop
+  // left over lies.
+  Points two = square;
+  for (const Point& p : square) two.push_back(p + Point(20, 0));
+  const std::vector<Triangle> apart = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+  const Points moved = {{20, 0}, {30, 0}, {30, 10}, {20, 10}};
+  absl::StatusOr<OverlayResult> no_cut =
+      OverlayOntoDomain(apart, {two}, {{0, 1, 2, 3}, {4, 5, 6, 7}}, {square, moved});
+  EXPECT_EQ(no_cut.status().code(), absl::StatusCode::kFailedPrecondition) << no_cut.status();
+  EXPECT_THAT(no_cut.status().message(),
+              HasSubstr("no cut through the mesh joins the boundary loop through (20, 0)"));
   CancelToken cancel;
   cancel.Cancel();
   absl::StatusOr<OverlayResult> cancelled =
