@@ -103,11 +103,18 @@ using VertexHandle = Cdt::Vertex_handle;
 // seen on real icons). 1e-7 is far below any spacing a mesh within max_vertices needs and far
 // above where double constructions fail.
 constexpr double kMinRefinementSpacing = 1e-7;
+// The same bound on the input's own points (checked before the mesher runs), ten times lower:
+// a drawing may hold points closer than the refinement would construct and still mesh (the
+// icon `filetype-scss`: a boundary segment 7e-8 of the diagonal long where a straight side meets
+// a curve), while the fuzz input that broke CGAL's edge refinement had two corners 8e-11 of it
+// apart.
+constexpr double kMinInputSpacing = 1e-8;
 
 // CGAL::refine_Delaunay_mesh_2, one step at a time so that it can stop at `max_vertices` and
-// before a point closer than `min_spacing` to its neighbours.
-absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices,
-                           double min_spacing) {
+// before a point closer than kMinRefinementSpacing of the input's diagonal to its neighbours.
+absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices, double diagonal) {
+  const double min_spacing = kMinRefinementSpacing * diagonal;
+  const double min_input_spacing = kMinInputSpacing * diagonal;
   // Input points already that close (a needle folded back on itself, two boundaries nearly
   // touching) get the same answer before the mesher sees them: its edge refinement can fail an
   // internal assertion on them before the first point is inserted (mesh_fuzz finding,
@@ -116,11 +123,11 @@ absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices,
     const CgalPoint& a = e->first->vertex(Cdt::ccw(e->second))->point();
     const CgalPoint& b = e->first->vertex(Cdt::cw(e->second))->point();
     const double d = std::sqrt(CGAL::to_double(CGAL::squared_distance(a, b)));
-    if (d < min_spacing) {
+    if (d < min_input_spacing) {
       return absl::InvalidArgumentError(
           absl::StrCat("triangulate: the drawing has a cusp or boundaries that nearly touch near (",
                        a.x(), ", ", a.y(), "): two of its points are ", d, " apart (less than ",
-                       min_spacing, "); widen the cusp or separate the boundaries"));
+                       min_input_spacing, "); widen the cusp or separate the boundaries"));
     }
   }
   CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, criteria);
@@ -206,9 +213,8 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
       // The mesher's set-up marks the faces inside the polygon and inserts nothing.
       CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, Criteria(options.shape_bound, size));
       mesher.init();
-    } else if (absl::Status s =
-                   RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices,
-                                 kMinRefinementSpacing * Diagonal({boundary}));
+    } else if (absl::Status s = RefineBounded(cdt, Criteria(options.shape_bound, size),
+                                              options.max_vertices, Diagonal({boundary}));
                !s.ok()) {
       return s;
     }
@@ -311,9 +317,8 @@ absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Poin
       // The mesher's set-up marks the enclosed faces and inserts nothing.
       CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, Criteria(options.shape_bound, size));
       mesher.init();
-    } else if (absl::Status s =
-                   RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices,
-                                 kMinRefinementSpacing * Diagonal(loops));
+    } else if (absl::Status s = RefineBounded(cdt, Criteria(options.shape_bound, size),
+                                              options.max_vertices, Diagonal(loops));
                !s.ok()) {
       return s;
     }

@@ -74,6 +74,24 @@ TEST(CgalTriangulateBoundedTest, CornersNearlyTouchingAreRefusedBeforeTheMesherS
   EXPECT_EQ(p.status().code(), absl::StatusCode::kInvalidArgument) << p.status();
 }
 
+// A boundary segment shorter than the refinement's own spacing (1e-7 of the diagonal) where a
+// straight side meets a curve, as in the icon filetype-scss (its points, moved to the origin):
+// it meshes, above and below the side. The check before the mesher refused it at 1e-7 of the
+// diagonal and takes 1e-8 now (the fuzz input it is there for: 8e-11).
+TEST(CgalTriangulateBoundedTest, TinySegmentWhereASideMeetsACurveStillMeshes) {
+  const Point a(0.764, 0), b(0.764 + 5.569e-7, 1.3868e-6), c(1.4245689139, 0.5181232773);
+  for (const double side : {1.0, -1.0}) {
+    // Diagonal 17.7: the segment (1.49e-6) is 8.4e-8 of it.
+    Points p = {{-8, 0}, a, b, c, {c.x(), side * 15}, {-8, side * 15}};
+    if (side < 0) std::reverse(p.begin(), p.end());
+    TriangulateOptions t;
+    t.max_edge = 1.0;
+    absl::StatusOr<PolygonTriangulation> mesh = CgalTriangulate(p, t);
+    ASSERT_TRUE(mesh.ok()) << side << ": " << mesh.status();
+    EXPECT_GT(mesh->triangles.size(), 10u);
+  }
+}
+
 TEST(CgalTriangulateBoundedTest, OrdinaryPolygonMeshesWithinTheBound) {
   const Points square = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
   TriangulateOptions options;
