@@ -753,9 +753,6 @@ absl::StatusOr<std::vector<std::vector<int>>> Slits(const std::vector<Triangle>&
   for (const Triangle& t : cdt->triangles) {
     for (int k = 0; k < 3; ++k) {
       const int ca = t[k], cb = t[(k + 1) % 3];
-      if (ca >= static_cast<int>(vertex_of.size()) || cb >= static_cast<int>(vertex_of.size())) {
-        continue;
-      }
       const int a = vertex_of[ca], b = vertex_of[cb];
       if (a < 0 || b < 0 || loop_of[a] == loop_of[b]) continue;
       candidates.insert(

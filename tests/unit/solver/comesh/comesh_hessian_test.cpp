@@ -61,26 +61,38 @@ TEST(ComeshHessianTest, OdtMatchesDifferencedGradient) {
   }
 }
 
+// A random pair of triangles and the MIPS Hessian blocks of the map between them.
+struct MipsPair {
+  Corners xi, xj;
+  Matrix4 hp, hq;
+};
+
+MipsPair RandomMipsPair(std::mt19937& rng) {
+  MipsPair m;
+  m.xi = RandomTriangle(rng);
+  m.xj = RandomTriangle(rng);
+  MipsEdgeHessians(EdgeMatrix(m.xi), EdgeMatrix(m.xj), &m.hp, &m.hq);
+  return m;
+}
+
 TEST(ComeshHessianTest, MipsBlocksMatchDifferencedGradients) {
   std::mt19937 rng(12);
   for (int i = 0; i < 50; ++i) {
-    const Corners xi = RandomTriangle(rng), xj = RandomTriangle(rng);
-    Matrix4 hp, hq;
-    MipsEdgeHessians(EdgeMatrix(xi), EdgeMatrix(xj), &hp, &hq);
+    const MipsPair m = RandomMipsPair(rng);
     const GradientFn in_p = [&](const Corners& c) {
       Corners g;
-      MipsTriangleEnergy(c, xj, &g, nullptr);
+      MipsTriangleEnergy(c, m.xj, &g, nullptr);
       return g;
     };
     const GradientFn in_q = [&](const Corners& c) {
       Corners g;
-      MipsTriangleEnergy(xi, c, nullptr, &g);
+      MipsTriangleEnergy(m.xi, c, nullptr, &g);
       return g;
     };
-    ExpectNear(CornerHessian(hp), DifferenceHessian(xi, in_p));
-    ExpectNear(CornerHessian(hq), DifferenceHessian(xj, in_q));
+    ExpectNear(CornerHessian(m.hp), DifferenceHessian(m.xi, in_p));
+    ExpectNear(CornerHessian(m.hq), DifferenceHessian(m.xj, in_q));
     // H_P is positive semidefinite by construction (a quadratic form over det Q > 0).
-    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Matrix4>(hp).eigenvalues().minCoeff(), -1e-12);
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Matrix4>(m.hp).eigenvalues().minCoeff(), -1e-12);
   }
 }
 
@@ -91,20 +103,18 @@ TEST(ComeshHessianTest, MipsBlocksMatchDifferencedGradients) {
 TEST(ComeshHessianTest, MipsTargetBlockHasNoCurvatureAlongTheTrianglesScaling) {
   std::mt19937 rng(14);
   for (int i = 0; i < 50; ++i) {
-    const Corners xi = RandomTriangle(rng), xj = RandomTriangle(rng);
-    Matrix4 hp, hq;
-    MipsEdgeHessians(EdgeMatrix(xi), EdgeMatrix(xj), &hp, &hq);
+    const MipsPair m = RandomMipsPair(rng);
     Corners gi, gj;
-    const double c = MipsTriangleEnergy(xi, xj, &gi, &gj);
-    const Eigen::Matrix2d p = EdgeMatrix(xi), q = EdgeMatrix(xj);
+    const double c = MipsTriangleEnergy(m.xi, m.xj, &gi, &gj);
+    const Eigen::Matrix2d p = EdgeMatrix(m.xi), q = EdgeMatrix(m.xj);
     const Eigen::Vector4d up(p(0, 0), p(1, 0), p(0, 1), p(1, 1));
     const Eigen::Vector4d uq(q(0, 0), q(1, 0), q(0, 1), q(1, 1));
     // Edge-space gradient: the corner gradients of corners 1 and 2 (corner 0 = minus their sum).
     const Eigen::Vector4d grad_q(gj[1].x(), gj[1].y(), gj[2].x(), gj[2].y());
-    const double scale = hq.cwiseAbs().maxCoeff() * uq.squaredNorm();
-    EXPECT_LE((hq * uq + grad_q).norm(), 1e-9 * (1.0 + scale));
-    EXPECT_LE(std::abs(uq.dot(hq * uq)), 1e-9 * (1.0 + scale));
-    EXPECT_NEAR(up.dot(hp * up), 2.0 * c, 1e-9 * (1.0 + c));
+    const double scale = m.hq.cwiseAbs().maxCoeff() * uq.squaredNorm();
+    EXPECT_LE((m.hq * uq + grad_q).norm(), 1e-9 * (1.0 + scale));
+    EXPECT_LE(std::abs(uq.dot(m.hq * uq)), 1e-9 * (1.0 + scale));
+    EXPECT_NEAR(up.dot(m.hp * up), 2.0 * c, 1e-9 * (1.0 + c));
   }
 }
 
