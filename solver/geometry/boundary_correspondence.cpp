@@ -10,6 +10,8 @@
 #include <numeric>
 #include <string>
 
+#include <Eigen/Dense>
+
 #include "absl/strings/str_cat.h"
 #include "solver/geometry/polygon.h"
 #include "solver/geometry/resample_outline.h"
@@ -180,8 +182,9 @@ Point Centroid(const Points& p) {
   return total > 0 ? Point(c / total) : p[0];
 }
 
-// Assignment of `a` items to `b` items (same count) minimising total cost; brute force up to 8,
-// greedy beyond.
+// Assignment of `a` items to `b` items (same count) minimising total cost: brute force up to 8
+// (ties go to the first permutation in lexicographic order), beyond that the Hungarian method
+// (shortest augmenting paths with row and column potentials, O(k^3)), also exact.
 std::vector<int> Assign(const std::vector<std::vector<double>>& cost) {
   const int k = static_cast<int>(cost.size());
   std::vector<int> perm(k), best;
@@ -195,15 +198,44 @@ std::vector<int> Assign(const std::vector<std::vector<double>>& cost) {
     } while (std::next_permutation(perm.begin(), perm.end()));
     return best;
   }
-  best.assign(k, -1);
-  std::vector<bool> taken(k, false);
-  for (int i = 0; i < k; ++i) {
-    int pick = -1;
-    for (int j = 0; j < k; ++j) {
-      if (!taken[j] && (pick < 0 || cost[i][j] < cost[i][pick])) pick = j;
-    }
-    best[i] = pick, taken[pick] = true;
+  // Rows 1..k and columns 1..k; column 0 is the virtual start of each augmenting path.
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<double> u(k + 1, 0.0), v(k + 1, 0.0);
+  std::vector<int> row_of(k + 1, 0), way(k + 1, 0);  // row_of[j]: the row assigned column j
+  for (int i = 1; i <= k; ++i) {
+    row_of[0] = i;
+    int j0 = 0;
+    std::vector<double> slack(k + 1, kInf);
+    std::vector<bool> used(k + 1, false);
+    do {
+      used[j0] = true;
+      const int i0 = row_of[j0];
+      double delta = kInf;
+      int j1 = 0;
+      for (int j = 1; j <= k; ++j) {
+        if (used[j]) continue;
+        const double reduced = cost[i0 - 1][j - 1] - u[i0] - v[j];
+        if (reduced < slack[j]) slack[j] = reduced, way[j] = j0;
+        if (slack[j] < delta) delta = slack[j], j1 = j;
+      }
+      for (int j = 0; j <= k; ++j) {
+        if (used[j]) {
+          u[row_of[j]] += delta;
+          v[j] -= delta;
+        } else {
+          slack[j] -= delta;
+        }
+      }
+      j0 = j1;
+    } while (row_of[j0] != 0);
+    do {  // flip the path's assignments back to its start
+      const int j1 = way[j0];
+      row_of[j0] = row_of[j1];
+      j0 = j1;
+    } while (j0 != 0);
   }
+  best.assign(k, -1);
+  for (int j = 1; j <= k; ++j) best[row_of[j] - 1] = j - 1;
   return best;
 }
 
@@ -243,6 +275,31 @@ double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, co
     if (cost < best_cost) best_cost = cost, best = s;
   }
   return b.length() * best / m;
+}
+
+// The least-squares affine map p -> m p + t taking outline `a` (drawing 1) onto outline `b`
+// (another drawing), the two sampled at kAlignSamples equal arc-length steps from their aligned
+// starts (b_start on b): where the component's outline carries its holes. False when the fit is
+// singular or reverses orientation.
+bool OutlineAffine(const Curve& a, const Curve& b, double b_start, Eigen::Matrix2d* m, Point* t) {
+  const int n = kAlignSamples;
+  Points pa(n), pb(n);
+  Point ca = Point::Zero(), cb = Point::Zero();
+  for (int k = 0; k < n; ++k) {
+    pa[k] = a.At(a.length() * k / n);
+    pb[k] = b.At(b_start + b.length() * k / n);
+    ca += pa[k] / n;
+    cb += pb[k] / n;
+  }
+  Eigen::Matrix2d aa = Eigen::Matrix2d::Zero(), ba = Eigen::Matrix2d::Zero();
+  for (int k = 0; k < n; ++k) {
+    aa += (pa[k] - ca) * (pa[k] - ca).transpose();
+    ba += (pb[k] - cb) * (pa[k] - ca).transpose();
+  }
+  if (!(std::abs(aa.determinant()) > 1e-12 * aa.squaredNorm())) return false;
+  *m = ba * aa.inverse();
+  *t = cb - *m * ca;
+  return m->allFinite() && t->allFinite() && m->determinant() > 0.0;
 }
 
 // A corner of a loop: its arc length, the sign of its turn (+1 convex, -1 reflex, for a loop
@@ -449,12 +506,27 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
                          i + 1, " has ", holes[d].size(), " holes instead of ", holes[0].size()));
       }
     }
+    // Holes: drawing 1's hole centroids carried by the least-squares affine map of the
+    // component's outline onto its match (so a sheared, rotated copy matches hole to hole), else
+    // (a degenerate fit) compared in the bounding-box normalisation.
     std::vector<std::vector<int>> hole_match(num_shapes);
+    const Curve& outline0 = curves[0][g[0]];
     for (int d = 0; d < num_shapes; ++d) {
+      Eigen::Matrix2d m = Eigen::Matrix2d::Identity();
+      Point t = Point::Zero();
+      const Curve& outline = curves[d][g[d]];
+      const bool carried =
+          holes[0].size() > 1 &&
+          OutlineAffine(outline0, outline,
+                        AlignStart(outline0, outline, centre[0], scale[0], centre[d], scale[d]),
+                        &m, &t);
       std::vector<std::vector<double>> cost(holes[0].size(), std::vector<double>(holes[d].size()));
       for (size_t a = 0; a < holes[0].size(); ++a) {
+        const Point from = centre[0] + scale[0] * centroid[0][holes[0][a]];
         for (size_t b = 0; b < holes[d].size(); ++b) {
-          cost[a][b] = (centroid[0][holes[0][a]] - centroid[d][holes[d][b]]).squaredNorm();
+          const Point to = centre[d] + scale[d] * centroid[d][holes[d][b]];
+          cost[a][b] = carried ? (m * from + t - to).squaredNorm()
+                               : (centroid[0][holes[0][a]] - centroid[d][holes[d][b]]).squaredNorm();
         }
       }
       const std::vector<int> assignment = Assign(cost);
