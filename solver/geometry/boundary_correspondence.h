@@ -38,7 +38,11 @@ struct BoundaryCorrespondenceOptions {
 // Loops are matched as follows (documented default): each drawing is normalised by its
 // bounding box (centre, diagonal); components are matched to drawing 1's by the assignment of
 // least total squared distance between normalised area centroids (components with a different
-// hole count never match); holes within matched components likewise. Without marks, each loop
+// hole count never match; exact: brute force up to 8, the Hungarian method beyond). Holes within
+// matched components likewise, but drawing 1's hole centroids are first carried by the
+// least-squares affine map of the component's outline onto its match (sampled by arc length from
+// the aligned starts), so that a sheared, rotated copy matches hole to hole where the bounding
+// boxes would pair neighbours (bootstrap-icons' flower1, 13 holes). Without marks, each loop
 // gets the cyclic shift that best matches drawing 1's loop in normalised turning angle and
 // position over arc length (orientation is fixed: the drawing is on the left of every loop).
 struct BoundaryCorrespondence {
