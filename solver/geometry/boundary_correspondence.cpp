@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <string>
 
 #include <Eigen/Dense>
@@ -21,6 +22,10 @@ namespace {
 
 constexpr int kDefaultVertices = 64;
 constexpr int kAlignSamples = 128;
+// Rounds of matching holes again by the affine fit of the matched holes' centroids.
+constexpr int kMaxHoleRematches = 4;
+// Turns of the outline's affine map tried as starts of the hole matching (three holes or more).
+constexpr int kRotationHypotheses = 24;
 constexpr double kSameT = 1e-9;
 
 double Wrap01(double t) {
@@ -239,18 +244,27 @@ std::vector<int> Assign(const std::vector<std::vector<double>>& cost) {
   return best;
 }
 
-// Best start (arc length) of `b` against `a` (both normalised): turning angle + position.
+// An affine map p -> m p + t of drawing 1 into another drawing.
+struct Affine {
+  Eigen::Matrix2d m = Eigen::Matrix2d::Identity();
+  Point t = Point::Zero();
+};
+
+// Best start (arc length) of `b` against `a` (both normalised): turning angle + position. With
+// `carry`, `a` is first carried into b's drawing by that map (and normalised as b).
 double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, const Point& cb,
-                  double sb) {
+                  double sb, const Affine* carry = nullptr) {
   const int m = kAlignSamples;
   Points pa(m), pb(m);
   std::vector<double> ta(m), tb(m);
   for (int k = 0; k < m; ++k) {
-    pa[k] = (a.At(a.length() * k / m) - ca) / sa;
+    pa[k] = carry == nullptr ? Point((a.At(a.length() * k / m) - ca) / sa)
+                             : Point((carry->m * a.At(a.length() * k / m) + carry->t - cb) / sb);
     pb[k] = (b.At(b.length() * k / m) - cb) / sb;
   }
   for (int k = 0; k < m; ++k) {
-    const Point da = a.At(a.length() * (k + 0.5) / m) - a.At(a.length() * (k - 0.5) / m);
+    Point da = a.At(a.length() * (k + 0.5) / m) - a.At(a.length() * (k - 0.5) / m);
+    if (carry != nullptr) da = carry->m * da;
     const Point db = b.At(b.length() * (k + 0.5) / m) - b.At(b.length() * (k - 0.5) / m);
     ta[k] = std::atan2(da.y(), da.x());
     tb[k] = std::atan2(db.y(), db.x());
@@ -277,29 +291,139 @@ double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, co
   return b.length() * best / m;
 }
 
-// The least-squares affine map p -> m p + t taking outline `a` (drawing 1) onto outline `b`
-// (another drawing), the two sampled at kAlignSamples equal arc-length steps from their aligned
-// starts (b_start on b): where the component's outline carries its holes. False when the fit is
-// singular or reverses orientation.
-bool OutlineAffine(const Curve& a, const Curve& b, double b_start, Eigen::Matrix2d* m, Point* t) {
-  const int n = kAlignSamples;
-  Points pa(n), pb(n);
+// The least-squares affine map p -> m p + t taking each pair's first point to its second.
+// False when it is singular or reverses orientation.
+bool FitAffine(const std::vector<std::pair<Point, Point>>& pairs, Affine* fit) {
+  if (pairs.empty()) return false;
   Point ca = Point::Zero(), cb = Point::Zero();
-  for (int k = 0; k < n; ++k) {
-    pa[k] = a.At(a.length() * k / n);
-    pb[k] = b.At(b_start + b.length() * k / n);
-    ca += pa[k] / n;
-    cb += pb[k] / n;
-  }
+  for (const auto& [a, b] : pairs) ca += a, cb += b;
+  ca /= static_cast<double>(pairs.size());
+  cb /= static_cast<double>(pairs.size());
   Eigen::Matrix2d aa = Eigen::Matrix2d::Zero(), ba = Eigen::Matrix2d::Zero();
-  for (int k = 0; k < n; ++k) {
-    aa += (pa[k] - ca) * (pa[k] - ca).transpose();
-    ba += (pb[k] - cb) * (pa[k] - ca).transpose();
+  for (const auto& [a, b] : pairs) {
+    aa += (a - ca) * (a - ca).transpose();
+    ba += (b - cb) * (a - ca).transpose();
   }
   if (!(std::abs(aa.determinant()) > 1e-12 * aa.squaredNorm())) return false;
-  *m = ba * aa.inverse();
-  *t = cb - *m * ca;
-  return m->allFinite() && t->allFinite() && m->determinant() > 0.0;
+  fit->m = ba * aa.inverse();
+  fit->t = cb - fit->m * ca;
+  return fit->m.allFinite() && fit->t.allFinite() && fit->m.determinant() > 0.0;
+}
+
+// The affine fit of outline `a` (drawing 1) onto outline `b` (another drawing), the two sampled
+// at kAlignSamples equal arc-length steps from their aligned starts (b_start on b).
+bool OutlineAffine(const Curve& a, const Curve& b, double b_start, Affine* fit) {
+  const int n = kAlignSamples;
+  std::vector<std::pair<Point, Point>> pairs;
+  for (int k = 0; k < n; ++k) {
+    pairs.emplace_back(a.At(a.length() * k / n), b.At(b_start + b.length() * k / n));
+  }
+  return FitAffine(pairs, fit);
+}
+
+// One drawing's loops as the loop matching sees them: curves, area centroids in the drawing's
+// bounding-box normalisation (centre, scale).
+struct LoopSet {
+  const std::vector<Curve>* curves;
+  const std::vector<Point>* centroid;  // normalised
+  Point centre;
+  double scale;
+  Point Raw(int loop) const { return centre + scale * (*centroid)[loop]; }
+};
+
+struct HoleMatch {
+  std::vector<int> assignment;  // per hole of drawing 1, its match's index in the other's holes
+  std::optional<Affine> carry;  // the map that matched them, if any
+  double score = std::numeric_limits<double>::infinity();
+};
+
+// How far drawing 1's loop `a`, carried, lies from loop `b` of another drawing: the mean squared
+// distance over arc-length samples from the aligned starts.
+double CarriedDistance(const LoopSet& from, const LoopSet& to, int a, int b, const Affine& carry) {
+  const Curve& ca = (*from.curves)[a];
+  const Curve& cb = (*to.curves)[b];
+  const double b0 = AlignStart(ca, cb, from.centre, from.scale, to.centre, to.scale, &carry);
+  const int n = kAlignSamples;
+  double sum = 0.0;
+  for (int k = 0; k < n; ++k) {
+    sum += (carry.m * ca.At(ca.length() * k / n) + carry.t - cb.At(b0 + cb.length() * k / n))
+               .squaredNorm();
+  }
+  return sum / n;
+}
+
+// Holes matched from the map `carry`: by the carried area centroids, then (three holes or more)
+// the map fitted to the matched centroids (affine images of each other in a copy) and the holes
+// matched again, until the match settles. Scored by how far the carried outline and holes lie
+// from their matches (CarriedDistance, summed).
+HoleMatch MatchHolesFrom(const LoopSet& from, const LoopSet& to, int outline0, int outline,
+                         const std::vector<int>& holes0, const std::vector<int>& holes,
+                         Affine carry) {
+  HoleMatch out;
+  for (int round = 0; round <= kMaxHoleRematches; ++round) {
+    std::vector<std::vector<double>> cost(holes0.size(), std::vector<double>(holes.size()));
+    for (size_t a = 0; a < holes0.size(); ++a) {
+      for (size_t b = 0; b < holes.size(); ++b) {
+        cost[a][b] = (carry.m * from.Raw(holes0[a]) + carry.t - to.Raw(holes[b])).squaredNorm();
+      }
+    }
+    std::vector<int> again = Assign(cost);
+    if (again == out.assignment) break;
+    out.assignment = std::move(again);
+    std::vector<std::pair<Point, Point>> matched;
+    for (size_t a = 0; a < holes0.size(); ++a) {
+      matched.emplace_back(from.Raw(holes0[a]), to.Raw(holes[out.assignment[a]]));
+    }
+    Affine fit;
+    if (holes0.size() < 3 || !FitAffine(matched, &fit)) break;
+    carry = fit;
+  }
+  out.carry = carry;
+  out.score = CarriedDistance(from, to, outline0, outline, carry);
+  for (size_t a = 0; a < holes0.size(); ++a) {
+    out.score += CarriedDistance(from, to, holes0[a], holes[out.assignment[a]], carry);
+  }
+  return out;
+}
+
+// The holes of drawing 1's component (outline0, holes0) matched to those of its match in another
+// drawing (outline, holes). Drawing 1's holes are carried by the least-squares affine map of the
+// outline onto its match (so a sheared, rotated copy matches hole to hole where the bounding
+// boxes pair neighbours) and refined by MatchHolesFrom. An outline alone may not fix the map (a
+// round one: any rotation fits it), so with three holes or more the map is also tried turned
+// about the outline's centroid by kRotationHypotheses steps of the full turn, and the best score
+// wins (the first on ties). Without a map (drawing 1 itself, or a degenerate fit), the centroids
+// are compared in the bounding-box normalisation.
+HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int outline,
+                     const std::vector<int>& holes0, const std::vector<int>& holes, bool fit) {
+  const Curve& a = (*from.curves)[outline0];
+  const Curve& b = (*to.curves)[outline];
+  Affine carry;
+  if (fit && !holes0.empty() &&
+      OutlineAffine(a, b, AlignStart(a, b, from.centre, from.scale, to.centre, to.scale),
+                    &carry)) {
+    HoleMatch best = MatchHolesFrom(from, to, outline0, outline, holes0, holes, carry);
+    const Point c0 = from.Raw(outline0);
+    for (int j = 1; holes0.size() >= 3 && j < kRotationHypotheses; ++j) {
+      const double angle = 2.0 * std::numbers::pi * j / kRotationHypotheses;
+      const Eigen::Matrix2d r{{std::cos(angle), -std::sin(angle)},
+                              {std::sin(angle), std::cos(angle)}};
+      // p -> carry(c0 + r (p - c0))
+      const Affine turned{carry.m * r, carry.m * (c0 - r * c0) + carry.t};
+      HoleMatch match = MatchHolesFrom(from, to, outline0, outline, holes0, holes, turned);
+      if (match.score < best.score) best = std::move(match);
+    }
+    return best;
+  }
+  std::vector<std::vector<double>> cost(holes0.size(), std::vector<double>(holes.size()));
+  for (size_t i = 0; i < holes0.size(); ++i) {
+    for (size_t j = 0; j < holes.size(); ++j) {
+      cost[i][j] = ((*from.centroid)[holes0[i]] - (*to.centroid)[holes[j]]).squaredNorm();
+    }
+  }
+  HoleMatch out;
+  out.assignment = Assign(cost);
+  return out;
 }
 
 // A corner of a loop: its arc length, the sign of its turn (+1 convex, -1 reflex, for a loop
@@ -491,12 +615,17 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     for (size_t i = 0; i < outer0.size(); ++i) component_match[d].push_back(outer[assignment[i]]);
   }
   BoundaryCorrespondence out;
+  // Per loop group and drawing: the affine map of the component that carried its holes (none
+  // without holes, for drawing 1, or a degenerate fit), which aligns the loops' starts.
+  std::vector<std::vector<std::optional<Affine>>> hole_carry;
   for (size_t i = 0; i < outer0.size(); ++i) {
     std::vector<int> g(num_shapes);
     for (int d = 0; d < num_shapes; ++d) g[d] = component_match[d][i];
     group_loops.push_back(g);
     out.loop_outer.push_back(true);
     out.loop_component.push_back(static_cast<int>(i));
+    const size_t outer_group = hole_carry.size();
+    hole_carry.emplace_back(num_shapes);
     std::vector<std::vector<int>> holes(num_shapes);
     for (int d = 0; d < num_shapes; ++d) {
       holes[d] = loops_of(d, graphs[d].loops[g[d]].component, false);
@@ -506,38 +635,28 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
                          i + 1, " has ", holes[d].size(), " holes instead of ", holes[0].size()));
       }
     }
-    // Holes: drawing 1's hole centroids carried by the least-squares affine map of the
-    // component's outline onto its match (so a sheared, rotated copy matches hole to hole), else
-    // (a degenerate fit) compared in the bounding-box normalisation.
+    // Holes: drawing 1's holes carried by an affine map of the component (MatchHoles), else (a
+    // degenerate fit) compared in the bounding-box normalisation. The map aligns each hole's
+    // start below.
     std::vector<std::vector<int>> hole_match(num_shapes);
-    const Curve& outline0 = curves[0][g[0]];
+    std::vector<std::optional<Affine>> carry(num_shapes);
     for (int d = 0; d < num_shapes; ++d) {
-      Eigen::Matrix2d m = Eigen::Matrix2d::Identity();
-      Point t = Point::Zero();
-      const Curve& outline = curves[d][g[d]];
-      const bool carried =
-          holes[0].size() > 1 &&
-          OutlineAffine(outline0, outline,
-                        AlignStart(outline0, outline, centre[0], scale[0], centre[d], scale[d]),
-                        &m, &t);
-      std::vector<std::vector<double>> cost(holes[0].size(), std::vector<double>(holes[d].size()));
+      const LoopSet from{&curves[0], &centroid[0], centre[0], scale[0]};
+      const LoopSet to{&curves[d], &centroid[d], centre[d], scale[d]};
+      HoleMatch match = MatchHoles(from, to, g[0], g[d], holes[0], holes[d], d > 0);
+      carry[d] = match.carry;
       for (size_t a = 0; a < holes[0].size(); ++a) {
-        const Point from = centre[0] + scale[0] * centroid[0][holes[0][a]];
-        for (size_t b = 0; b < holes[d].size(); ++b) {
-          const Point to = centre[d] + scale[d] * centroid[d][holes[d][b]];
-          cost[a][b] = carried ? (m * from + t - to).squaredNorm()
-                               : (centroid[0][holes[0][a]] - centroid[d][holes[d][b]]).squaredNorm();
-        }
+        hole_match[d].push_back(holes[d][match.assignment[a]]);
       }
-      const std::vector<int> assignment = Assign(cost);
-      for (size_t a = 0; a < holes[0].size(); ++a) hole_match[d].push_back(holes[d][assignment[a]]);
     }
+    hole_carry[outer_group] = carry;  // the outline's start too: a round one has no other
     for (size_t a = 0; a < holes[0].size(); ++a) {
       std::vector<int> hg(num_shapes);
       for (int d = 0; d < num_shapes; ++d) hg[d] = hole_match[d][a];
       group_loops.push_back(hg);
       out.loop_outer.push_back(false);
       out.loop_component.push_back(static_cast<int>(i));
+      hole_carry.push_back(carry);
     }
   }
   const int num_groups = static_cast<int>(group_loops.size());
@@ -591,7 +710,9 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
       for (int d = 0; d < num_shapes; ++d) {
         loop_curves.push_back(&curve(d, g));
         if (d > 0) {
-          start[d] = AlignStart(curve(0, g), curve(d, g), centre[0], scale[0], centre[d], scale[d]);
+          const std::optional<Affine>& carry = hole_carry[g][d];
+          start[d] = AlignStart(curve(0, g), curve(d, g), centre[0], scale[0], centre[d], scale[d],
+                                carry.has_value() ? &*carry : nullptr);
         }
       }
       if (options.match_corners) {
