@@ -26,6 +26,8 @@ constexpr int kAlignSamples = 128;
 constexpr int kMaxHoleRematches = 4;
 // Turns of the outline's affine map tried as starts of the hole matching (three holes or more).
 constexpr int kRotationHypotheses = 24;
+// Holes' centroids spread less than this across their main direction do not fix an affine map.
+constexpr double kMinHoleSpread = 0.1;
 constexpr double kSameT = 1e-9;
 
 double Wrap01(double t) {
@@ -352,13 +354,13 @@ double CarriedDistance(const LoopSet& from, const LoopSet& to, int a, int b, con
   return sum / n;
 }
 
-// Holes matched from the map `carry`: by the carried area centroids, then (three holes or more)
-// the map fitted to the matched centroids (affine images of each other in a copy) and the holes
-// matched again, until the match settles. Scored by how far the carried outline and holes lie
-// from their matches (CarriedDistance, summed).
+// Holes matched from the map `carry`: by the carried area centroids, then (with `refit`) the map
+// fitted to the matched centroids (affine images of each other in a copy) and the holes matched
+// again, until the match settles. Scored by how far the carried outline and holes lie from their
+// matches (CarriedDistance, summed).
 HoleMatch MatchHolesFrom(const LoopSet& from, const LoopSet& to, int outline0, int outline,
                          const std::vector<int>& holes0, const std::vector<int>& holes,
-                         Affine carry) {
+                         Affine carry, bool refit) {
   HoleMatch out;
   for (int round = 0; round <= kMaxHoleRematches; ++round) {
     std::vector<std::vector<double>> cost(holes0.size(), std::vector<double>(holes.size()));
@@ -375,7 +377,7 @@ HoleMatch MatchHolesFrom(const LoopSet& from, const LoopSet& to, int outline0, i
       matched.emplace_back(from.Raw(holes0[a]), to.Raw(holes[out.assignment[a]]));
     }
     Affine fit;
-    if (holes0.size() < 3 || !FitAffine(matched, &fit)) break;
+    if (!refit || !FitAffine(matched, &fit)) break;
     carry = fit;
   }
   out.carry = carry;
@@ -386,13 +388,27 @@ HoleMatch MatchHolesFrom(const LoopSet& from, const LoopSet& to, int outline0, i
   return out;
 }
 
+// Whether points spread in both directions enough for an affine map to be fitted to them: three
+// or more, the smaller principal spread at least kMinHoleSpread of the larger (holes in a row
+// leave the map across the row to chance).
+bool SpreadInTheFlat(const std::vector<Point>& points) {
+  if (points.size() < 3) return false;
+  Point mean = Point::Zero();
+  for (const Point& p : points) mean += p / static_cast<double>(points.size());
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const Point& p : points) cov += (p - mean) * (p - mean).transpose();
+  const Eigen::Vector2d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues();
+  return eig(1) > 0.0 && eig(0) >= kMinHoleSpread * kMinHoleSpread * eig(1);
+}
+
 // The holes of drawing 1's component (outline0, holes0) matched to those of its match in another
 // drawing (outline, holes). Drawing 1's holes are carried by the least-squares affine map of the
 // outline onto its match (so a sheared, rotated copy matches hole to hole where the bounding
-// boxes pair neighbours) and refined by MatchHolesFrom. An outline alone may not fix the map (a
-// round one: any rotation fits it), so with three holes or more the map is also tried turned
-// about the outline's centroid by kRotationHypotheses steps of the full turn, and the best score
-// wins (the first on ties). Without a map (drawing 1 itself, or a degenerate fit), the centroids
+// boxes pair neighbours; MatchHolesFrom). An outline alone may not fix the map (a round one: any
+// rotation fits it), so when the holes' centroids spread in both directions (SpreadInTheFlat)
+// the map is also refitted to them, starting from the outline's map turned about the outline's
+// centroid by each of kRotationHypotheses steps of the full turn, and the best score wins (the
+// outline's own map on ties). Without a map (drawing 1 itself, or a degenerate fit), the centroids
 // are compared in the bounding-box normalisation.
 HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int outline,
                      const std::vector<int>& holes0, const std::vector<int>& holes, bool fit) {
@@ -402,15 +418,18 @@ HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int o
   if (fit && !holes0.empty() &&
       OutlineAffine(a, b, AlignStart(a, b, from.centre, from.scale, to.centre, to.scale),
                     &carry)) {
-    HoleMatch best = MatchHolesFrom(from, to, outline0, outline, holes0, holes, carry);
+    HoleMatch best = MatchHolesFrom(from, to, outline0, outline, holes0, holes, carry, false);
+    std::vector<Point> centroids0;
+    for (const int h : holes0) centroids0.push_back(from.Raw(h));
+    if (!SpreadInTheFlat(centroids0)) return best;
     const Point c0 = from.Raw(outline0);
-    for (int j = 1; holes0.size() >= 3 && j < kRotationHypotheses; ++j) {
+    for (int j = 0; j < kRotationHypotheses; ++j) {
       const double angle = 2.0 * std::numbers::pi * j / kRotationHypotheses;
       const Eigen::Matrix2d r{{std::cos(angle), -std::sin(angle)},
                               {std::sin(angle), std::cos(angle)}};
       // p -> carry(c0 + r (p - c0))
       const Affine turned{carry.m * r, carry.m * (c0 - r * c0) + carry.t};
-      HoleMatch match = MatchHolesFrom(from, to, outline0, outline, holes0, holes, turned);
+      HoleMatch match = MatchHolesFrom(from, to, outline0, outline, holes0, holes, turned, true);
       if (match.score < best.score) best = std::move(match);
     }
     return best;
