@@ -24,7 +24,7 @@ constexpr int kDefaultVertices = 64;
 constexpr int kAlignSamples = 128;
 // Rounds of matching holes again by the affine fit of the matched holes' centroids.
 constexpr int kMaxHoleRematches = 4;
-// Turns of the outline's affine map tried as starts of the hole matching (three holes or more).
+// Turns of the outline's affine map tried as starts of the hole matching (MatchHoles).
 constexpr int kRotationHypotheses = 24;
 // Holes' centroids spread less than this across their main direction do not fix an affine map.
 constexpr double kMinHoleSpread = 0.1;
@@ -191,11 +191,29 @@ Point Centroid(const Points& p) {
 
 // Assignment of `a` items to `b` items (same count) minimising total cost: brute force up to 8
 // (ties go to the first permutation in lexicographic order), beyond that the Hungarian method
-// (shortest augmenting paths with row and column potentials, O(k^3)), also exact.
+// (shortest augmenting paths with row and column potentials, O(k^3)), also exact; greedy, row by
+// row, if a cost is not finite (coordinates near the double range), where the potentials would
+// not be.
 std::vector<int> Assign(const std::vector<std::vector<double>>& cost) {
   const int k = static_cast<int>(cost.size());
   std::vector<int> perm(k), best;
   std::iota(perm.begin(), perm.end(), 0);
+  bool finite = true;
+  for (const std::vector<double>& row : cost) {
+    for (const double c : row) finite = finite && std::isfinite(c);
+  }
+  if (!finite) {
+    best.assign(k, -1);
+    std::vector<bool> taken(k, false);
+    for (int i = 0; i < k; ++i) {
+      int pick = -1;
+      for (int j = 0; j < k; ++j) {
+        if (!taken[j] && (pick < 0 || cost[i][j] < cost[i][pick])) pick = j;
+      }
+      best[i] = pick, taken[pick] = true;
+    }
+    return best;
+  }
   if (k <= 8) {
     double best_cost = std::numeric_limits<double>::infinity();
     do {

@@ -42,9 +42,13 @@ struct BoundaryCorrespondenceOptions {
 // matched components likewise, but drawing 1's hole centroids are first carried by the
 // least-squares affine map of the component's outline onto its match (sampled by arc length from
 // the aligned starts), so that a sheared, rotated copy matches hole to hole where the bounding
-// boxes would pair neighbours (bootstrap-icons' flower1, 13 holes). Without marks, each loop
-// gets the cyclic shift that best matches drawing 1's loop in normalised turning angle and
-// position over arc length (orientation is fixed: the drawing is on the left of every loop).
+// boxes would pair neighbours (bootstrap-icons' flower1, 13 holes); where the holes' centroids
+// spread across, that map is also refitted to them from 24 turns of it (a round outline does not
+// fix the turn: browser-safari's ticks), the best by how far the carried outline and holes lie
+// from their matches. Without marks, each loop gets the cyclic shift that best matches drawing
+// 1's loop in normalised turning angle and position over arc length, its component's map (if
+// any) carrying drawing 1's loop first (orientation is fixed: the drawing is on the left of
+// every loop).
 struct BoundaryCorrespondence {
   // Loop g's vertices are the global indices loop_start[g] .. loop_start[g + 1] - 1; edge e joins
   // vertex e to the next vertex of its loop.
