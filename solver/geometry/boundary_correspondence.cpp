@@ -26,6 +26,9 @@ constexpr int kAlignSamples = 128;
 constexpr int kMaxHoleRematches = 4;
 // Turns of the outline's affine map tried as starts of the hole matching (MatchHoles).
 constexpr int kRotationHypotheses = 24;
+// Above this many holes only the outline's map itself is refitted (each turn costs a few
+// assignments, O(holes^3): a 30 x 30 grid of holes took 16 s with every turn, 0.3 s without).
+constexpr size_t kMaxHolesForTurns = 64;
 // Holes' centroids spread less than this across their main direction do not fix an affine map.
 constexpr double kMinHoleSpread = 0.1;
 constexpr double kSameT = 1e-9;
@@ -425,8 +428,8 @@ bool SpreadInTheFlat(const std::vector<Point>& points) {
 // boxes pair neighbours; MatchHolesFrom). An outline alone may not fix the map (a round one: any
 // rotation fits it), so when the holes' centroids spread in both directions (SpreadInTheFlat)
 // the map is also refitted to them, starting from the outline's map turned about the outline's
-// centroid by each of kRotationHypotheses steps of the full turn, and the best score wins (the
-// outline's own map on ties). Without a map (drawing 1 itself, or a degenerate fit), the centroids
+// centroid by each of kRotationHypotheses steps of the full turn (only unturned above
+// kMaxHolesForTurns holes), and the best score wins (the outline's own map on ties). Without a map (drawing 1 itself, or a degenerate fit), the centroids
 // are compared in the bounding-box normalisation.
 HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int outline,
                      const std::vector<int>& holes0, const std::vector<int>& holes, bool fit) {
@@ -441,7 +444,8 @@ HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int o
     for (const int h : holes0) centroids0.push_back(from.Raw(h));
     if (!SpreadInTheFlat(centroids0)) return best;
     const Point c0 = from.Raw(outline0);
-    for (int j = 0; j < kRotationHypotheses; ++j) {
+    const int turns = holes0.size() <= kMaxHolesForTurns ? kRotationHypotheses : 1;
+    for (int j = 0; j < turns; ++j) {
       const double angle = 2.0 * std::numbers::pi * j / kRotationHypotheses;
       const Eigen::Matrix2d r{{std::cos(angle), -std::sin(angle)},
                               {std::sin(angle), std::cos(angle)}};
