@@ -788,9 +788,12 @@ TEST(BoundaryReparamCountsTest, AffineCopiesMatchVertexToVertex) {
 // The copy then maps without the overlay, every loop (the round outline too) onto its affine
 // image.
 TEST(BoundaryReparamCountsTest, AffineCopiesMatchHoleToHole) {
-  for (const int ring : {6, 12, 16, 4}) {
+  enum class Layout { kRing, kFlower, kTicks, kColumn };
+  const std::pair<Layout, int> cases[] = {
+      {Layout::kRing, 6}, {Layout::kFlower, 12}, {Layout::kTicks, 16}, {Layout::kColumn, 4}};
+  for (const auto& [layout, ring] : cases) {
     SCOPED_TRACE(::testing::Message() << ring << " holes");
-    const bool round = ring == 16, column = ring == 4;
+    const bool round = layout == Layout::kTicks, column = layout == Layout::kColumn;
     Points outline;  // five petals and an asymmetry, or a circle
     for (int i = 0; i < 120; ++i) {
       const double a = 2 * M_PI * i / 120;
@@ -807,7 +810,9 @@ TEST(BoundaryReparamCountsTest, AffineCopiesMatchHoleToHole) {
                            c + along + 0.25 * across, c - along + 0.25 * across}}
                 : Outline{Circle(c, 0.8 + 0.1 * i * column, 12)});
     }
-    if (ring == 12) drawing.outlines.push_back(Outline{Circle(Point(0.4, -0.2), 1.5, 16)});
+    if (layout == Layout::kFlower) {  // the centre hole
+      drawing.outlines.push_back(Outline{Circle(Point(0.4, -0.2), 1.5, 16)});
+    }
     if (round) drawing.outlines.push_back(Outline{{{-3, -1}, {0, -0.5}, {3, 1.5}, {0, 0.5}}});
     Eigen::Matrix2d affine;
     // Three quarters of the holes' spacing; the column as the icons' copies (16 degrees).
