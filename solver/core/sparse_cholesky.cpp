@@ -613,7 +613,9 @@ SparseCholesky::Impl::Impl(Method method) {
   InstallAllocator();
   cholmod_start(&common);
   common.print = 0;  // errors come back as absl::Status, not on stderr
-  common.supernodal = method == Method::kAuto ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
+  common.supernodal = method == Method::kAuto         ? CHOLMOD_AUTO
+                      : method == Method::kSupernodal ? CHOLMOD_SUPERNODAL
+                                                      : CHOLMOD_SIMPLICIAL;
   common.final_ll = false;
   // Supernodal from flops / nnz(L) >= 100 (CHOLMOD's default switch is 40): on the comesh
   // Hessians (2 unknowns per vertex) the simplicial factor with our substitutions is faster up to
@@ -689,9 +691,7 @@ absl::Status SparseCholesky::Factorize(const Eigen::SparseMatrix<double>& a,
         "SparseCholesky: Factorize needs the pattern that was analyzed");
   }
   m.factorized = false;
-  auto cancelled = [] {
-    return NumericCancelled();
-  };
+  auto cancelled = [] { return NumericCancelled(); };
   // (No early return for a token already set: the first poll, at the first row block or the
   // first supernode, answers then; the tests rely on that to reach both polls.)
   cholmod_sparse view = View(a);
@@ -1023,6 +1023,22 @@ void PanelledPotrf(int n, double* a, int lda, int* info) {
   }
   *info = 0;
 }
+
+// OpenBLAS (0.3.21, Debian 12's) maps a thread's work buffer at its first BLAS-3 or LAPACK call
+// and, should that mmap fail, retries it forever (OpenBLAS issue #5289; 0.3.30 exits instead): a
+// first supernodal factorization that meets a memory cap spun in blas_memory_alloc instead of
+// answering RESOURCE_EXHAUSTED (seen in MapToBoundaryTest.OutOfMemory*, whose capped children are
+// forked from a process that never factored). One 1 x 1 dpotrf_ while the process loads takes that
+// buffer while memory is there; OpenBLAS keeps it for the thread's later calls. Threads whose
+// first BLAS call comes later (a server's workers) still map their own then.
+const bool kBlasBufferTaken = [] {
+  (void)Blas();
+  const int one = 1;
+  double a = 1.0;
+  int info = 0;
+  LapackPotrf()("L", &one, &a, &one, &info, 1);
+  return info == 0;
+}();
 
 }  // namespace
 }  // namespace inbetween::solver
