@@ -44,7 +44,34 @@ double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.
 struct TriangleFrame {
   double area = 0.0;                 // source area (weight)
   Eigen::Matrix<double, 3, 2> grad;  // J(r, c) = sum_j x_j(r) * grad(j, c)
+  Eigen::Matrix3d gram;              // grad grad^T
 };
+
+// The SLIM proxy's weights at Jacobian j (Rabinovich et al. 2017, symmetric Dirichlet): with
+// j = U diag(s) V^T (U and V rotations, the smaller singular value negative when det(j) < 0),
+// *m = W^T W = U diag(w(s)^2) U^T, w(s)^2 = (s + 1)(s^2 + 1) / s^3 with s clamped to 1e-8, and
+// *rotation = U V^T, the rotation nearest j. Closed form: for j = [a b; c d], U V^T turns by
+// atan2(c - b, a + d) and U by half the sum of that angle and atan2(c + b, a - d); the singular
+// values are |(a + d, c - b)| / 2 +- |(a - d, c + b)| / 2.
+void ProxyWeights(const Eigen::Matrix2d& j, Eigen::Matrix2d* m, Eigen::Matrix2d* rotation) {
+  const double e = 0.5 * (j(0, 0) + j(1, 1)), f = 0.5 * (j(0, 0) - j(1, 1));
+  const double g = 0.5 * (j(1, 0) + j(0, 1)), h = 0.5 * (j(1, 0) - j(0, 1));
+  const double q = std::hypot(e, h), r = std::hypot(f, g);
+  const double turn = std::atan2(h, e), u_turn = 0.5 * (turn + std::atan2(g, f));
+  const double s[2] = {q + r, q - r};
+  double w2[2];
+  for (int i = 0; i < 2; ++i) {
+    const double si = std::max(s[i], 1e-8);
+    w2[i] = (si + 1) * (si * si + 1) / (si * si * si);
+  }
+  const double cu = std::cos(u_turn), su = std::sin(u_turn);
+  // U diag(w2) U^T with U's columns (cu, su) and (-su, cu).
+  (*m)(0, 0) = w2[0] * cu * cu + w2[1] * su * su;
+  (*m)(1, 1) = w2[0] * su * su + w2[1] * cu * cu;
+  (*m)(0, 1) = (*m)(1, 0) = (w2[0] - w2[1]) * cu * su;
+  const double cr = std::cos(turn), sr = std::sin(turn);
+  *rotation << cr, -sr, sr, cr;
+}
 
 // Which vertices move in a solve and where the fixed ones sit.
 struct Constraints {
@@ -70,6 +97,7 @@ class Mapper {
       f.grad.row(1) = inv.row(0);
       f.grad.row(2) = inv.row(1);
       f.grad.row(0) = -(inv.row(0) + inv.row(1));
+      f.gram = f.grad * f.grad.transpose();
       total_area_ += f.area;
       frames_.push_back(f);
     }
@@ -109,58 +137,43 @@ class Mapper {
   // Minimiser of the SLIM proxy sum_t area |W_t (J_t - R_t)|^2 (+ boundary penalty). OK, or
   // FAILED_PRECONDITION when the system is numerically not positive definite (the penalty
   // outgrew the factorization), RESOURCE_EXHAUSTED when memory ran out.
+  // Per triangle the proxy is a |W (J - R)|^2 with J = X G (X: the corners' positions as 2 x 3
+  // columns, G: the frame's 3 x 2 gradient), so its 6 x 6 block over (dimension, corner) is the
+  // Kronecker product a (W^T W) (x) (G G^T), and its linear term a W^T W R G^T; G G^T is fixed
+  // per triangle (TriangleFrame::gram). The matrix's upper triangle is accumulated straight into
+  // its compressed values through slots computed once per constraint set (Pattern), so an
+  // iteration allocates nothing of the matrix's size.
   absl::Status ProxySolve(const Points& x, const Constraints& c, Points* out) const {
     const int nf = c.free_count;
-    std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(triangles_.size() * 36 + 2 * boundary_.size());
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * nf);
+    Pattern* pattern = PatternFor(c);
+    Eigen::SparseMatrix<double>& h = pattern->matrix;
+    double* values = h.valuePtr();
+    std::fill(values, values + h.nonZeros(), 0.0);
+    Eigen::MatrixXd& rhs = pattern->rhs;
+    rhs.setZero();
     for (size_t t = 0; t < triangles_.size(); ++t) {
       const Eigen::Matrix2d j = Jacobian(t, x);
-      Eigen::JacobiSVD<Eigen::Matrix2d> svd(j, Eigen::ComputeFullU | Eigen::ComputeFullV);
-      Eigen::Matrix2d u = svd.matrixU(), v = svd.matrixV();
-      Eigen::Vector2d s = svd.singularValues();
-      if (u.determinant() * v.determinant() < 0) {  // only for det(J) <= 0, kept for safety
-        u.col(1) *= -1;
-        s(1) *= -1;
-      }
-      Eigen::Vector2d w;
-      for (int i = 0; i < 2; ++i) {
-        const double si = std::max(s(i), 1e-8);
-        w(i) = std::sqrt((si + 1) * (si * si + 1) / (si * si * si));
-      }
-      const Eigen::Matrix2d weight = u * w.asDiagonal() * u.transpose();
-      const Eigen::Matrix2d target = weight * (u * v.transpose());
-      // Local 6 x 6 system over (dimension, corner), then one triplet per free pair.
-      const double a = frames_[t].area;
-      Eigen::Matrix<double, 6, 6> local = Eigen::Matrix<double, 6, 6>::Zero();
-      Eigen::Matrix<double, 6, 1> local_rhs = Eigen::Matrix<double, 6, 1>::Zero();
-      for (int r = 0; r < 2; ++r) {
-        for (int col = 0; col < 2; ++col) {
-          Eigen::Matrix<double, 6, 1> coef;
-          for (int sdim = 0; sdim < 2; ++sdim) {
-            for (int k = 0; k < 3; ++k)
-              coef(3 * sdim + k) = weight(r, sdim) * frames_[t].grad(k, col);
-          }
-          local.noalias() += a * coef * coef.transpose();
-          local_rhs += a * target(r, col) * coef;
-        }
-      }
-      int index[6];
-      for (int q = 0; q < 6; ++q) {
-        const int vtx = triangles_[t][q % 3];
-        index[q] = c.free_index[vtx] < 0 ? -1 : (q / 3) * nf + c.free_index[vtx];
-      }
+      Eigen::Matrix2d m, rotation;
+      ProxyWeights(j, &m, &rotation);
+      const TriangleFrame& frame = frames_[t];
+      m *= frame.area;
+      // a W^T W R G^T: the linear term, 2 x 3 over (dimension, corner).
+      const Eigen::Matrix<double, 2, 3> linear = m * rotation * frame.grad.transpose();
+      const int* slot = pattern->slots.data() + kPairs * t;
       for (int p = 0; p < 6; ++p) {
-        if (index[p] < 0) continue;
-        double value = local_rhs(p);
+        const int vp = triangles_[t][p % 3];
+        if (c.free_index[vp] < 0) continue;
+        double value = linear(p / 3, p % 3);
         for (int q = 0; q < 6; ++q) {
-          if (index[q] >= 0) {
-            entries.emplace_back(index[p], index[q], local(p, q));
-          } else {
-            value -= local(p, q) * c.fixed_at[triangles_[t][q % 3]](q / 3);
+          const double entry = m(p / 3, q / 3) * frame.gram(p % 3, q % 3);
+          const int vq = triangles_[t][q % 3];
+          if (c.free_index[vq] < 0) {
+            value -= entry * c.fixed_at[vq](q / 3);
+          } else if (q >= p) {
+            values[slot[Pair(p, q)]] += entry;
           }
         }
-        rhs(index[p]) += value;
+        rhs((p / 3) * nf + c.free_index[vp], 0) += value;
       }
     }
     if (c.penalty > 0) {
@@ -168,33 +181,25 @@ class Mapper {
         const int fi = c.free_index[boundary_[k]];
         if (fi < 0) continue;
         for (int sdim = 0; sdim < 2; ++sdim) {
-          entries.emplace_back(sdim * nf + fi, sdim * nf + fi, c.penalty);
-          rhs(sdim * nf + fi) += c.penalty * target_[k](sdim);
+          values[pattern->diagonal[sdim * nf + fi]] += c.penalty;
+          rhs(sdim * nf + fi, 0) += c.penalty * target_[k](sdim);
         }
       }
     }
-    Eigen::SparseMatrix<double> h(2 * nf, 2 * nf);
-    h.setFromTriplets(entries.begin(), entries.end());
-    // The sparsity pattern depends only on which vertices are free: analyse it once per
-    // constraint set (the ordering is most of a small factorization's cost) and refactor the
-    // numbers each iteration.
-    Cached& cached = cache_[&c];
-    if (cached.size != 2 * nf || cached.nonzeros != h.nonZeros()) {
-      cached.size = -1;  // until the analysis succeeds
-      cached.solver = std::make_unique<SparseCholesky>();
-      if (absl::Status s = cached.solver->Analyze(h); !s.ok()) return SolveError(s, h);
-      cached.size = 2 * nf;
-      cached.nonzeros = h.nonZeros();
+    // The pattern depends only on which vertices are free: analysed once per constraint set (the
+    // ordering is most of a small factorization's cost), the numbers refactored each iteration.
+    SparseCholesky& solver = pattern->solver;
+    if (!pattern->analyzed) {
+      if (absl::Status s = solver.Analyze(h); !s.ok()) return SolveError(s, h);
+      pattern->analyzed = true;
     }
-    SparseCholesky& solver = *cached.solver;
     if (absl::Status s = solver.Factorize(h); !s.ok()) return SolveError(s, h);
-    absl::StatusOr<Eigen::MatrixXd> sol = solver.Solve(rhs);
-    if (!sol.ok()) return SolveError(sol.status(), h);
-    if (!sol->allFinite()) return absl::FailedPreconditionError("map: the proxy solve diverged");
+    if (absl::Status s = solver.SolveInPlace(&rhs); !s.ok()) return SolveError(s, h);
+    if (!rhs.allFinite()) return absl::FailedPreconditionError("map: the proxy solve diverged");
     *out = x;
     for (size_t v = 0; v < x.size(); ++v) {
       const int fi = c.free_index[v];
-      (*out)[v] = fi < 0 ? c.fixed_at[v] : Point((*sol)(fi, 0), (*sol)(nf + fi, 0));
+      (*out)[v] = fi < 0 ? c.fixed_at[v] : Point(rhs(fi, 0), rhs(nf + fi, 0));
     }
     return absl::OkStatus();
   }
@@ -257,12 +262,76 @@ class Mapper {
   }
 
  private:
-  struct Cached {
-    std::unique_ptr<SparseCholesky> solver;
-    int size = -1;
-    Eigen::Index nonzeros = -1;
+  // A triangle's 6 x 6 block over (dimension, corner) is symmetric: its 21 entries (p, q), p <= q,
+  // are numbered row by row.
+  static constexpr int kPairs = 21;
+  static constexpr int Pair(int p, int q) { return p * 6 - p * (p - 1) / 2 + (q - p); }
+
+  // The proxy system's upper triangle for one constraint set (which vertices are free): its
+  // compressed pattern, where each triangle's entries land in its values (slots: kPairs per
+  // triangle, the upper-triangle entry of the two unknowns' pair; unused at a fixed vertex), each
+  // unknown's diagonal entry, the right-hand side's storage and the analysed factorization.
+  struct Pattern {
+    Eigen::SparseMatrix<double> matrix;
+    std::vector<int> slots, diagonal;
+    Eigen::MatrixXd rhs;
+    SparseCholesky solver{SparseCholesky::Method::kSupernodal};
+    bool analyzed = false;
   };
-  mutable std::map<const Constraints*, Cached> cache_;
+
+  Pattern* PatternFor(const Constraints& c) const {
+    std::unique_ptr<Pattern>& cached = patterns_[&c];
+    const int size = 2 * c.free_count;
+    if (cached != nullptr && cached->matrix.rows() == size) return cached.get();
+    cached = std::make_unique<Pattern>();
+    Pattern& p = *cached;
+    // The unknowns of the triangle's (dimension, corner) pairs, -1 at a fixed vertex.
+    auto unknowns = [&](const Triangle& t, int* out) {
+      for (int q = 0; q < 6; ++q) {
+        const int fi = c.free_index[t[q % 3]];
+        out[q] = fi < 0 ? -1 : (q / 3) * c.free_count + fi;
+      }
+    };
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(triangles_.size() * kPairs + size);
+    for (int i = 0; i < size; ++i) entries.emplace_back(i, i, 0.0);
+    int u[6];
+    for (const Triangle& t : triangles_) {
+      unknowns(t, u);
+      for (int a = 0; a < 6; ++a) {
+        for (int b = a; b < 6; ++b) {
+          if (u[a] >= 0 && u[b] >= 0) {
+            entries.emplace_back(std::min(u[a], u[b]), std::max(u[a], u[b]), 0.0);
+          }
+        }
+      }
+    }
+    p.matrix.resize(size, size);
+    p.matrix.setFromTriplets(entries.begin(), entries.end());
+    p.matrix.makeCompressed();
+    auto position = [&](int row, int col) {
+      const int* begin = p.matrix.innerIndexPtr() + p.matrix.outerIndexPtr()[col];
+      const int* end = p.matrix.innerIndexPtr() + p.matrix.outerIndexPtr()[col + 1];
+      return static_cast<int>(std::lower_bound(begin, end, row) - p.matrix.innerIndexPtr());
+    };
+    p.slots.assign(kPairs * triangles_.size(), -1);
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+      unknowns(triangles_[t], u);
+      for (int a = 0; a < 6; ++a) {
+        for (int b = a; b < 6; ++b) {
+          if (u[a] >= 0 && u[b] >= 0) {
+            p.slots[kPairs * t + Pair(a, b)] = position(std::min(u[a], u[b]), std::max(u[a], u[b]));
+          }
+        }
+      }
+    }
+    p.diagonal.resize(size);
+    for (int i = 0; i < size; ++i) p.diagonal[i] = position(i, i);
+    p.rhs.resize(size, 1);
+    return cached.get();
+  }
+
+  mutable std::map<const Constraints*, std::unique_ptr<Pattern>> patterns_;
   const std::vector<Triangle>& triangles_;
   const std::vector<int>& boundary_;
   const Points& target_;
