@@ -1024,20 +1024,16 @@ void PanelledPotrf(int n, double* a, int lda, int* info) {
   *info = 0;
 }
 
-// OpenBLAS (0.3.21, Debian 12's) maps a thread's work buffer at its first BLAS-3 or LAPACK call
-// and, should that mmap fail, retries it forever (OpenBLAS issue #5289; 0.3.30 exits instead): a
-// first supernodal factorization that meets a memory cap spun in blas_memory_alloc instead of
-// answering RESOURCE_EXHAUSTED (seen in MapToBoundaryTest.OutOfMemory*, whose capped children are
-// forked from a process that never factored). One 1 x 1 dpotrf_ while the process loads takes that
-// buffer while memory is there; OpenBLAS keeps it for the thread's later calls. Threads whose
-// first BLAS call comes later (a server's workers) still map their own then.
-const bool kBlasBufferTaken = [] {
+// The BLAS is set up (Blas(): one thread) while the process loads, not at the first supernodal
+// factorization. Set up late, in a child forked from a process that had not factored and whose
+// address space was then capped (RLIMIT_AS), OpenBLAS 0.3.21's first factorization of a
+// 10k- or 22k-unknown matrix spun in blas_memory_alloc, retrying a 128 MiB mmap forever (OpenBLAS
+// issue #5289; 0.3.30 exits instead), where it should have answered RESOURCE_EXHAUSTED or factored:
+// seen in MapToBoundaryTest.OutOfMemory* and
+// SparseCholeskyTest.FirstSupernodalFactorizationUnder... Set up at load, neither hangs.
+const bool kBlasSetUpAtLoad = [] {
   (void)Blas();
-  const int one = 1;
-  double a = 1.0;
-  int info = 0;
-  LapackPotrf()("L", &one, &a, &one, &info, 1);
-  return info == 0;
+  return true;
 }();
 
 }  // namespace

@@ -2,6 +2,10 @@
 #include "solver/core/sparse_cholesky.h"
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -13,6 +17,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "tests/unit/solver/core/address_space.h"
 
 namespace inbetween::solver {
 namespace {
@@ -218,6 +223,52 @@ TEST(SparseCholeskyTest, AutoGoesSupernodalOnLargeMatricesWithTheSameSolution) {
   EXPECT_EQ(indefinite.Compute(GridMatrix(100, -0.5, 1.0, 3)).code(),
             absl::StatusCode::kFailedPrecondition);
   EXPECT_FALSE(indefinite.factorized());
+}
+
+TEST(SparseCholeskyTest, SupernodalWhenAskedEvenOnSmallMatrices) {
+  const Eigen::SparseMatrix<double> a = GridMatrix(6, 0.1);
+  SparseCholesky super(SparseCholesky::Method::kSupernodal), simplicial;
+  ASSERT_TRUE(super.Compute(a).ok());
+  EXPECT_TRUE(super.supernodal());
+  ASSERT_TRUE(simplicial.Compute(a).ok());
+  const Eigen::MatrixXd b = Eigen::VectorXd::LinSpaced(a.rows(), -1.0, 2.0);
+  Eigen::MatrixXd x = b, y = b;
+  ASSERT_TRUE(super.SolveInPlace(&x).ok());
+  ASSERT_TRUE(simplicial.SolveInPlace(&y).ok());
+  EXPECT_LT((a * x - b).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 1e-12 * y.cwiseAbs().maxCoeff());
+}
+
+// A child forked from this process (which has factored nothing supernodally itself when the
+// test runs alone) and capped at 16 MiB above its address space factors a 10k-unknown matrix
+// supernodally or answers out of memory, in either case soon; it is killed after 60 s. With the
+// BLAS set up at the first factorization instead of at load, it spun in OpenBLAS's
+// blas_memory_alloc (sparse_cholesky.cpp, kBlasSetUpAtLoad).
+TEST(SparseCholeskyTest, FirstSupernodalFactorizationUnderAMemoryCapDoesNotHang) {
+  if (testing::kSanitizerBuild) GTEST_SKIP() << "RLIMIT_AS caps do not apply under ASan/TSan";
+  const Eigen::SparseMatrix<double> a = GridMatrix(100, 0.1);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    rlimit cap;
+    cap.rlim_cur = cap.rlim_max = testing::AddressSpaceBytes() + (size_t{16} << 20);
+    if (setrlimit(RLIMIT_AS, &cap) != 0) _exit(3);
+    SparseCholesky super(SparseCholesky::Method::kSupernodal);
+    const absl::Status s = super.Compute(a);
+    _exit(s.ok() && super.supernodal() ? 0 : absl::IsResourceExhausted(s) ? 1 : 2);
+  }
+  int status = 0;
+  const auto start = std::chrono::steady_clock::now();
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() - start > std::chrono::seconds(60)) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      FAIL() << "the capped child still runs after 60 s";
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_TRUE(WEXITSTATUS(status) == 0 || WEXITSTATUS(status) == 1) << WEXITSTATUS(status);
 }
 
 // Float substitutions: a supernodal factor's solves read its values rounded to float, so the

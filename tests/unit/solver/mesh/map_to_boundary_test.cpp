@@ -21,9 +21,13 @@
 #include "solver/mesh/cgal_triangulate.h"
 #include "solver/mesh/split_boundary_chords.h"
 #include "solver/mesh/validate.h"
+#include "tests/unit/solver/core/address_space.h"
 
 namespace inbetween::solver {
 namespace {
+
+using testing::AddressSpaceBytes;
+using testing::kSanitizerBuild;
 
 Points Square() { return {{0, 0}, {100, 0}, {100, 100}, {0, 100}}; }
 
@@ -191,41 +195,12 @@ TEST(MapToBoundaryTest, Cancelled) {
 // different points (the sparse factorizations among them). Eigen's SparseLU / SimplicialLDLT
 // died there (a double free after a failed allocation, docs/hardening.md); the map must answer
 // RESOURCE_EXHAUSTED "... out of memory ..." or succeed, never die.
-// Not in sanitizer builds: ASan reserves terabytes of shadow address space, and its allocator
-// answers an allocation that does not fit under the cap with its own out-of-memory report (then
-// a failed CHECK that hangs the child: seen in build/asan, 2026-12-02) instead of a null or
-// std::bad_alloc our code could turn into a status.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr bool kSanitizerBuild = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-constexpr bool kSanitizerBuild = true;
-#else
-constexpr bool kSanitizerBuild = false;
-#endif
-#else
-constexpr bool kSanitizerBuild = false;
-#endif
-
+// Not in sanitizer builds (address_space.h).
 struct CappedRun {
   int exit = -1;        // 0 mapped, 1 RESOURCE_EXHAUSTED naming "out of memory", 2 another status,
                         // 5 an exception escaped; 128 + signal when the child died
   std::string message;  // the status message (first 300 bytes)
 };
-
-size_t AddressSpaceBytes() {
-  std::ifstream in("/proc/self/status");
-  std::string key;
-  while (in >> key) {
-    if (key == "VmSize:") {
-      size_t kb = 0;
-      in >> kb;
-      return kb * 1024;
-    }
-    in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
-  }
-  return 0;
-}
 
 CappedRun MapUnderCap(const MapCase& s, const MapToBoundaryOptions& options, size_t headroom) {
   int fds[2];
