@@ -50,27 +50,30 @@ struct TriangleFrame {
 // The SLIM proxy's weights at Jacobian j (Rabinovich et al. 2017, symmetric Dirichlet): with
 // j = U diag(s) V^T (U and V rotations, the smaller singular value negative when det(j) < 0),
 // *m = W^T W = U diag(w(s)^2) U^T, w(s)^2 = (s + 1)(s^2 + 1) / s^3 with s clamped to 1e-8, and
-// *rotation = U V^T, the rotation nearest j. Closed form: for j = [a b; c d], U V^T turns by
-// atan2(c - b, a + d) and U by half the sum of that angle and atan2(c + b, a - d); the singular
-// values are |(a + d, c - b)| / 2 +- |(a - d, c + b)| / 2.
+// *rotation = U V^T, the rotation nearest j. Closed form, no trigonometry: for j = [a b; c d],
+// U V^T turns by the angle of (a + d, c - b), U by half the sum of that angle and the angle of
+// (a - d, c + b) (0 for a zero vector), and the singular values are |(a + d, c - b)| / 2 +-
+// |(a - d, c + b)| / 2; U diag(w0, w1) U^T = (w0 + w1) / 2 I + (w0 - w1) / 2 [cos 2u, sin 2u;
+// sin 2u, -cos 2u] for U's turn u.
 void ProxyWeights(const Eigen::Matrix2d& j, Eigen::Matrix2d* m, Eigen::Matrix2d* rotation) {
   const double e = 0.5 * (j(0, 0) + j(1, 1)), f = 0.5 * (j(0, 0) - j(1, 1));
   const double g = 0.5 * (j(1, 0) + j(0, 1)), h = 0.5 * (j(1, 0) - j(0, 1));
-  const double q = std::hypot(e, h), r = std::hypot(f, g);
-  const double turn = std::atan2(h, e), u_turn = 0.5 * (turn + std::atan2(g, f));
+  const double q = std::sqrt(e * e + h * h), r = std::sqrt(f * f + g * g);
+  // Cosine and sine of the two angles.
+  const double ca = q > 0 ? e / q : 1.0, sa = q > 0 ? h / q : 0.0;
+  const double cb = r > 0 ? f / r : 1.0, sb = r > 0 ? g / r : 0.0;
   const double s[2] = {q + r, q - r};
   double w2[2];
   for (int i = 0; i < 2; ++i) {
     const double si = std::max(s[i], 1e-8);
     w2[i] = (si + 1) * (si * si + 1) / (si * si * si);
   }
-  const double cu = std::cos(u_turn), su = std::sin(u_turn);
-  // U diag(w2) U^T with U's columns (cu, su) and (-su, cu).
-  (*m)(0, 0) = w2[0] * cu * cu + w2[1] * su * su;
-  (*m)(1, 1) = w2[0] * su * su + w2[1] * cu * cu;
-  (*m)(0, 1) = (*m)(1, 0) = (w2[0] - w2[1]) * cu * su;
-  const double cr = std::cos(turn), sr = std::sin(turn);
-  *rotation << cr, -sr, sr, cr;
+  const double mean = 0.5 * (w2[0] + w2[1]), half = 0.5 * (w2[0] - w2[1]);
+  const double cos2u = ca * cb - sa * sb, sin2u = sa * cb + ca * sb;
+  (*m)(0, 0) = mean + half * cos2u;
+  (*m)(1, 1) = mean - half * cos2u;
+  (*m)(0, 1) = (*m)(1, 0) = half * sin2u;
+  *rotation << ca, -sa, sa, ca;
 }
 
 // Which vertices move in a solve and where the fixed ones sit.

@@ -245,27 +245,40 @@ TEST(BuildMultimeshTest, OverlayBuildsWhatNoMeshMaps) {
               HasSubstr(absl::StrCat("needs more than ", options.max_mesh_vertices, " vertices")));
 }
 
-// A triangle with a hole and a heptagon with a hole elsewhere (random star-shaped outlines and
-// holes): no drawing's mesh maps onto the other; the overlay cuts the mesh open from its hole to
-// its outline, overlays it and glues the cut back.
+// Two random star-shaped outlines, each with a hole, the holes far apart (at the left end of one
+// drawing, in the lower right of the other): no drawing's mesh maps onto the other (the pull from
+// drawing 1 stalls 3.75 away from its target); the overlay cuts the mesh open from its hole to its
+// outline, overlays it and glues the cut back. (The pair used before, a triangle and a heptagon,
+// mapped directly once the map's proxy weights were computed without trigonometry.)
 TEST(BuildMultimeshTest, OverlayBuildsAroundAHole) {
   const std::vector<Drawing> drawings = {
-      Drawing{
-          {Outline{{{9.19, 38.11}, {-14.05, 15.40}, {6.77, -12.77}}}, Outline{{{6.35, 19.62},
-                                                                               {6.41, 19.17},
-                                                                               {5.55, 19.20},
-                                                                               {5.33, 19.14},
-                                                                               {3.56, 17.79},
-                                                                               {3.78, 21.23},
-                                                                               {4.82, 21.10}}}}},
-      Drawing{{Outline{{{20.94, 9.26},
-                        {17.11, 15.36},
-                        {18.39, 22.22},
-                        {-11.34, 32.70},
-                        {-14.49, 7.26},
-                        {-7.04, -17.03},
-                        {10.70, -6.90}}},
-               Outline{{{-3.27, 7.39}, {-3.96, 9.11}, {-3.55, 10.55}, {-2.53, 10.40}}}}}};
+      Drawing{{Outline{{{29.74, 0.95},
+                        {18.10, 7.62},
+                        {20.94, 14.74},
+                        {-2.42, 24.48},
+                        {-25.38, 3.63},
+                        {-14.50, -8.23},
+                        {19.37, -7.60},
+                        {16.21, -3.95},
+                        {25.28, -1.98},
+                        {10.03, -0.07}}},
+               Outline{{{-18.21, 0.94}, {-21.04, 1.23}, {-20.52, 2.45}, {-19.50, 1.60}}}}},
+      Drawing{{Outline{{{8.71, 15.69},
+                        {-13.19, 23.23},
+                        {-27.86, -10.42},
+                        {-15.37, -24.15},
+                        {-0.97, -14.47},
+                        {4.22, -11.61},
+                        {17.48, -16.52},
+                        {13.47, -10.79},
+                        {22.12, -16.50},
+                        {18.51, -5.22},
+                        {18.97, -0.22}}},
+               Outline{{{11.32, -12.00},
+                        {10.49, -11.96},
+                        {9.07, -10.13},
+                        {10.11, -10.30},
+                        {10.83, -10.30}}}}}};
   MultimeshOptions options;
   options.boundary_vertices = 48;
   options.overlay = false;
