@@ -27,8 +27,6 @@
 #include <map>
 #include <memory>
 #include <new>
-#include <cstdio>
-#include <cstdlib>
 
 #include "absl/strings/str_cat.h"
 #include "solver/core/sparse_cholesky.h"
@@ -527,10 +525,8 @@ absl::StatusOr<Points> MapToBoundaryImpl(const Points& source,
         if (!iterated.ok()) return iterated.status();
         const double progress = *iterated;
         if (progress < 0) break;  // the penalty outgrew the factorization: the pull is stuck
-        static const double zz_tol = std::getenv("ZZTOL") ? std::atof(std::getenv("ZZTOL")) : 1e-7;
-        if (progress < zz_tol) break;
+        if (progress < options.stage_progress) break;
       }
-      if (std::getenv("ZZMAP")) std::fprintf(stderr, "ZZ stage %d penalty %.3g iterations %d distance %.3g tol %.3g\n", rep.stages, pull.penalty, rep.iterations, mapper.MaxBoundaryDistance(x), tolerance);
       if (rep.stages > 40 || !(pull.penalty < 1e20)) break;
     }
     const double distance = mapper.MaxBoundaryDistance(x);
