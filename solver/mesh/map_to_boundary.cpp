@@ -19,7 +19,6 @@
 #include "solver/mesh/map_to_boundary.h"
 
 #include <Eigen/LU>
-#include <Eigen/SVD>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
