@@ -3,6 +3,7 @@
 // drawing, mirrored across each cohesive zone), equal vertex counts per segment between them.
 #include "solver/geometry/boundary_correspondence.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,8 +11,6 @@
 #include <numeric>
 #include <optional>
 #include <string>
-
-#include <Eigen/Dense>
 
 #include "absl/strings/str_cat.h"
 #include "solver/geometry/polygon.h"
@@ -429,16 +428,16 @@ bool SpreadInTheFlat(const std::vector<Point>& points) {
 // rotation fits it), so when the holes' centroids spread in both directions (SpreadInTheFlat)
 // the map is also refitted to them, starting from the outline's map turned about the outline's
 // centroid by each of kRotationHypotheses steps of the full turn (only unturned above
-// kMaxHolesForTurns holes), and the best score wins (the outline's own map on ties). Without a map (drawing 1 itself, or a degenerate fit), the centroids
-// are compared in the bounding-box normalisation.
+// kMaxHolesForTurns holes), and the best score wins (the outline's own map on ties). Without a
+// map (drawing 1 itself, or a degenerate fit), the centroids are compared in the bounding-box
+// normalisation.
 HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int outline,
                      const std::vector<int>& holes0, const std::vector<int>& holes, bool fit) {
   const Curve& a = (*from.curves)[outline0];
   const Curve& b = (*to.curves)[outline];
   Affine carry;
   if (fit && !holes0.empty() &&
-      OutlineAffine(a, b, AlignStart(a, b, from.centre, from.scale, to.centre, to.scale),
-                    &carry)) {
+      OutlineAffine(a, b, AlignStart(a, b, from.centre, from.scale, to.centre, to.scale), &carry)) {
     HoleMatch best = MatchHolesFrom(from, to, outline0, outline, holes0, holes, carry, false);
     std::vector<Point> centroids0;
     for (const int h : holes0) centroids0.push_back(from.Raw(h));

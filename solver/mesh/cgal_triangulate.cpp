@@ -13,6 +13,7 @@
 #include <CGAL/Delaunay_mesher_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -324,18 +325,14 @@ absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Poin
     }
     // Each loop's bounding box first: a centroid outside it is outside the loop (a drawing of
     // 900 holes spent 3.6 s here testing 218k centroids against every loop).
-    std::vector<std::pair<Point, Point>> boxes;
-    for (const Points& loop : loops) {
-      Point lo = loop[0], hi = loop[0];
-      for (const Point& p : loop) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-      boxes.emplace_back(lo, hi);
+    std::vector<Eigen::AlignedBox2d> boxes(loops.size());
+    for (size_t l = 0; l < loops.size(); ++l) {
+      for (const Point& p : loops[l]) boxes[l].extend(p);
     }
     auto in_domain = [&](const Point& q) {
       bool in = false;
       for (size_t l = 0; l < loops.size(); ++l) {
-        const auto& [lo, hi] = boxes[l];
-        if (q.x() < lo.x() || q.y() < lo.y() || q.x() > hi.x() || q.y() > hi.y()) continue;
-        in ^= PolygonContains(loops[l], q);
+        if (boxes[l].contains(q)) in ^= PolygonContains(loops[l], q);
       }
       return in;
     };
