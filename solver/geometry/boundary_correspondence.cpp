@@ -343,6 +343,53 @@ bool OutlineAffine(const Curve& a, const Curve& b, double b_start, Affine* fit) 
   return FitAffine(pairs, fit);
 }
 
+// Loops (or components, by their outer loops) of drawing 1 paired by correspondence marks with
+// loops of another drawing: to[a] = b and from[b] = a, else -1, with the mark that paired them.
+struct Pins {
+  std::vector<int> to, from, to_mark, from_mark;
+  Pins() = default;
+  Pins(size_t loops0, size_t loops)
+      : to(loops0, -1), from(loops, -1), to_mark(loops0), from_mark(loops) {}
+
+  // Pairs a with b for mark `mark` (0-based) of drawing d (0-based); INVALID_ARGUMENT naming both
+  // marks when an earlier mark paired either with another (`what`: "outline", "hole", "component").
+  absl::Status Add(int a, int b, int mark, int d, const char* what) {
+    if (to[a] >= 0 && to[a] != b) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("correspondence marks ", to_mark[a] + 1, " and ", mark + 1, " sit on one ",
+                       what, " of drawing 1 but on two different ", what, "s of drawing ", d + 1));
+    }
+    if (from[b] >= 0 && from[b] != a) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "correspondence marks ", from_mark[b] + 1, " and ", mark + 1, " sit on two different ",
+          what, "s of drawing 1 but on one ", what, " of drawing ", d + 1));
+    }
+    to[a] = b, from[b] = a, to_mark[a] = mark, from_mark[b] = mark;
+    return absl::OkStatus();
+  }
+  // Whether pairing drawing 1's loop a with b breaks a pin.
+  bool Breaks(int a, int b) const {
+    return (!to.empty() && to[a] >= 0 && to[a] != b) ||
+           (!from.empty() && from[b] >= 0 && from[b] != a);
+  }
+};
+
+// Makes every pairing of rows[i] (drawing 1's loops) with cols[j] (another drawing's) that
+// breaks a pin cost more than all other pairings together, so that the exact assignment keeps
+// every pin (Pins::Add keeps them consistent, so some assignment does).
+void Penalize(const Pins& pins, const std::vector<int>& rows, const std::vector<int>& cols,
+              std::vector<std::vector<double>>* cost) {
+  double total = 1.0;
+  for (const std::vector<double>& row : *cost) {
+    for (const double c : row) total += std::abs(c);
+  }
+  for (size_t i = 0; i < rows.size(); ++i) {
+    for (size_t j = 0; j < cols.size(); ++j) {
+      if (pins.Breaks(rows[i], cols[j])) (*cost)[i][j] += total;
+    }
+  }
+}
+
 // One drawing's loops as the loop matching sees them: curves, area centroids in the drawing's
 // bounding-box normalisation (centre, scale).
 struct LoopSet {
@@ -380,7 +427,7 @@ double CarriedDistance(const LoopSet& from, const LoopSet& to, int a, int b, con
 // matches (CarriedDistance, summed).
 HoleMatch MatchHolesFrom(const LoopSet& from, const LoopSet& to, int outline0, int outline,
                          const std::vector<int>& holes0, const std::vector<int>& holes,
-                         Affine carry, bool refit) {
+                         const Pins& pins, Affine carry, bool refit) {
   HoleMatch out;
   for (int round = 0; round <= kMaxHoleRematches; ++round) {
     std::vector<std::vector<double>> cost(holes0.size(), std::vector<double>(holes.size()));
@@ -389,6 +436,7 @@ HoleMatch MatchHolesFrom(const LoopSet& from, const LoopSet& to, int outline0, i
         cost[a][b] = (carry.m * from.Raw(holes0[a]) + carry.t - to.Raw(holes[b])).squaredNorm();
       }
     }
+    Penalize(pins, holes0, holes, &cost);
     std::vector<int> again = Assign(cost);
     if (again == out.assignment) break;
     out.assignment = std::move(again);
@@ -432,13 +480,14 @@ bool SpreadInTheFlat(const std::vector<Point>& points) {
 // map (drawing 1 itself, or a degenerate fit), the centroids are compared in the bounding-box
 // normalisation.
 HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int outline,
-                     const std::vector<int>& holes0, const std::vector<int>& holes, bool fit) {
+                     const std::vector<int>& holes0, const std::vector<int>& holes,
+                     const Pins& pins, bool fit) {
   const Curve& a = (*from.curves)[outline0];
   const Curve& b = (*to.curves)[outline];
   Affine carry;
   if (fit && !holes0.empty() &&
       OutlineAffine(a, b, AlignStart(a, b, from.centre, from.scale, to.centre, to.scale), &carry)) {
-    HoleMatch best = MatchHolesFrom(from, to, outline0, outline, holes0, holes, carry, false);
+    HoleMatch best = MatchHolesFrom(from, to, outline0, outline, holes0, holes, pins, carry, false);
     std::vector<Point> centroids0;
     for (const int h : holes0) centroids0.push_back(from.Raw(h));
     if (!SpreadInTheFlat(centroids0)) return best;
@@ -450,7 +499,8 @@ HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int o
                               {std::sin(angle), std::cos(angle)}};
       // p -> carry(c0 + r (p - c0))
       const Affine turned{carry.m * r, carry.m * (c0 - r * c0) + carry.t};
-      HoleMatch match = MatchHolesFrom(from, to, outline0, outline, holes0, holes, turned, true);
+      HoleMatch match =
+          MatchHolesFrom(from, to, outline0, outline, holes0, holes, pins, turned, true);
       if (match.score < best.score) best = std::move(match);
     }
     return best;
@@ -461,6 +511,7 @@ HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int o
       cost[i][j] = ((*from.centroid)[holes0[i]] - (*to.centroid)[holes[j]]).squaredNorm();
     }
   }
+  Penalize(pins, holes0, holes, &cost);
   HoleMatch out;
   out.assignment = Assign(cost);
   return out;
@@ -584,6 +635,75 @@ struct UnionFind {
 // that boundary loop.
 constexpr double kMarkRelativeTolerance = 0.05;
 
+namespace {
+
+// The loop of drawing `graph` that is component c's outline.
+int OuterLoopOf(const BoundaryGraph& graph, int c) {
+  for (size_t l = 0; l < graph.loops.size(); ++l) {
+    if (graph.loops[l].outer && graph.loops[l].component == c) return static_cast<int>(l);
+  }
+  return -1;
+}
+
+// The loops that correspondence marks pair (each mark sits on the nearest loop of each drawing,
+// within kMarkRelativeTolerance of its length; a mark off every loop is left to the
+// parameterization, which names it), and their components: loop_pins[d] and component_pins[d]
+// for d >= 1. INVALID_ARGUMENT for a mark on an outline in one drawing and on a hole in another,
+// or two marks that pair one loop or component with two.
+absl::Status PinByMarks(const std::vector<BoundaryGraph>& graphs,
+                        const std::vector<std::vector<Curve>>& curves,
+                        const std::vector<std::vector<Point>>& marks, std::vector<Pins>* loop_pins,
+                        std::vector<Pins>* component_pins) {
+  const size_t num_shapes = graphs.size();
+  loop_pins->assign(num_shapes, Pins());
+  component_pins->assign(num_shapes, Pins());
+  auto nearest = [&](size_t d, const Point& p) {
+    int best = -1;
+    double best_dist = std::numeric_limits<double>::infinity();
+    for (size_t l = 0; l < curves[d].size(); ++l) {
+      double dist;
+      curves[d][l].Project(p, &dist);
+      if (dist < best_dist) best_dist = dist, best = static_cast<int>(l);
+    }
+    return best >= 0 && best_dist <= kMarkRelativeTolerance * curves[d][best].length() ? best : -1;
+  };
+  for (size_t d = 1; d < num_shapes; ++d) {
+    (*loop_pins)[d] = Pins(graphs[0].loops.size(), graphs[d].loops.size());
+    (*component_pins)[d] = Pins(graphs[0].loops.size(), graphs[d].loops.size());
+  }
+  for (size_t m = 0; m < marks.size(); ++m) {
+    if (marks[m].size() != num_shapes) continue;  // named by the parameterization
+    const int a = nearest(0, marks[m][0]);
+    if (a < 0) continue;
+    const BoundaryLoop& la = graphs[0].loops[a];
+    for (size_t d = 1; d < num_shapes; ++d) {
+      const int b = nearest(d, marks[m][d]);
+      if (b < 0) continue;
+      const BoundaryLoop& lb = graphs[d].loops[b];
+      const int dd = static_cast<int>(d), mm = static_cast<int>(m);
+      if (la.outer != lb.outer) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "drawing ", d + 1, ": correspondence mark ", m + 1, " sits on ",
+            lb.outer ? "an outline" : "a hole", " but on ", la.outer ? "an outline" : "a hole",
+            " in drawing 1 (a mark pairs an outline with an outline, a hole with a hole)"));
+      }
+      if (absl::Status s = (*loop_pins)[d].Add(a, b, mm, dd, la.outer ? "outline" : "hole");
+          !s.ok()) {
+        return s;
+      }
+      if (absl::Status s =
+              (*component_pins)[d].Add(OuterLoopOf(graphs[0], la.component),
+                                       OuterLoopOf(graphs[d], lb.component), mm, dd, "component");
+          !s.ok()) {
+        return s;
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::Status CheckSameEquivalence(const std::vector<BoundaryGraph>& graphs) {
   bool same = true;
   for (const BoundaryGraph& g : graphs) same = same && g.equivalence == graphs[0].equivalence;
@@ -624,6 +744,13 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     }
   }
 
+  // Correspondence marks decide which loops and components pair where they sit on them.
+  std::vector<Pins> loop_pins, component_pins;
+  if (absl::Status s = PinByMarks(graphs, curves, options.marks, &loop_pins, &component_pins);
+      !s.ok()) {
+    return s;
+  }
+
   // Loop groups: drawing 1's components in order, each followed by its holes.
   std::vector<std::vector<int>> group_loops;  // [g][d]
   auto loops_of = [&](int d, int component, bool outer) {
@@ -651,6 +778,7 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
             (centroid[0][outer0[i]] - centroid[d][outer[j]]).squaredNorm() + (h0 != hd ? 1e6 : 0.0);
       }
     }
+    Penalize(component_pins[d], outer0, outer, &cost);
     const std::vector<int> assignment = Assign(cost);
     for (size_t i = 0; i < outer0.size(); ++i) component_match[d].push_back(outer[assignment[i]]);
   }
@@ -683,7 +811,7 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     for (int d = 0; d < num_shapes; ++d) {
       const LoopSet from{&curves[0], &centroid[0], centre[0], scale[0]};
       const LoopSet to{&curves[d], &centroid[d], centre[d], scale[d]};
-      HoleMatch match = MatchHoles(from, to, g[0], g[d], holes[0], holes[d], d > 0);
+      HoleMatch match = MatchHoles(from, to, g[0], g[d], holes[0], holes[d], loop_pins[d], d > 0);
       carry[d] = match.carry;
       for (size_t a = 0; a < holes[0].size(); ++a) {
         hole_match[d].push_back(holes[d][match.assignment[a]]);

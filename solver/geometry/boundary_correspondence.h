@@ -18,7 +18,11 @@ struct BoundaryCorrespondenceOptions {
   double corner_angle_degrees = 30.0;
   // marks[m][d]: where correspondence mark m sits in drawing d (one point per drawing). Each mark
   // pins the nearest boundary point of drawing 1 to the nearest point of the matching loop in
-  // every other drawing; marks on a loop must keep their cyclic order in every drawing.
+  // every other drawing; marks on a loop must keep their cyclic order in every drawing. A mark
+  // also pairs the loops it sits on (the nearest loop of each drawing) and their components: the
+  // loop matching below keeps every such pair, so one mark says which part or hole of drawing 1
+  // becomes which of another. A mark on an outline in one drawing and on a hole in another, or two
+  // marks that pair one loop (or component) with two, give INVALID_ARGUMENT naming the marks.
   std::vector<std::vector<Point>> marks;
   // Without marks on a loop: when every drawing has as many corners on it as drawing 1, they are
   // matched in cyclic order (each pair turning the same way, convex or reflex; of such shifts,
@@ -35,7 +39,8 @@ struct BoundaryCorrespondenceOptions {
   bool match_corners = false;
 };
 
-// Loops are matched as follows (documented default): each drawing is normalised by its
+// Loops are matched as follows (documented default; pairs set by marks are kept, and the rest
+// matched around them): each drawing is normalised by its
 // bounding box (centre, diagonal); components are matched to drawing 1's by the assignment of
 // least total squared distance between normalised area centroids (components with a different
 // hole count never match; exact: brute force up to 8, the Hungarian method beyond). Holes within

@@ -12,8 +12,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <map>
+#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -748,9 +752,18 @@ TEST(BoundaryReparamCountsTest, AffineCopiesMatchVertexToVertex) {
       // A random star-shaped polygon whose vertex (16.91, 23.46) turns by less than a degree and,
       // sheared, by more: the corners above a degree differ in count, the vertices off their
       // neighbours' line (an affine invariant) do not.
-      {{{24.43, 21.27}, {34.93, 35.43}, {21.32, 36.86}, {16.91, 23.46}, {13.04, 18.84},
-        {10.61, -10.14}, {35.51, 8.42}, {45.08, 9.14}, {20.28, 15.43}},
-       5.2, 1.6, 0.4},
+      {{{24.43, 21.27},
+        {34.93, 35.43},
+        {21.32, 36.86},
+        {16.91, 23.46},
+        {13.04, 18.84},
+        {10.61, -10.14},
+        {35.51, 8.42},
+        {45.08, 9.14},
+        {20.28, 15.43}},
+       5.2,
+       1.6,
+       0.4},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
     SCOPED_TRACE(::testing::Message() << "case " << i);
@@ -768,8 +781,9 @@ TEST(BoundaryReparamCountsTest, AffineCopiesMatchVertexToVertex) {
     const Points& from = s->bc.shapes[0][0];
     const Points& to = s->bc.shapes[1][0];
     for (size_t k = 0; k < c.polygon.size(); ++k) {
-      const auto at = std::find_if(from.begin(), from.end(),
-                                   [&](const Point& p) { return (p - c.polygon[k]).norm() < 1e-9; });
+      const auto at = std::find_if(from.begin(), from.end(), [&](const Point& p) {
+        return (p - c.polygon[k]).norm() < 1e-9;
+      });
       ASSERT_NE(at, from.end()) << "polygon vertex " << k;
       EXPECT_LT((to[at - from.begin()] - image[k]).norm(), 1e-9) << "polygon vertex " << k;
     }
@@ -854,8 +868,8 @@ TEST(BoundaryReparamCountsTest, AffineCopiesMatchHoleToHole) {
     MultimeshOptions options;
     options.max_edge_relative = 0.08;
     MultimeshReport report;
-    absl::StatusOr<Multimesh> mesh = BuildMultimesh({drawing, copy}, options, nullptr, nullptr,
-                                                    &report);
+    absl::StatusOr<Multimesh> mesh =
+        BuildMultimesh({drawing, copy}, options, nullptr, nullptr, &report);
     ASSERT_TRUE(mesh.ok()) << mesh.status();
     EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
     EXPECT_EQ(report.overlays, 0);
@@ -1011,6 +1025,144 @@ TEST(BoundaryReparamCountsTest, ExamplesWithMarks) {
     EXPECT_FALSE(mesh->cohesive_edges.empty()) << name;
     EXPECT_TRUE(CheckAll(MeshViews(*mesh, *s))) << name;
   }
+}
+
+// Marks decide which components pair. Three discs of radius 6, 10 and 14, and the same three
+// turned by 120 degrees about the middle, so each place holds another disc: without marks the
+// components pair by place (normalised centroids), so the small disc pairs with the large one;
+// a mark on the small disc in both drawings pairs it with itself, and marks on all three follow
+// the turn. Checked at the correspondence and through BuildMultimesh (each component's area in
+// both shapes).
+TEST(BoundaryReparamCountsTest, MarksPairComponents) {
+  const Point at[] = {{0, -30}, {26, 15}, {-26, 15}};
+  const double radius[] = {6, 10, 14};
+  const double turn = 2 * M_PI / 3;
+  const Eigen::Matrix2d r{{std::cos(turn), -std::sin(turn)}, {std::sin(turn), std::cos(turn)}};
+  Drawing discs, turned;
+  for (int i = 0; i < 3; ++i) {
+    discs.outlines.push_back(Outline{Circle(at[i], radius[i], 48)});
+    turned.outlines.push_back(Outline{Circle(r * at[i], radius[i], 48)});
+  }
+  // Mark i: the bottom of disc i, and where the turn takes it.
+  auto mark = [&](int i) {
+    const Point p = at[i] - Point(0, radius[i]);
+    return std::vector<Point>{p, r * p};
+  };
+  // Per loop group, drawing 2's loop's mean distance from drawing 1's centre, as a radius.
+  auto radii = [](const Stage& s) {
+    std::vector<std::pair<double, double>> out;
+    for (int g = 0; g < s.bc.num_loops(); ++g) {
+      double size[2];
+      for (int d = 0; d < 2; ++d) {
+        Point c = Point::Zero();
+        for (const Point& p : s.bc.shapes[d][g]) c += p / s.bc.shapes[d][g].size();
+        size[d] = 0;
+        for (const Point& p : s.bc.shapes[d][g])
+          size[d] += (p - c).norm() / s.bc.shapes[d][g].size();
+      }
+      out.push_back({size[0], size[1]});
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  {
+    absl::StatusOr<Stage> s = Correspond({discs, turned}, {});
+    ASSERT_TRUE(s.ok()) << s.status();
+    const auto pairs = radii(*s);
+    EXPECT_NEAR(pairs[0].second, 14, 0.1);  // by place: the small disc onto the large one
+  }
+  {
+    absl::StatusOr<Stage> s = Correspond({discs, turned}, {mark(0)});
+    ASSERT_TRUE(s.ok()) << s.status();
+    EXPECT_TRUE(CheckAll(s->views));
+    const auto pairs = radii(*s);
+    EXPECT_NEAR(pairs[0].first, 6, 0.1);
+    EXPECT_NEAR(pairs[0].second, 6, 0.1);
+  }
+  const std::vector<std::vector<Point>> all = {mark(0), mark(1), mark(2)};
+  absl::StatusOr<Stage> s = Correspond({discs, turned}, all);
+  ASSERT_TRUE(s.ok()) << s.status();
+  EXPECT_TRUE(CheckAll(s->views));
+  EXPECT_EQ(CountMarks(s->views), 3);
+  for (const auto& [first, second] : radii(*s)) EXPECT_NEAR(first, second, 0.1);
+
+  MultimeshOptions options;
+  options.marks = all;
+  options.max_edge_relative = 0.1;
+  absl::StatusOr<Multimesh> mesh = BuildMultimesh({discs, turned}, options);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
+  // Triangles by component (the first vertex's), and each component's area in both shapes.
+  std::vector<int> parent(mesh->num_vertices());
+  std::iota(parent.begin(), parent.end(), 0);
+  std::function<int(int)> find = [&](int v) {
+    return parent[v] == v ? v : parent[v] = find(parent[v]);
+  };
+  for (const Triangle& t : mesh->triangles) {
+    parent[find(t[0])] = find(t[1]);
+    parent[find(t[1])] = find(t[2]);
+  }
+  std::map<int, std::array<double, 2>> area;
+  for (const Triangle& t : mesh->triangles) {
+    for (int d = 0; d < 2; ++d) {
+      const Points& x = mesh->shapes[d];
+      const Point ab = x[t[1]] - x[t[0]], ac = x[t[2]] - x[t[0]];
+      area[find(t[0])][d] += 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
+    }
+  }
+  ASSERT_EQ(area.size(), 3u);
+  for (const auto& [root, a] : area) EXPECT_NEAR(a[1] / a[0], 1.0, 0.02) << a[0];
+}
+
+// Marks decide which holes pair: a plate with a small hole on the left and a large one on the
+// right, and the same plate with the two swapped; a mark on the small hole in both pairs it with
+// itself (by place, it would pair with the large one).
+TEST(BoundaryReparamCountsTest, MarksPairHoles) {
+  auto plate = [](double left, double right) {
+    return Drawing{{Outline{Rect(0, 0, 100, 50)}, Outline{Circle(Point(25, 25), left, 32)},
+                    Outline{Circle(Point(75, 25), right, 32)}}};
+  };
+  const Drawing a = plate(5, 12), b = plate(12, 5);
+  auto small_hole_radius = [](const Stage& s, int d) {
+    // Drawing 1's small hole's group: the hole loop nearest (25, 25) in drawing 1.
+    for (int g = 0; g < s.bc.num_loops(); ++g) {
+      if (s.bc.loop_outer[g]) continue;
+      Point c = Point::Zero();
+      for (const Point& p : s.bc.shapes[0][g]) c += p / s.bc.shapes[0][g].size();
+      if ((c - Point(25, 25)).norm() > 1) continue;
+      Point e = Point::Zero();
+      for (const Point& p : s.bc.shapes[d][g]) e += p / s.bc.shapes[d][g].size();
+      return (s.bc.shapes[d][g][0] - e).norm();
+    }
+    return -1.0;
+  };
+  absl::StatusOr<Stage> by_place = Correspond({a, b}, {});
+  ASSERT_TRUE(by_place.ok()) << by_place.status();
+  EXPECT_NEAR(small_hole_radius(*by_place, 1), 12, 0.2);
+  absl::StatusOr<Stage> marked = Correspond({a, b}, {{Point(25, 20), Point(75, 20)}});
+  ASSERT_TRUE(marked.ok()) << marked.status();
+  EXPECT_TRUE(CheckAll(marked->views));
+  EXPECT_NEAR(small_hole_radius(*marked, 0), 5, 0.2);
+  EXPECT_NEAR(small_hole_radius(*marked, 1), 5, 0.2);
+}
+
+// Marks that cannot pair loops are named: one on an outline in drawing 1 and on a hole in drawing
+// 2, and two on one outline of drawing 1 but on two outlines of drawing 2.
+TEST(BoundaryReparamCountsTest, MarksThatPairLoopsInconsistentlyAreNamed) {
+  const Drawing plate{{Outline{Rect(0, 0, 100, 50)}, Outline{Circle(Point(50, 25), 10, 32)}}};
+  absl::StatusOr<Stage> s = Correspond({plate, plate}, {{Point(50, 0), Point(50, 15)}});
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.status().message(),
+              HasSubstr("drawing 2: correspondence mark 1 sits on a hole but on an outline in "
+                        "drawing 1"));
+  const Drawing two{{Outline{Rect(0, 0, 40, 40)}, Outline{Rect(60, 0, 100, 40)}}};
+  s = Correspond({two, two}, {{Point(20, 0), Point(20, 0)}, {Point(20, 40), Point(80, 40)}});
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.status().message(),
+              HasSubstr("correspondence marks 1 and 2 sit on one outline of drawing 1 but on two "
+                        "different outlines of drawing 2"));
 }
 
 }  // namespace
