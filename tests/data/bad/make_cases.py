@@ -135,6 +135,11 @@ case("different_equivalence_class_hole", "drawing 1 a disk, drawing 2 an annulus
      [step("PutDrawing", put_svg(ANNULUS), code="OK"),
       step("BuildMultimesh", {"session_id": S, "expected_version": V}, code="INVALID_ARGUMENT", message="drawing 1: 1 component, 0 holes; drawing 2: 1 component, 1 hole")],
      setup="one_drawing")
+case("correspondence_outline_to_hole", "a mark on the outline in drawing 1 and on the hole in drawing 2 (two annuli)",
+     [step("PutDrawing", put_svg(ANNULUS, name="a.svg"), code="OK"),
+      step("PutDrawing", put_svg(ANNULUS, name="b.svg"), code="OK"),
+      step("SetCorrespondences", {"session_id": S, "expected_version": V, "correspondences": [{"points": [{"x": 10, "y": 60}, {"x": 40, "y": 60}]}]}, code="OK"),
+      step("BuildMultimesh", {"session_id": S, "expected_version": V}, code="INVALID_ARGUMENT", message="drawing 2: correspondence mark 1 sits on a hole but on an outline in drawing 1")])
 case("different_equivalence_class_components", "drawing 1 one component, drawing 2 two",
      [step("PutDrawing", put_svg(svg('<rect x="0" y="0" width="40" height="40"/><rect x="60" y="0" width="40" height="40"/>')), code="OK"),
       step("BuildMultimesh", {"session_id": S, "expected_version": V}, code="INVALID_ARGUMENT", message="drawing 2: 2 components, 0 holes")],
