@@ -30,6 +30,11 @@ constexpr int kRotationHypotheses = 24;
 constexpr size_t kMaxHolesForTurns = 64;
 // Holes' centroids spread less than this across their main direction do not fix an affine map.
 constexpr double kMinHoleSpread = 0.1;
+// Matches from turned maps that score within this factor of the best (plus a floor of
+// kScoreFloor times the drawing's squared diagonal per loop) are equally good: of those, the one
+// that turns least from the first candidate's map wins (ChooseMatch).
+constexpr double kScoreTie = 1.5;
+constexpr double kScoreFloor = 1e-4;
 constexpr double kSameT = 1e-9;
 
 double Wrap01(double t) {
@@ -374,18 +379,24 @@ struct Pins {
   }
 };
 
+// Which pairings of drawing 1's loops (rows) with another drawing's (columns) may be made at all
+// (components: the same number of holes); empty: all.
+using Allowed = std::vector<std::vector<bool>>;
+
 // Makes every pairing of rows[i] (drawing 1's loops) with cols[j] (another drawing's) that
-// breaks a pin cost more than all other pairings together, so that the exact assignment keeps
-// every pin (Pins::Add keeps them consistent, so some assignment does).
+// breaks a pin, or that `allowed` rules out, cost more than all other pairings together, so that
+// the exact assignment makes none where it can (Pins::Add keeps the pins consistent).
 void Penalize(const Pins& pins, const std::vector<int>& rows, const std::vector<int>& cols,
-              std::vector<std::vector<double>>* cost) {
+              const Allowed& allowed, std::vector<std::vector<double>>* cost) {
   double total = 1.0;
   for (const std::vector<double>& row : *cost) {
     for (const double c : row) total += std::abs(c);
   }
   for (size_t i = 0; i < rows.size(); ++i) {
     for (size_t j = 0; j < cols.size(); ++j) {
-      if (pins.Breaks(rows[i], cols[j])) (*cost)[i][j] += total;
+      if (pins.Breaks(rows[i], cols[j]) || (!allowed.empty() && !allowed[i][j])) {
+        (*cost)[i][j] += total;
+      }
     }
   }
 }
@@ -421,39 +432,66 @@ double CarriedDistance(const LoopSet& from, const LoopSet& to, int a, int b, con
   return sum / n;
 }
 
-// Holes matched from the map `carry`: by the carried area centroids, then (with `refit`) the map
-// fitted to the matched centroids (affine images of each other in a copy) and the holes matched
-// again, until the match settles. Scored by how far the carried outline and holes lie from their
-// matches (CarriedDistance, summed).
-HoleMatch MatchHolesFrom(const LoopSet& from, const LoopSet& to, int outline0, int outline,
-                         const std::vector<int>& holes0, const std::vector<int>& holes,
-                         const Pins& pins, Affine carry, bool refit) {
+// Drawing 1's loops `loops0` matched to another drawing's `loops` from the map `carry`: by the
+// carried area centroids, then (with `refit`) the map fitted to the matched centroids (affine
+// images of each other in a copy) and the loops matched again, until the match settles. Scored
+// by how far the carried loops, and the enclosing outline `outline0` (holes; -1: none) from
+// `outline`, lie from their matches (CarriedDistance, summed).
+HoleMatch MatchLoopsFrom(const LoopSet& from, const LoopSet& to, int outline0, int outline,
+                         const std::vector<int>& loops0, const std::vector<int>& loops,
+                         const Pins& pins, const Allowed& allowed, Affine carry, bool refit) {
   HoleMatch out;
   for (int round = 0; round <= kMaxHoleRematches; ++round) {
-    std::vector<std::vector<double>> cost(holes0.size(), std::vector<double>(holes.size()));
-    for (size_t a = 0; a < holes0.size(); ++a) {
-      for (size_t b = 0; b < holes.size(); ++b) {
-        cost[a][b] = (carry.m * from.Raw(holes0[a]) + carry.t - to.Raw(holes[b])).squaredNorm();
+    std::vector<std::vector<double>> cost(loops0.size(), std::vector<double>(loops.size()));
+    for (size_t a = 0; a < loops0.size(); ++a) {
+      for (size_t b = 0; b < loops.size(); ++b) {
+        cost[a][b] = (carry.m * from.Raw(loops0[a]) + carry.t - to.Raw(loops[b])).squaredNorm();
       }
     }
-    Penalize(pins, holes0, holes, &cost);
+    Penalize(pins, loops0, loops, allowed, &cost);
     std::vector<int> again = Assign(cost);
     if (again == out.assignment) break;
     out.assignment = std::move(again);
     std::vector<std::pair<Point, Point>> matched;
-    for (size_t a = 0; a < holes0.size(); ++a) {
-      matched.emplace_back(from.Raw(holes0[a]), to.Raw(holes[out.assignment[a]]));
+    for (size_t a = 0; a < loops0.size(); ++a) {
+      matched.emplace_back(from.Raw(loops0[a]), to.Raw(loops[out.assignment[a]]));
     }
     Affine fit;
     if (!refit || !FitAffine(matched, &fit)) break;
     carry = fit;
   }
   out.carry = carry;
-  out.score = CarriedDistance(from, to, outline0, outline, carry);
-  for (size_t a = 0; a < holes0.size(); ++a) {
-    out.score += CarriedDistance(from, to, holes0[a], holes[out.assignment[a]], carry);
+  out.score = outline0 >= 0 ? CarriedDistance(from, to, outline0, outline, carry) : 0.0;
+  for (size_t a = 0; a < loops0.size(); ++a) {
+    out.score += CarriedDistance(from, to, loops0[a], loops[out.assignment[a]], carry);
   }
   return out;
+}
+
+// The turn (radians, in [-pi, pi]) of an affine map's linear part: the angle of its nearest
+// rotation.
+double TurnOf(const Affine& a) { return std::atan2(a.m(1, 0) - a.m(0, 1), a.m(0, 0) + a.m(1, 1)); }
+
+// Of matches from turned maps (candidates[0]: the unturned start), the one whose map turns least
+// from candidates[0]'s among those scoring at most kScoreTie times the best score plus `floor`.
+// A symmetric layout (four equal dots in a square) is fitted as well by a map a quarter turn off
+// as by the right one, and the scores then differ by noise alone; the smaller motion is the one
+// meant.
+HoleMatch ChooseMatch(std::vector<HoleMatch> candidates, double floor) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const HoleMatch& c : candidates) best = std::min(best, c.score);
+  const double start = candidates[0].carry ? TurnOf(*candidates[0].carry) : 0.0;
+  size_t pick = 0;
+  double pick_turn = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    if (!(candidates[i].score <= kScoreTie * best + floor)) continue;
+    const double turn =
+        candidates[i].carry
+            ? std::abs(std::remainder(TurnOf(*candidates[i].carry) - start, 2 * std::numbers::pi))
+            : 0.0;
+    if (turn < pick_turn) pick_turn = turn, pick = i;
+  }
+  return std::move(candidates[pick]);
 }
 
 // Whether points spread in both directions enough for an affine map to be fitted to them: three
@@ -472,7 +510,7 @@ bool SpreadInTheFlat(const std::vector<Point>& points) {
 // The holes of drawing 1's component (outline0, holes0) matched to those of its match in another
 // drawing (outline, holes). Drawing 1's holes are carried by the least-squares affine map of the
 // outline onto its match (so a sheared, rotated copy matches hole to hole where the bounding
-// boxes pair neighbours; MatchHolesFrom). An outline alone may not fix the map (a round one: any
+// boxes pair neighbours; MatchLoopsFrom). An outline alone may not fix the map (a round one: any
 // rotation fits it), so when the holes' centroids spread in both directions (SpreadInTheFlat)
 // the map is also refitted to them, starting from the outline's map turned about the outline's
 // centroid by each of kRotationHypotheses steps of the full turn (only unturned above
@@ -487,10 +525,11 @@ HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int o
   Affine carry;
   if (fit && !holes0.empty() &&
       OutlineAffine(a, b, AlignStart(a, b, from.centre, from.scale, to.centre, to.scale), &carry)) {
-    HoleMatch best = MatchHolesFrom(from, to, outline0, outline, holes0, holes, pins, carry, false);
+    std::vector<HoleMatch> candidates = {
+        MatchLoopsFrom(from, to, outline0, outline, holes0, holes, pins, {}, carry, false)};
     std::vector<Point> centroids0;
     for (const int h : holes0) centroids0.push_back(from.Raw(h));
-    if (!SpreadInTheFlat(centroids0)) return best;
+    if (!SpreadInTheFlat(centroids0)) return std::move(candidates[0]);
     const Point c0 = from.Raw(outline0);
     const int turns = holes0.size() <= kMaxHolesForTurns ? kRotationHypotheses : 1;
     for (int j = 0; j < turns; ++j) {
@@ -499,11 +538,11 @@ HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int o
                               {std::sin(angle), std::cos(angle)}};
       // p -> carry(c0 + r (p - c0))
       const Affine turned{carry.m * r, carry.m * (c0 - r * c0) + carry.t};
-      HoleMatch match =
-          MatchHolesFrom(from, to, outline0, outline, holes0, holes, pins, turned, true);
-      if (match.score < best.score) best = std::move(match);
+      candidates.push_back(
+          MatchLoopsFrom(from, to, outline0, outline, holes0, holes, pins, {}, turned, true));
     }
-    return best;
+    return ChooseMatch(std::move(candidates),
+                       kScoreFloor * to.scale * to.scale * static_cast<double>(holes0.size() + 1));
   }
   std::vector<std::vector<double>> cost(holes0.size(), std::vector<double>(holes.size()));
   for (size_t i = 0; i < holes0.size(); ++i) {
@@ -511,7 +550,7 @@ HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int o
       cost[i][j] = ((*from.centroid)[holes0[i]] - (*to.centroid)[holes[j]]).squaredNorm();
     }
   }
-  Penalize(pins, holes0, holes, &cost);
+  Penalize(pins, holes0, holes, {}, &cost);
   HoleMatch out;
   out.assignment = Assign(cost);
   return out;
@@ -765,8 +804,11 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
   };
   const std::vector<int> outer0 = loops_of(0, 0, true);
   std::vector<std::vector<int>> component_match(num_shapes);  // [d][c0] -> outer loop in d
+  std::vector<Point> centroids0;                              // drawing 1's components, as drawn
+  for (const int l : outer0) centroids0.push_back(centre[0] + scale[0] * centroid[0][l]);
   for (int d = 0; d < num_shapes; ++d) {
     const std::vector<int> outer = loops_of(d, 0, true);
+    Allowed same_holes(outer0.size(), std::vector<bool>(outer.size()));
     std::vector<std::vector<double>> cost(outer0.size(), std::vector<double>(outer.size()));
     for (size_t i = 0; i < outer0.size(); ++i) {
       const int h0 =
@@ -774,12 +816,44 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
       for (size_t j = 0; j < outer.size(); ++j) {
         const int hd =
             static_cast<int>(loops_of(d, graphs[d].loops[outer[j]].component, false).size());
+        same_holes[i][j] = h0 == hd;
         cost[i][j] =
             (centroid[0][outer0[i]] - centroid[d][outer[j]]).squaredNorm() + (h0 != hd ? 1e6 : 0.0);
       }
     }
-    Penalize(component_pins[d], outer0, outer, &cost);
-    const std::vector<int> assignment = Assign(cost);
+    Penalize(component_pins[d], outer0, outer, {}, &cost);
+    std::vector<int> assignment = Assign(cost);
+    if (d > 0 && SpreadInTheFlat(centroids0)) {
+      // Components spread across the drawing: drawing 1's placement in drawing d's bounding box
+      // (the match above), against that placement turned about drawing 1's centre by each of
+      // kRotationHypotheses steps and refitted to the matched centroids (only unturned above
+      // kMaxHolesForTurns components), the best by how far the carried outlines lie from their
+      // matches (the placement on ties): a rearranged drawing (a turned copy) pairs each part
+      // with its image, not with whichever part now sits where it sat.
+      const LoopSet from{&curves[0], &centroid[0], centre[0], scale[0]};
+      const LoopSet to{&curves[d], &centroid[d], centre[d], scale[d]};
+      const double s = scale[d] / scale[0];
+      const Affine place{s * Eigen::Matrix2d::Identity(), centre[d] - s * centre[0]};
+      std::vector<HoleMatch> candidates(1);  // the placement's own match (above), under `place`
+      candidates[0].assignment = assignment;
+      candidates[0].carry = place;
+      candidates[0].score = 0.0;
+      for (size_t i = 0; i < outer0.size(); ++i) {
+        candidates[0].score += CarriedDistance(from, to, outer0[i], outer[assignment[i]], place);
+      }
+      const int turns = outer0.size() <= kMaxHolesForTurns ? kRotationHypotheses : 1;
+      for (int j = 0; j < turns; ++j) {
+        const double angle = 2.0 * std::numbers::pi * j / kRotationHypotheses;
+        const Eigen::Matrix2d r{{std::cos(angle), -std::sin(angle)},
+                                {std::sin(angle), std::cos(angle)}};
+        // p -> place(c + r (p - c)), c drawing 1's centre
+        const Affine turned{place.m * r, place.m * (centre[0] - r * centre[0]) + place.t};
+        candidates.push_back(MatchLoopsFrom(from, to, -1, -1, outer0, outer, component_pins[d],
+                                            same_holes, turned, /*refit=*/true));
+      }
+      const double floor = kScoreFloor * scale[d] * scale[d] * static_cast<double>(outer0.size());
+      assignment = ChooseMatch(std::move(candidates), floor).assignment;
+    }
     for (size_t i = 0; i < outer0.size(); ++i) component_match[d].push_back(outer[assignment[i]]);
   }
   BoundaryCorrespondence out;

@@ -1027,91 +1027,117 @@ TEST(BoundaryReparamCountsTest, ExamplesWithMarks) {
   }
 }
 
-// Marks decide which components pair. Three discs of radius 6, 10 and 14, and the same three
-// turned by 120 degrees about the middle, so each place holds another disc: without marks the
-// components pair by place (normalised centroids), so the small disc pairs with the large one;
-// a mark on the small disc in both drawings pairs it with itself, and marks on all three follow
-// the turn. Checked at the correspondence and through BuildMultimesh (each component's area in
-// both shapes).
-TEST(BoundaryReparamCountsTest, MarksPairComponents) {
-  const Point at[] = {{0, -30}, {26, 15}, {-26, 15}};
-  const double radius[] = {6, 10, 14};
-  const double turn = 2 * M_PI / 3;
-  const Eigen::Matrix2d r{{std::cos(turn), -std::sin(turn)}, {std::sin(turn), std::cos(turn)}};
-  Drawing discs, turned;
-  for (int i = 0; i < 3; ++i) {
-    discs.outlines.push_back(Outline{Circle(at[i], radius[i], 48)});
-    turned.outlines.push_back(Outline{Circle(r * at[i], radius[i], 48)});
-  }
-  // Mark i: the bottom of disc i, and where the turn takes it.
-  auto mark = [&](int i) {
-    const Point p = at[i] - Point(0, radius[i]);
-    return std::vector<Point>{p, r * p};
-  };
-  // Per loop group, drawing 2's loop's mean distance from drawing 1's centre, as a radius.
-  auto radii = [](const Stage& s) {
-    std::vector<std::pair<double, double>> out;
-    for (int g = 0; g < s.bc.num_loops(); ++g) {
-      double size[2];
-      for (int d = 0; d < 2; ++d) {
-        Point c = Point::Zero();
-        for (const Point& p : s.bc.shapes[d][g]) c += p / s.bc.shapes[d][g].size();
-        size[d] = 0;
-        for (const Point& p : s.bc.shapes[d][g])
-          size[d] += (p - c).norm() / s.bc.shapes[d][g].size();
-      }
-      out.push_back({size[0], size[1]});
+// Per loop group, the mean distance of drawing 1's and drawing 2's loop from their own centre
+// (a disc's radius), sorted by drawing 1's.
+std::vector<std::pair<double, double>> GroupRadii(const Stage& s) {
+  std::vector<std::pair<double, double>> out;
+  for (int g = 0; g < s.bc.num_loops(); ++g) {
+    double size[2];
+    for (int d = 0; d < 2; ++d) {
+      const Points& loop = s.bc.shapes[d][g];
+      Point c = Point::Zero();
+      for (const Point& p : loop) c += p / loop.size();
+      size[d] = 0;
+      for (const Point& p : loop) size[d] += (p - c).norm() / loop.size();
     }
-    std::sort(out.begin(), out.end());
-    return out;
-  };
-  {
-    absl::StatusOr<Stage> s = Correspond({discs, turned}, {});
-    ASSERT_TRUE(s.ok()) << s.status();
-    const auto pairs = radii(*s);
-    EXPECT_NEAR(pairs[0].second, 14, 0.1);  // by place: the small disc onto the large one
+    out.push_back({size[0], size[1]});
   }
-  {
-    absl::StatusOr<Stage> s = Correspond({discs, turned}, {mark(0)});
-    ASSERT_TRUE(s.ok()) << s.status();
-    EXPECT_TRUE(CheckAll(s->views));
-    const auto pairs = radii(*s);
-    EXPECT_NEAR(pairs[0].first, 6, 0.1);
-    EXPECT_NEAR(pairs[0].second, 6, 0.1);
-  }
-  const std::vector<std::vector<Point>> all = {mark(0), mark(1), mark(2)};
-  absl::StatusOr<Stage> s = Correspond({discs, turned}, all);
-  ASSERT_TRUE(s.ok()) << s.status();
-  EXPECT_TRUE(CheckAll(s->views));
-  EXPECT_EQ(CountMarks(s->views), 3);
-  for (const auto& [first, second] : radii(*s)) EXPECT_NEAR(first, second, 0.1);
+  std::sort(out.begin(), out.end());
+  return out;
+}
 
-  MultimeshOptions options;
-  options.marks = all;
-  options.max_edge_relative = 0.1;
-  absl::StatusOr<Multimesh> mesh = BuildMultimesh({discs, turned}, options);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
-  EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
-  // Triangles by component (the first vertex's), and each component's area in both shapes.
-  std::vector<int> parent(mesh->num_vertices());
+// Each component's area in every shape of a multimesh (components by the triangles' vertices).
+std::vector<std::vector<double>> ComponentAreas(const Multimesh& mesh) {
+  std::vector<int> parent(mesh.num_vertices());
   std::iota(parent.begin(), parent.end(), 0);
   std::function<int(int)> find = [&](int v) {
     return parent[v] == v ? v : parent[v] = find(parent[v]);
   };
-  for (const Triangle& t : mesh->triangles) {
+  for (const Triangle& t : mesh.triangles) {
     parent[find(t[0])] = find(t[1]);
     parent[find(t[1])] = find(t[2]);
   }
-  std::map<int, std::array<double, 2>> area;
-  for (const Triangle& t : mesh->triangles) {
-    for (int d = 0; d < 2; ++d) {
-      const Points& x = mesh->shapes[d];
+  std::map<int, std::vector<double>> area;
+  for (const Triangle& t : mesh.triangles) {
+    std::vector<double>& a = area[find(t[0])];
+    a.resize(mesh.shapes.size());
+    for (size_t d = 0; d < mesh.shapes.size(); ++d) {
+      const Points& x = mesh.shapes[d];
       const Point ab = x[t[1]] - x[t[0]], ac = x[t[2]] - x[t[0]];
-      area[find(t[0])][d] += 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
+      a[d] += 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
     }
   }
-  ASSERT_EQ(area.size(), 3u);
-  for (const auto& [root, a] : area) EXPECT_NEAR(a[1] / a[0], 1.0, 0.02) << a[0];
+  std::vector<std::vector<double>> out;
+  for (auto& [root, a] : area) out.push_back(std::move(a));
+  return out;
+}
+
+// A rearranged drawing pairs each part with its image. Three discs of radius 6, 10 and 14, and
+// the same three turned by 120 degrees about the middle, sheared and moved, so that each place
+// holds another disc: by place (the bounding-box normalisation alone) the small disc would pair
+// with the large one; the turns of the placement, refitted to the matched centroids, pair each
+// disc with itself. Checked at the correspondence and through BuildMultimesh.
+TEST(BoundaryReparamCountsTest, RearrangedComponentsPairWithTheirImages) {
+  const Point at[] = {{0, -30}, {26, 15}, {-26, 15}};
+  const double radius[] = {6, 10, 14};
+  for (const double shear : {0.0, 0.25}) {
+    SCOPED_TRACE(::testing::Message() << "shear " << shear);
+    const double turn = 2 * M_PI / 3;
+    const Eigen::Matrix2d r =
+        Eigen::Matrix2d{{1.0, shear}, {0.0, 1.0}} *
+        Eigen::Matrix2d{{std::cos(turn), -std::sin(turn)}, {std::sin(turn), std::cos(turn)}};
+    Drawing discs, turned;
+    for (int i = 0; i < 3; ++i) {
+      const Points circle = Circle(at[i], radius[i], 48);
+      discs.outlines.push_back(Outline{circle});
+      Points image;
+      for (const Point& p : circle) image.push_back(r * p + Point(100, 7));
+      turned.outlines.push_back(Outline{image});
+    }
+    absl::StatusOr<Stage> s = Correspond({discs, turned}, {});
+    ASSERT_TRUE(s.ok()) << s.status();
+    EXPECT_TRUE(CheckAll(s->views));
+    for (const auto& [first, second] : GroupRadii(*s)) {
+      EXPECT_NEAR(second / first, 1.0, shear > 0 ? 0.1 : 0.01);
+    }
+    MultimeshOptions options;
+    options.max_edge_relative = 0.1;
+    absl::StatusOr<Multimesh> mesh = BuildMultimesh({discs, turned}, options);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
+    const std::vector<std::vector<double>> areas = ComponentAreas(*mesh);
+    ASSERT_EQ(areas.size(), 3u);
+    for (const std::vector<double>& a : areas) EXPECT_NEAR(a[1] / a[0], 1.0, 0.02) << a[0];
+  }
+}
+
+// Marks decide which components pair. Two discs of radius 6 and 14 that swap places: two parts
+// do not fix a turn, so they pair by place (the small disc onto the large one); a mark on the
+// small disc in both drawings pairs it with itself, at the correspondence and in the multimesh.
+TEST(BoundaryReparamCountsTest, MarksPairComponents) {
+  const Drawing discs{
+      {Outline{Circle(Point(-20, 0), 6, 48)}, Outline{Circle(Point(20, 0), 14, 48)}}};
+  const Drawing swapped{
+      {Outline{Circle(Point(20, 0), 6, 48)}, Outline{Circle(Point(-20, 0), 14, 48)}}};
+  absl::StatusOr<Stage> by_place = Correspond({discs, swapped}, {});
+  ASSERT_TRUE(by_place.ok()) << by_place.status();
+  EXPECT_NEAR(GroupRadii(*by_place)[0].second, 14, 0.1);
+  const std::vector<std::vector<Point>> marks = {{Point(-20, -6), Point(20, -6)}};
+  absl::StatusOr<Stage> s = Correspond({discs, swapped}, marks);
+  ASSERT_TRUE(s.ok()) << s.status();
+  EXPECT_TRUE(CheckAll(s->views));
+  EXPECT_EQ(CountMarks(s->views), 1);
+  for (const auto& [first, second] : GroupRadii(*s)) EXPECT_NEAR(first, second, 0.1);
+
+  MultimeshOptions options;
+  options.marks = marks;
+  options.max_edge_relative = 0.1;
+  absl::StatusOr<Multimesh> mesh = BuildMultimesh({discs, swapped}, options);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
+  const std::vector<std::vector<double>> areas = ComponentAreas(*mesh);
+  ASSERT_EQ(areas.size(), 2u);
+  for (const std::vector<double>& a : areas) EXPECT_NEAR(a[1] / a[0], 1.0, 0.02) << a[0];
 }
 
 // Marks decide which holes pair: a plate with a small hole on the left and a large one on the
