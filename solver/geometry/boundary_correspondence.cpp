@@ -283,7 +283,7 @@ double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, co
                   double sb, const Affine* carry = nullptr) {
   const int m = kAlignSamples;
   Points pa(m), pb(m);
-  std::vector<double> ta(m), tb(m);
+  Points ua(m), ub(m);  // (cos, sin) of the tangents' angles ta, tb
   for (int k = 0; k < m; ++k) {
     pa[k] = carry == nullptr ? Point((a.At(a.length() * k / m) - ca) / sa)
                              : Point((carry->m * a.At(a.length() * k / m) + carry->t - cb) / sb);
@@ -293,8 +293,9 @@ double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, co
     Point da = a.At(a.length() * (k + 0.5) / m) - a.At(a.length() * (k - 0.5) / m);
     if (carry != nullptr) da = carry->m * da;
     const Point db = b.At(b.length() * (k + 0.5) / m) - b.At(b.length() * (k - 0.5) / m);
-    ta[k] = std::atan2(da.y(), da.x());
-    tb[k] = std::atan2(db.y(), db.x());
+    const double ta = std::atan2(da.y(), da.x()), tb = std::atan2(db.y(), db.x());
+    ua[k] = Point(std::cos(ta), std::sin(ta));
+    ub[k] = Point(std::cos(tb), std::sin(tb));
   }
   Point mean = Point::Zero();
   for (const Point& p : pa) mean += p / m;
@@ -306,8 +307,11 @@ double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, co
   for (int s = 0; s < m; ++s) {
     double sn = 0, cs = 0, position = 0;
     for (int k = 0; k < m; ++k) {
-      const double d = ta[k] - tb[(k + s) % m];
-      sn += std::sin(d), cs += std::cos(d);
+      // sin and cos of ta[k] - tb[k + s], by the angle-difference identities (no trigonometry in
+      // the m^2 loop: it was most of a many-part drawing's loop matching).
+      const Point& u = ua[k];
+      const Point& v = ub[(k + s) % m];
+      sn += u.y() * v.x() - u.x() * v.y(), cs += u.x() * v.x() + u.y() * v.y();
       position += (pa[k] - pb[(k + s) % m]).squaredNorm();
     }
     // sum_k (1 - cos(d_k - rotation)) at the best rotation = m - |sum e^{i d_k}|.
