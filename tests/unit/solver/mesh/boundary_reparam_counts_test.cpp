@@ -1111,6 +1111,39 @@ TEST(BoundaryReparamCountsTest, RearrangedComponentsPairWithTheirImages) {
   }
 }
 
+// Symmetric layouts pair each loop with its image, not with the image of its neighbour a quarter
+// turn away (which fits the loops as well): four equal holes in the corners of a square plate,
+// and four equal discs on their own, each against a sheared, turned copy (the icon corpus' copy
+// map), as bootstrap-icons' dice-4-fill and dice-4.
+TEST(BoundaryReparamCountsTest, SymmetricLayoutsPairEachLoopWithItsImage) {
+  const Eigen::Matrix2d m{{1.2, -0.25}, {0.35, 1.1}};
+  const Point t(30, -4);
+  const Point corners[] = {{4, 4}, {12, 4}, {12, 12}, {4, 12}};
+  Drawing plate{{Outline{Rect(0, 0, 16, 16)}}}, dots;
+  for (const Point& c : corners) {
+    plate.outlines.push_back(Outline{Circle(c, 1.5, 24)});
+    dots.outlines.push_back(Outline{Circle(c, 1.5, 24)});
+  }
+  for (const Drawing* drawing : {&plate, &dots}) {
+    SCOPED_TRACE(drawing == &plate ? "holes" : "discs");
+    Drawing copy;
+    for (const Outline& o : drawing->outlines) {
+      Points image;
+      for (const Point& p : o.points) image.push_back(m * p + t);
+      copy.outlines.push_back(Outline{image});
+    }
+    absl::StatusOr<Stage> s = Correspond({*drawing, copy}, {});
+    ASSERT_TRUE(s.ok()) << s.status();
+    EXPECT_TRUE(CheckAll(s->views));
+    for (int g = 0; g < s->bc.num_loops(); ++g) {
+      Point from = Point::Zero(), to = Point::Zero();
+      for (const Point& p : s->bc.shapes[0][g]) from += p / s->bc.shapes[0][g].size();
+      for (const Point& p : s->bc.shapes[1][g]) to += p / s->bc.shapes[1][g].size();
+      EXPECT_LT((m * from + t - to).norm(), 0.1) << "loop " << g + 1;
+    }
+  }
+}
+
 // Marks decide which components pair. Two discs of radius 6 and 14 that swap places: two parts
 // do not fix a turn, so they pair by place (the small disc onto the large one); a mark on the
 // small disc in both drawings pairs it with itself, at the correspondence and in the multimesh.
