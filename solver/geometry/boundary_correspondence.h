@@ -40,17 +40,22 @@ struct BoundaryCorrespondenceOptions {
 };
 
 // Loops are matched as follows (documented default; pairs set by marks are kept, and the rest
-// matched around them): each drawing is normalised by its
-// bounding box (centre, diagonal); components are matched to drawing 1's by the assignment of
-// least total squared distance between normalised area centroids (components with a different
-// hole count never match; exact: brute force up to 8, the Hungarian method beyond). Holes within
-// matched components likewise, but drawing 1's hole centroids are first carried by the
-// least-squares affine map of the component's outline onto its match (sampled by arc length from
-// the aligned starts), so that a sheared, rotated copy matches hole to hole where the bounding
-// boxes would pair neighbours (bootstrap-icons' flower1, 13 holes); where the holes' centroids
-// spread across, that map is also refitted to them from 24 turns of it (a round outline does not
-// fix the turn: browser-safari's ticks), the best by how far the carried outline and holes lie
-// from their matches. Without marks, each loop gets the cyclic shift that best matches drawing
+// matched around them): each drawing is normalised by its bounding box (centre, diagonal);
+// components are matched to drawing 1's by the assignment of least total squared distance
+// between normalised area centroids (components with a different hole count never match; exact:
+// brute force up to 8, the Hungarian method beyond). Where three or more components spread
+// across drawing 1, that placement is also turned about drawing 1's centre by 24 steps and
+// refitted to the matched centroids (affine), and the candidate whose carried outlines lie
+// nearest their matches wins, so a turned or sheared drawing pairs each part with its image.
+// Holes within matched components likewise, but drawing 1's hole centroids are first carried by
+// the least-squares affine map of the component's outline onto its match (sampled by arc length
+// from the aligned starts), so that a sheared, rotated copy matches hole to hole where the
+// bounding boxes would pair neighbours (bootstrap-icons' flower1, 13 holes); where the holes'
+// centroids spread across, that map is also refitted to them from 24 turns of it (a round
+// outline does not fix the turn: browser-safari's ticks). Of the turned candidates (components
+// or holes) that score within 1.5 times the best (plus a small floor), the one turning least
+// from the start wins: a symmetric layout (four equal dots) fits a quarter turn as well as the
+// right map. Without marks, each loop gets the cyclic shift that best matches drawing
 // 1's loop in normalised turning angle and position over arc length, its component's map (if
 // any) carrying drawing 1's loop first (orientation is fixed: the drawing is on the left of
 // every loop).
