@@ -1072,6 +1072,21 @@ std::vector<std::vector<double>> ComponentAreas(const Multimesh& mesh) {
   return out;
 }
 
+// BuildMultimesh of two drawings (with `marks`) gives a valid multimesh of `parts` components,
+// each with the same area in both shapes (within 2%): every part meshed onto its own image.
+void ExpectPartsKeepTheirArea(const std::vector<Drawing>& drawings,
+                              const std::vector<std::vector<Point>>& marks, size_t parts) {
+  MultimeshOptions options;
+  options.marks = marks;
+  options.max_edge_relative = 0.1;
+  absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, options);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
+  const std::vector<std::vector<double>> areas = ComponentAreas(*mesh);
+  ASSERT_EQ(areas.size(), parts);
+  for (const std::vector<double>& a : areas) EXPECT_NEAR(a[1] / a[0], 1.0, 0.02) << a[0];
+}
+
 // A rearranged drawing pairs each part with its image. Three discs of radius 6, 10 and 14, and
 // the same three turned by 120 degrees about the middle, sheared and moved, so that each place
 // holds another disc: by place (the bounding-box normalisation alone) the small disc would pair
@@ -1100,14 +1115,7 @@ TEST(BoundaryReparamCountsTest, RearrangedComponentsPairWithTheirImages) {
     for (const auto& [first, second] : GroupRadii(*s)) {
       EXPECT_NEAR(second / first, 1.0, shear > 0 ? 0.1 : 0.01);
     }
-    MultimeshOptions options;
-    options.max_edge_relative = 0.1;
-    absl::StatusOr<Multimesh> mesh = BuildMultimesh({discs, turned}, options);
-    ASSERT_TRUE(mesh.ok()) << mesh.status();
-    EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
-    const std::vector<std::vector<double>> areas = ComponentAreas(*mesh);
-    ASSERT_EQ(areas.size(), 3u);
-    for (const std::vector<double>& a : areas) EXPECT_NEAR(a[1] / a[0], 1.0, 0.02) << a[0];
+    ExpectPartsKeepTheirArea({discs, turned}, {}, 3);
   }
 }
 
@@ -1162,15 +1170,7 @@ TEST(BoundaryReparamCountsTest, MarksPairComponents) {
   EXPECT_EQ(CountMarks(s->views), 1);
   for (const auto& [first, second] : GroupRadii(*s)) EXPECT_NEAR(first, second, 0.1);
 
-  MultimeshOptions options;
-  options.marks = marks;
-  options.max_edge_relative = 0.1;
-  absl::StatusOr<Multimesh> mesh = BuildMultimesh({discs, swapped}, options);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
-  EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
-  const std::vector<std::vector<double>> areas = ComponentAreas(*mesh);
-  ASSERT_EQ(areas.size(), 2u);
-  for (const std::vector<double>& a : areas) EXPECT_NEAR(a[1] / a[0], 1.0, 0.02) << a[0];
+  ExpectPartsKeepTheirArea({discs, swapped}, marks, 2);
 }
 
 // Marks decide which holes pair: a plate with a small hole on the left and a large one on the
