@@ -13,6 +13,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "solver/geometry/affine_fit.h"
 #include "solver/geometry/polygon.h"
 #include "solver/geometry/resample_outline.h"
 
@@ -271,12 +272,6 @@ std::vector<int> Assign(const std::vector<std::vector<double>>& cost) {
   return best;
 }
 
-// An affine map p -> m p + t of drawing 1 into another drawing.
-struct Affine {
-  Eigen::Matrix2d m = Eigen::Matrix2d::Identity();
-  Point t = Point::Zero();
-};
-
 // Best start (arc length) of `b` against `a` (both normalised): turning angle + position. With
 // `carry`, `a` is first carried into b's drawing by that map (and normalised as b).
 double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, const Point& cb,
@@ -320,25 +315,6 @@ double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, co
     if (cost < best_cost) best_cost = cost, best = s;
   }
   return b.length() * best / m;
-}
-
-// The least-squares affine map p -> m p + t taking each pair's first point to its second.
-// False when it is singular or reverses orientation.
-bool FitAffine(const std::vector<std::pair<Point, Point>>& pairs, Affine* fit) {
-  if (pairs.empty()) return false;
-  Point ca = Point::Zero(), cb = Point::Zero();
-  for (const auto& [a, b] : pairs) ca += a, cb += b;
-  ca /= static_cast<double>(pairs.size());
-  cb /= static_cast<double>(pairs.size());
-  Eigen::Matrix2d aa = Eigen::Matrix2d::Zero(), ba = Eigen::Matrix2d::Zero();
-  for (const auto& [a, b] : pairs) {
-    aa += (a - ca) * (a - ca).transpose();
-    ba += (b - cb) * (a - ca).transpose();
-  }
-  if (!(std::abs(aa.determinant()) > 1e-12 * aa.squaredNorm())) return false;
-  fit->m = ba * aa.inverse();
-  fit->t = cb - fit->m * ca;
-  return fit->m.allFinite() && fit->t.allFinite() && fit->m.determinant() > 0.0;
 }
 
 // The affine fit of outline `a` (drawing 1) onto outline `b` (another drawing), the two sampled

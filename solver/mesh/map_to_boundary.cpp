@@ -30,6 +30,7 @@
 #include "absl/strings/str_cat.h"
 #include "solver/core/sparse_cholesky.h"
 #include "solver/core/sparse_lu.h"
+#include "solver/geometry/affine_fit.h"
 #include "solver/geometry/polygon.h"
 #include "solver/mesh/validate.h"
 
@@ -407,25 +408,17 @@ absl::Status TutteEmbedding(const Points& source, const std::vector<Triangle>& t
 
 // The least-squares affine map of the source boundary onto the target boundary, applied to every
 // vertex: when the target is (close to) an affine image of the source, a start that is already
-// (close to) done. False when that map reverses orientation or folds a triangle.
+// (close to) done (FitAffine). False when there is no such map (FitAffine) or it folds a triangle.
 bool AffineStart(const Points& source, const std::vector<Triangle>& triangles,
                  const std::vector<int>& boundary, const Points& target_boundary, Points* out) {
-  const int m = static_cast<int>(boundary.size());
-  Point cs = Point::Zero(), ct = Point::Zero();
-  for (int k = 0; k < m; ++k) cs += source[boundary[k]], ct += target_boundary[k];
-  cs /= m;
-  ct /= m;
-  Eigen::Matrix2d ss = Eigen::Matrix2d::Zero(), ts = Eigen::Matrix2d::Zero();
-  for (int k = 0; k < m; ++k) {
-    const Point a = source[boundary[k]] - cs, b = target_boundary[k] - ct;
-    ss += a * a.transpose();
-    ts += b * a.transpose();
+  Affine map;
+  if (!FitAffine(
+          static_cast<int>(boundary.size()), [&](int k) { return source[boundary[k]]; },
+          [&](int k) { return target_boundary[k]; }, &map)) {
+    return false;
   }
-  if (!(std::abs(ss.determinant()) > 1e-300)) return false;
-  const Eigen::Matrix2d map = ts * ss.inverse();
-  if (!map.allFinite() || !(map.determinant() > 0.0)) return false;
   out->resize(source.size());
-  for (size_t v = 0; v < source.size(); ++v) (*out)[v] = ct + map * (source[v] - cs);
+  for (size_t v = 0; v < source.size(); ++v) (*out)[v] = map(source[v]);
   return CountInverted(triangles, *out) == 0;
 }
 
