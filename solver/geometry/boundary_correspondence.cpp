@@ -22,8 +22,10 @@ namespace {
 
 constexpr int kDefaultVertices = 64;
 constexpr int kAlignSamples = 128;
-// Rounds of matching holes again by the affine fit of the matched holes' centroids.
-constexpr int kMaxHoleRematches = 4;
+// Rounds of matching loops again by the affine fit of the matched loops' centroids (each round
+// stops early once the match settles; a 30 x 30 grid of parts under a shear settles in 16, and 4
+// left most of it paired with neighbours).
+constexpr int kMaxHoleRematches = 16;
 // Turns of the outline's affine map tried as starts of the hole matching (MatchHoles).
 constexpr int kRotationHypotheses = 24;
 // Above this many holes only the outline's map itself is refitted (each turn costs a few
@@ -31,11 +33,10 @@ constexpr int kRotationHypotheses = 24;
 constexpr size_t kMaxHolesForTurns = 64;
 // Holes' centroids spread less than this across their main direction do not fix an affine map.
 constexpr double kMinHoleSpread = 0.1;
-// Matches from turned maps that score within this factor of the best (plus a floor of
-// kScoreFloor times the drawing's squared diagonal per loop) are equally good: of those, the one
-// that turns least from the first candidate's map wins (ChooseMatch).
+// Matches from turned maps that score within this factor of the best (plus the scores' sampling
+// floor, SamplingFloor) are equally good: of those, the one that turns least from the first
+// candidate's map wins (ChooseMatch).
 constexpr double kScoreTie = 1.5;
-constexpr double kScoreFloor = 1e-4;
 constexpr double kSameT = 1e-9;
 
 double Wrap01(double t) {
@@ -452,6 +453,22 @@ HoleMatch MatchLoopsFrom(const LoopSet& from, const LoopSet& to, int outline0, i
 // rotation.
 double TurnOf(const Affine& a) { return std::atan2(a.m(1, 0) - a.m(0, 1), a.m(0, 0) + a.m(1, 1)); }
 
+// What a match's score (CarriedDistance, summed) may hold of the sampling alone: per loop scored
+// in the other drawing, its squared arc-length step between samples. Summed like the scores, so
+// that many loops' noise stays within it, but far below what one loop paired with a neighbour
+// adds (a floor of a fixed share of the squared diagonal per loop hid that on grids of hundreds
+// of holes, and the outline's unrefitted map won there).
+double SamplingFloor(const LoopSet& to, const std::vector<int>& loops, int outline) {
+  double floor = 0.0;
+  auto add = [&](int l) {
+    const double step = (*to.curves)[l].length() / kAlignSamples;
+    floor += step * step;
+  };
+  for (const int l : loops) add(l);
+  if (outline >= 0) add(outline);
+  return floor;
+}
+
 // Of matches from turned maps (candidates[0]: the unturned start), the one whose map turns least
 // from candidates[0]'s among those scoring at most kScoreTie times the best score plus `floor`.
 // A symmetric layout (four equal dots in a square) is fitted as well by a map a quarter turn off
@@ -521,8 +538,7 @@ HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int o
       candidates.push_back(
           MatchLoopsFrom(from, to, outline0, outline, holes0, holes, pins, {}, turned, true));
     }
-    return ChooseMatch(std::move(candidates),
-                       kScoreFloor * to.scale * to.scale * static_cast<double>(holes0.size() + 1));
+    return ChooseMatch(std::move(candidates), SamplingFloor(to, holes, outline));
   }
   std::vector<std::vector<double>> cost(holes0.size(), std::vector<double>(holes.size()));
   for (size_t i = 0; i < holes0.size(); ++i) {
@@ -831,8 +847,7 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
         candidates.push_back(MatchLoopsFrom(from, to, -1, -1, outer0, outer, component_pins[d],
                                             same_holes, turned, /*refit=*/true));
       }
-      const double floor = kScoreFloor * scale[d] * scale[d] * static_cast<double>(outer0.size());
-      assignment = ChooseMatch(std::move(candidates), floor).assignment;
+      assignment = ChooseMatch(std::move(candidates), SamplingFloor(to, outer, -1)).assignment;
     }
     for (size_t i = 0; i < outer0.size(); ++i) component_match[d].push_back(outer[assignment[i]]);
   }
