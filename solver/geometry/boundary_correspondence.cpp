@@ -504,14 +504,37 @@ bool SpreadInTheFlat(const std::vector<Point>& points) {
   return eig(1) > 0.0 && eig(0) >= kMinHoleSpread * kMinHoleSpread * eig(1);
 }
 
+// `first` (the match from the map `start` itself) against the matches from `start` turned about
+// `c` by each of kRotationHypotheses steps of the full turn (only unturned above
+// kMaxHolesForTurns loops) and refitted to the matched centroids (MatchLoopsFrom): the one
+// ChooseMatch picks.
+HoleMatch MatchTurned(const LoopSet& from, const LoopSet& to, int outline0, int outline,
+                      const std::vector<int>& loops0, const std::vector<int>& loops,
+                      const Pins& pins, const Allowed& allowed, const Affine& start, const Point& c,
+                      HoleMatch first) {
+  std::vector<HoleMatch> candidates;
+  candidates.push_back(std::move(first));
+  const int turns = loops0.size() <= kMaxHolesForTurns ? kRotationHypotheses : 1;
+  for (int j = 0; j < turns; ++j) {
+    const double angle = 2.0 * std::numbers::pi * j / kRotationHypotheses;
+    const Eigen::Matrix2d r{{std::cos(angle), -std::sin(angle)},
+                            {std::sin(angle), std::cos(angle)}};
+    // p -> start(c + r (p - c))
+    const Affine turned{start.m * r, start.m * (c - r * c) + start.t};
+    candidates.push_back(MatchLoopsFrom(from, to, outline0, outline, loops0, loops, pins, allowed,
+                                        turned, /*refit=*/true));
+  }
+  return ChooseMatch(std::move(candidates), SamplingFloor(to, loops, outline));
+}
+
 // The holes of drawing 1's component (outline0, holes0) matched to those of its match in another
 // drawing (outline, holes). Drawing 1's holes are carried by the least-squares affine map of the
 // outline onto its match (so a sheared, rotated copy matches hole to hole where the bounding
 // boxes pair neighbours; MatchLoopsFrom). An outline alone may not fix the map (a round one: any
 // rotation fits it), so when the holes' centroids spread in both directions (SpreadInTheFlat)
 // the map is also refitted to them, starting from the outline's map turned about the outline's
-// centroid by each of kRotationHypotheses steps of the full turn (only unturned above
-// kMaxHolesForTurns holes), and the best score wins (the outline's own map on ties). Without a
+// centroid (MatchTurned, ChooseMatch: of the candidates that score about as well as the best, the
+// one turning least from the outline's map). Without a
 // map (drawing 1 itself, or a degenerate fit), the centroids are compared in the bounding-box
 // normalisation.
 HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int outline,
@@ -522,23 +545,13 @@ HoleMatch MatchHoles(const LoopSet& from, const LoopSet& to, int outline0, int o
   Affine carry;
   if (fit && !holes0.empty() &&
       OutlineAffine(a, b, AlignStart(a, b, from.centre, from.scale, to.centre, to.scale), &carry)) {
-    std::vector<HoleMatch> candidates = {
-        MatchLoopsFrom(from, to, outline0, outline, holes0, holes, pins, {}, carry, false)};
+    HoleMatch unturned =
+        MatchLoopsFrom(from, to, outline0, outline, holes0, holes, pins, {}, carry, false);
     std::vector<Point> centroids0;
     for (const int h : holes0) centroids0.push_back(from.Raw(h));
-    if (!SpreadInTheFlat(centroids0)) return std::move(candidates[0]);
-    const Point c0 = from.Raw(outline0);
-    const int turns = holes0.size() <= kMaxHolesForTurns ? kRotationHypotheses : 1;
-    for (int j = 0; j < turns; ++j) {
-      const double angle = 2.0 * std::numbers::pi * j / kRotationHypotheses;
-      const Eigen::Matrix2d r{{std::cos(angle), -std::sin(angle)},
-                              {std::sin(angle), std::cos(angle)}};
-      // p -> carry(c0 + r (p - c0))
-      const Affine turned{carry.m * r, carry.m * (c0 - r * c0) + carry.t};
-      candidates.push_back(
-          MatchLoopsFrom(from, to, outline0, outline, holes0, holes, pins, {}, turned, true));
-    }
-    return ChooseMatch(std::move(candidates), SamplingFloor(to, holes, outline));
+    if (!SpreadInTheFlat(centroids0)) return unturned;
+    return MatchTurned(from, to, outline0, outline, holes0, holes, pins, {}, carry,
+                       from.Raw(outline0), std::move(unturned));
   }
   std::vector<std::vector<double>> cost(holes0.size(), std::vector<double>(holes.size()));
   for (size_t i = 0; i < holes0.size(); ++i) {
@@ -800,8 +813,9 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
   };
   const std::vector<int> outer0 = loops_of(0, 0, true);
   std::vector<std::vector<int>> component_match(num_shapes);  // [d][c0] -> outer loop in d
-  std::vector<Point> centroids0;                              // drawing 1's components, as drawn
-  for (const int l : outer0) centroids0.push_back(centre[0] + scale[0] * centroid[0][l]);
+  const LoopSet from0{&curves[0], &centroid[0], centre[0], scale[0]};
+  std::vector<Point> centroids0;  // drawing 1's components, as drawn
+  for (const int l : outer0) centroids0.push_back(from0.Raw(l));
   for (int d = 0; d < num_shapes; ++d) {
     const std::vector<int> outer = loops_of(d, 0, true);
     Allowed same_holes(outer0.size(), std::vector<bool>(outer.size()));
@@ -821,33 +835,22 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     std::vector<int> assignment = Assign(cost);
     if (d > 0 && SpreadInTheFlat(centroids0)) {
       // Components spread across the drawing: drawing 1's placement in drawing d's bounding box
-      // (the match above), against that placement turned about drawing 1's centre by each of
-      // kRotationHypotheses steps and refitted to the matched centroids (only unturned above
-      // kMaxHolesForTurns components), the best by how far the carried outlines lie from their
-      // matches (the placement on ties): a rearranged drawing (a turned copy) pairs each part
-      // with its image, not with whichever part now sits where it sat.
-      const LoopSet from{&curves[0], &centroid[0], centre[0], scale[0]};
+      // (the match above) against that placement turned about drawing 1's centre and refitted
+      // (MatchTurned): a rearranged drawing (a turned copy) pairs each part with its image, not
+      // with whichever part now sits where it sat.
       const LoopSet to{&curves[d], &centroid[d], centre[d], scale[d]};
       const double s = scale[d] / scale[0];
       const Affine place{s * Eigen::Matrix2d::Identity(), centre[d] - s * centre[0]};
-      std::vector<HoleMatch> candidates(1);  // the placement's own match (above), under `place`
-      candidates[0].assignment = assignment;
-      candidates[0].carry = place;
-      candidates[0].score = 0.0;
+      HoleMatch placed;  // the placement's own match (above), scored under `place`
+      placed.assignment = assignment;
+      placed.carry = place;
+      placed.score = 0.0;
       for (size_t i = 0; i < outer0.size(); ++i) {
-        candidates[0].score += CarriedDistance(from, to, outer0[i], outer[assignment[i]], place);
+        placed.score += CarriedDistance(from0, to, outer0[i], outer[assignment[i]], place);
       }
-      const int turns = outer0.size() <= kMaxHolesForTurns ? kRotationHypotheses : 1;
-      for (int j = 0; j < turns; ++j) {
-        const double angle = 2.0 * std::numbers::pi * j / kRotationHypotheses;
-        const Eigen::Matrix2d r{{std::cos(angle), -std::sin(angle)},
-                                {std::sin(angle), std::cos(angle)}};
-        // p -> place(c + r (p - c)), c drawing 1's centre
-        const Affine turned{place.m * r, place.m * (centre[0] - r * centre[0]) + place.t};
-        candidates.push_back(MatchLoopsFrom(from, to, -1, -1, outer0, outer, component_pins[d],
-                                            same_holes, turned, /*refit=*/true));
-      }
-      assignment = ChooseMatch(std::move(candidates), SamplingFloor(to, outer, -1)).assignment;
+      assignment = MatchTurned(from0, to, -1, -1, outer0, outer, component_pins[d], same_holes,
+                               place, centre[0], std::move(placed))
+                       .assignment;
     }
     for (size_t i = 0; i < outer0.size(); ++i) component_match[d].push_back(outer[assignment[i]]);
   }
@@ -878,9 +881,8 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     std::vector<std::vector<int>> hole_match(num_shapes);
     std::vector<std::optional<Affine>> carry(num_shapes);
     for (int d = 0; d < num_shapes; ++d) {
-      const LoopSet from{&curves[0], &centroid[0], centre[0], scale[0]};
       const LoopSet to{&curves[d], &centroid[d], centre[d], scale[d]};
-      HoleMatch match = MatchHoles(from, to, g[0], g[d], holes[0], holes[d], loop_pins[d], d > 0);
+      HoleMatch match = MatchHoles(from0, to, g[0], g[d], holes[0], holes[d], loop_pins[d], d > 0);
       carry[d] = match.carry;
       for (size_t a = 0; a < holes[0].size(); ++a) {
         hole_match[d].push_back(holes[d][match.assignment[a]]);
