@@ -13,6 +13,7 @@
 #include "solver/comesh/comesh_optimizer.h"
 #include "solver/core/retain_memory.h"
 #include "solver/mesh/build_multimesh.h"
+#include "tests/unit/solver/comesh/comesh_test_meshes.h"
 
 namespace inbetween::bench {
 
@@ -217,6 +218,22 @@ inline nlohmann::json ComeshRow(const std::string& name, const solver::ComeshRep
             {"line_search", r.phase_seconds.line_search},
             {"relax", r.phase_seconds.relax},
             {"topology", r.phase_seconds.topology}}}};
+}
+
+// S-Tables 1 and 2's drawings: the unit square and a regular hexagon inside it.
+inline std::vector<solver::Drawing> SquareHexagon() {
+  return {solver::testing::UnitSquare(),
+          solver::testing::RegularPolygon(6, 0.6, solver::Point(0.5, 0.5))};
+}
+
+// BuildMultimesh of `drawings` at the boundary count and edge bound SizeFor gave (other options
+// default): the uniform meshes of the comesh tables.
+inline absl::StatusOr<solver::Multimesh> BuildSized(const std::vector<solver::Drawing>& drawings,
+                                                    const solver::testing::SizedMeshOptions& size) {
+  solver::MultimeshOptions options;
+  options.boundary_vertices = size.boundary_vertices;
+  options.max_edge_relative = size.max_edge_relative;
+  return solver::BuildMultimesh(drawings, options);
 }
 
 inline void WriteRows(const std::string& path, const nlohmann::json& rows) {

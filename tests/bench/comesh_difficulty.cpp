@@ -44,10 +44,7 @@ int main(int argc, char** argv) {
         sv::testing::Star(1.0, kInnerRatio[h], c)};
     const auto size = sv::testing::SizeFor(paper.before, 5 * 2 * std::sin(std::numbers::pi / 5),
                                            2.0, pentagon_area);
-    sv::MultimeshOptions mesh_options;
-    mesh_options.boundary_vertices = size.boundary_vertices;
-    mesh_options.max_edge_relative = size.max_edge_relative;
-    absl::StatusOr<sv::Multimesh> mesh = sv::BuildMultimesh(drawings, mesh_options);
+    absl::StatusOr<sv::Multimesh> mesh = inbetween::bench::BuildSized(drawings, size);
     const std::string name = "hard" + std::to_string(h + 1);
     if (!mesh.ok()) {
       std::fprintf(stderr, "%s: %s\n", name.c_str(), mesh.status().ToString().c_str());

@@ -38,8 +38,7 @@ int main(int argc, char** argv) {
   const inbetween::bench::ComeshBenchArgs args = inbetween::bench::ParseComeshBenchArgs(
       static_cast<int>(rest.size()), rest.data(), /*with_max_vertices=*/false);
   const sv::ComeshOptions& options = args.options;
-  const std::vector<sv::Drawing> drawings = {
-      sv::testing::UnitSquare(), sv::testing::RegularPolygon(6, 0.6, sv::Point(0.5, 0.5))};
+  const std::vector<sv::Drawing> drawings = inbetween::bench::SquareHexagon();
   std::printf("weight %.4f, line %.4f\n", options.map_weight, line);
   std::printf("%-30s %9s %11s %9s %8s %8s\n", "case", "boundary", "vertices", "seconds", "map",
               "mesh");
@@ -48,10 +47,7 @@ int main(int argc, char** argv) {
   for (int target : {80, 98, 120, 140, 160, 180, 200, 230, 260, 300}) {
     for (double perimeter : {3.0, 4.0, 5.0}) {
       const auto size = sv::testing::SizeFor(target, perimeter, std::sqrt(2.0), 1.0);
-      sv::MultimeshOptions mesh_options;
-      mesh_options.boundary_vertices = size.boundary_vertices;
-      mesh_options.max_edge_relative = size.max_edge_relative;
-      const absl::StatusOr<sv::Multimesh> mesh = sv::BuildMultimesh(drawings, mesh_options);
+      const absl::StatusOr<sv::Multimesh> mesh = inbetween::bench::BuildSized(drawings, size);
       if (!mesh.ok()) {
         std::fprintf(stderr, "%d vertices: %s\n", target, mesh.status().ToString().c_str());
         return 1;
@@ -65,9 +61,8 @@ int main(int argc, char** argv) {
       }
       const std::string name = "square-hexagon-res" + std::to_string(target) + "-b" +
                                std::to_string(size.boundary_vertices);
-      std::printf("%-30s %9d %5d/%-5d %9.3f %8.4f %8.4f\n", name.c_str(),
-                  size.boundary_vertices, r.vertices_before, r.vertices_after, r.seconds,
-                  r.map_energy, r.mesh_energy);
+      std::printf("%-30s %9d %5d/%-5d %9.3f %8.4f %8.4f\n", name.c_str(), size.boundary_vertices,
+                  r.vertices_before, r.vertices_after, r.seconds, r.map_energy, r.mesh_energy);
       nlohmann::json row = inbetween::bench::ComeshRow(name, r, /*paper_seconds=*/0.0);
       row.erase("paper_seconds");  // no paper row at these counts
       row["boundary_vertices"] = size.boundary_vertices;

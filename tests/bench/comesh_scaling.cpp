@@ -140,8 +140,7 @@ int main(int argc, char** argv) {
   std::printf("%-22s %13s %13s %11s %11s %6s %9s %9s %7s %7s %7s\n", "case", "ver ours",
               "ver paper", "inner o/p", "outer o/p", "evals", "seconds", "paper_s", "ratio", "map",
               "mesh");
-  const std::vector<sv::Drawing> drawings = {
-      sv::testing::UnitSquare(), sv::testing::RegularPolygon(6, 0.6, sv::Point(0.5, 0.5))};
+  const std::vector<sv::Drawing> drawings = inbetween::bench::SquareHexagon();
   for (const PaperRow& paper : kPaper) {
     if (paper.before > args.max_vertices) break;
     if (paper.before < args.min_vertices) continue;
@@ -164,16 +163,13 @@ int main(int argc, char** argv) {
       double request = paper.before;
       std::optional<sv::Multimesh> closest;
       for (int attempt = 0; attempt < kAttempts; ++attempt) {
-        const auto size = sv::testing::SizeFor(static_cast<int>(std::lround(request)), 4.0,
-                                               std::sqrt(2.0), 1.0);
-        sv::MultimeshOptions mesh_options;
-        mesh_options.boundary_vertices = size.boundary_vertices;
-        mesh_options.max_edge_relative = size.max_edge_relative;
-        mesh = sv::BuildMultimesh(drawings, mesh_options);
+        const auto size =
+            sv::testing::SizeFor(static_cast<int>(std::lround(request)), 4.0, std::sqrt(2.0), 1.0);
+        mesh = inbetween::bench::BuildSized(drawings, size);
         if (!mesh.ok()) break;
         const double got = mesh->num_vertices();
-        if (!closest || std::abs(got - paper.before) <
-                            std::abs(closest->num_vertices() - paper.before)) {
+        if (!closest ||
+            std::abs(got - paper.before) < std::abs(closest->num_vertices() - paper.before)) {
           closest = *std::move(mesh);  // `mesh` is rebuilt or replaced by `closest` below
         }
         if (std::abs(got - paper.before) <= 0.03 * paper.before) break;

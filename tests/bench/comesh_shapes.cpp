@@ -82,10 +82,7 @@ int main(int argc, char** argv) {
     std::vector<sv::Drawing> drawings(poses.begin(), poses.begin() + paper.shapes);
     if (pair >= 0) drawings = {poses[0], poses[pair]};
     if (pair2 >= 0) drawings.push_back(poses[pair2]);
-    sv::MultimeshOptions mesh_options;
-    mesh_options.boundary_vertices = size.boundary_vertices;
-    mesh_options.max_edge_relative = size.max_edge_relative;
-    absl::StatusOr<sv::Multimesh> mesh = sv::BuildMultimesh(drawings, mesh_options);
+    absl::StatusOr<sv::Multimesh> mesh = inbetween::bench::BuildSized(drawings, size);
     if (!mesh.ok()) {  // reported as a failed row; the other rows still run
       std::printf("%-7d multimesh failed: %s\n", paper.shapes, mesh.status().ToString().c_str());
       rows.push_back({{"case", "walk-" + std::to_string(paper.shapes) + "-shapes"},

@@ -42,13 +42,9 @@ int main(int argc, char** argv) {
       inbetween::bench::ParseComeshBenchArgs(argc, argv, /*with_max_vertices=*/false);
   sv::ComeshOptions& options = args.options;
   const sv::ProgressFn progress = inbetween::bench::VerboseProgress(args.verbose);
-  const std::vector<sv::Drawing> drawings = {
-      sv::testing::UnitSquare(), sv::testing::RegularPolygon(6, 0.6, sv::Point(0.5, 0.5))};
+  const std::vector<sv::Drawing> drawings = inbetween::bench::SquareHexagon();
   const auto size = sv::testing::SizeFor(467, 4.0, std::sqrt(2.0), 1.0);
-  sv::MultimeshOptions uniform_options;
-  uniform_options.boundary_vertices = size.boundary_vertices;
-  uniform_options.max_edge_relative = size.max_edge_relative;
-  absl::StatusOr<sv::Multimesh> uniform = sv::BuildMultimesh(drawings, uniform_options);
+  absl::StatusOr<sv::Multimesh> uniform = inbetween::bench::BuildSized(drawings, size);
   if (!uniform.ok()) {
     std::fprintf(stderr, "%s\n", uniform.status().ToString().c_str());
     return 1;
@@ -72,7 +68,7 @@ int main(int argc, char** argv) {
   }
   nlohmann::json rows = nlohmann::json::array();
   const std::pair<const char*, const sv::Multimesh*> starts[] = {{"uniform", &*uniform},
-                                                                  {"graded", &*graded}};
+                                                                 {"graded", &*graded}};
   for (const auto& [start, mesh] : starts) {
     std::printf("%s start (%d vertices, %zu on the boundary)\n", start, mesh->num_vertices(),
                 mesh->boundary.size());
@@ -95,8 +91,8 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
       const std::string prefix =
           std::string(start) == "graded" ? "square-hexagon-graded-w" : "square-hexagon-w";
-      rows.push_back(inbetween::bench::ComeshRow(
-          prefix + std::to_string(paper.weight).substr(0, 4), r, paper.seconds));
+      rows.push_back(inbetween::bench::ComeshRow(prefix + std::to_string(paper.weight).substr(0, 4),
+                                                 r, paper.seconds));
     }
   }
   inbetween::bench::WriteRows(args.json_path, rows);
