@@ -1,14 +1,14 @@
 // Value types shared by every solver stage: points, polylines, drawings, triangles.
 #pragma once
 
-#include <Eigen/Core>
 #include <array>
 #include <vector>
 
+#include "solver/core/art.h"
+#include "solver/core/point.h"
+
 namespace inbetween::solver {
 
-using Point = Eigen::Vector2d;
-using Points = std::vector<Point>;
 // Orientation convention, used everywhere: "positive" means positive signed area by the usual
 // formula 0.5 * sum(x_i * y_{i+1} - x_{i+1} * y_i) in the drawing's own coordinates (SVG user
 // units, y pointing down, so positive looks clockwise on screen). Every triangle of every shape
@@ -38,6 +38,9 @@ struct Drawing {
   // Correspondence marks drawn with the drawing (e.g. SVG data-corr="N" elements), in document
   // order. Used by BuildMultimesh when MultimeshOptions::marks is empty.
   std::vector<CorrespondenceMark> marks;
+  // The drawing's painted layers in paint order (SVG sources; empty for polylines). The outlines
+  // are the boundary of their union, or of the class="outline" elements (svg_import.h).
+  std::vector<ArtLayer> art;
 };
 
 }  // namespace inbetween::solver

@@ -1,6 +1,7 @@
 // Basic predicates on closed polygons: signed area, containment, convexity, self-intersection.
 #include "solver/geometry/polygon.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -100,13 +101,21 @@ std::optional<SelfIntersection> FindSelfIntersection(const Points& polygon, int6
 void OrientByNesting(std::vector<Outline>* outlines) {
   const size_t n = outlines->size();
   std::vector<bool> hole(n, false);
+  // Bounding boxes first: a point outside an outline's box is outside the outline (drawings of
+  // thousands of separate shapes test each point against a few boxes, not every outline).
+  std::vector<Eigen::AlignedBox2d> boxes(n);
+  for (size_t j = 0; j < n; ++j) {
+    for (const Point& q : (*outlines)[j].points) boxes[j].extend(q);
+  }
   for (size_t i = 0; i < n; ++i) {
     int depth = 0;
     // Test a point just inside the first edge to avoid vertices shared with other outlines.
     const Points& p = (*outlines)[i].points;
     const Point probe = p[0] + 1e-9 * (p[1] - p[0]);
     for (size_t j = 0; j < n; ++j) {
-      if (j != i && PolygonContains((*outlines)[j].points, probe)) ++depth;
+      if (j != i && boxes[j].contains(probe) && PolygonContains((*outlines)[j].points, probe)) {
+        ++depth;
+      }
     }
     hole[i] = depth % 2 == 1;
   }

@@ -20,6 +20,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -28,13 +29,17 @@
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
+#include <Eigen/Geometry>
 #include <svgpp/policy/xml/libxml2.hpp>
 #include <svgpp/svgpp.hpp>
 
 #include "absl/status/status.h"
+#include "absl/strings/ascii.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "solver/geometry/polygon.h"
+#include "solver/io/paint_union.h"
 
 namespace inbetween::solver {
 namespace {
@@ -98,18 +103,39 @@ void FlattenCubic(const Point& p0, const Point& p1, const Point& p2, const Point
   FlattenCubic(mid, p123, p23, p3, tolerance, depth + 1, out);
 }
 
-// Where finished outlines go, in document order.
+// The document has more than SvgImportOptions::max_layers painted layers.
+struct TooManyLayers : ImportError {
+  explicit TooManyLayers(std::string m) : ImportError(std::move(m)) {}
+};
+
+// The mean colour of a gradient's stops (the art model keeps plain colours), or nullopt when
+// it has none (SVG paints a gradient without stops as "none").
+struct GradientColour {
+  std::optional<uint32_t> rgb;
+  double opacity = 1.0;
+};
+
+// Where finished outlines and layers go, in document order.
 struct Collector {
   double tolerance = 0.05;
   size_t max_points = 1'000'000;
+  size_t max_layers = 100'000;
   size_t raw_points = 0;   // points written in path data so far
   size_t flat_points = 0;  // points after flattening so far
+  // The filled elements' own outlines (the one-colour convention: SilhouetteSource::kElements).
   std::vector<Outline> outlines;
+  std::vector<ArtLayer> art;              // painted elements, in paint order
+  std::vector<ArtLayer> outline_class;    // class="outline" elements, as filled shapes
+  bool stroked = false;                   // some layer has a visible stroke
   std::vector<Points> cuts, openings;     // from class="cut" / class="opening" elements
   std::vector<CorrespondenceMark> marks;  // from data-corr="N" elements
   // The explicit fill of the filled element with the largest outline (SvgImportInfo::fill_rgb).
   double largest_area = 0;
   std::optional<uint32_t> largest_fill;
+  std::vector<std::string> warnings;
+  // Elements by id (paint servers are looked up here) and the gradients resolved so far.
+  std::map<std::string, xmlNode*> by_id;
+  std::map<std::string, GradientColour> gradients;
 };
 
 // The value of attribute `name`, or nullopt.
@@ -119,6 +145,17 @@ std::optional<std::string> Attribute(xmlNode* node, const char* name) {
   std::string out = reinterpret_cast<const char*>(value);
   xmlFree(value);
   return out;
+}
+
+// A <use>'s or gradient's href (or xlink:href).
+std::optional<std::string> UseHref(xmlNode* use) {
+  std::optional<std::string> href = Attribute(use, "href");
+  if (!href) {
+    xmlChar* x = xmlGetNsProp(use, reinterpret_cast<const xmlChar*>("href"),
+                              reinterpret_cast<const xmlChar*>("http://www.w3.org/1999/xlink"));
+    if (x != nullptr) href = reinterpret_cast<const char*>(x), xmlFree(x);
+  }
+  return href;
 }
 
 // Whether the element's class attribute lists `token` (whitespace-separated).
@@ -139,6 +176,100 @@ bool HasClass(xmlNode* node, const std::string& token) {
   return false;
 }
 
+// The value of a presentation property: its attribute, or its declaration in style="" (which
+// takes precedence, as CSS does over presentation attributes).
+std::optional<std::string> Property(xmlNode* node, const char* name) {
+  std::optional<std::string> value = Attribute(node, name);
+  if (std::optional<std::string> style = Attribute(node, "style")) {
+    for (absl::string_view declaration : absl::StrSplit(*style, ';')) {
+      const size_t colon = declaration.find(':');
+      if (colon == absl::string_view::npos) continue;
+      if (absl::StripAsciiWhitespace(declaration.substr(0, colon)) == name) {
+        value = std::string(absl::StripAsciiWhitespace(declaration.substr(colon + 1)));
+      }
+    }
+  }
+  return value;
+}
+
+// Receives one colour from SVG++'s colour grammar.
+struct ColourSink {
+  std::optional<uint32_t> rgb;
+  void set(sv::tag::attribute::stop_color, int value) {
+    rgb = static_cast<uint32_t>(value) & 0xffffffu;
+  }
+  template <class... Args>
+  void set(sv::tag::attribute::stop_color, Args&&...) {}
+};
+
+// A colour written as SVG writes it (#rgb, #rrggbb, rgb(), a colour keyword), parsed by SVG++.
+std::optional<uint32_t> ParseColour(const std::string& text) {
+  ColourSink sink;
+  try {
+    sv::value_parser<sv::tag::type::color>::parse(sv::tag::attribute::stop_color(), sink, text,
+                                                  sv::tag::source::attribute());
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return sink.rgb;
+}
+
+// A gradient's stops, following href to the gradient that holds them (up to kMaxUseDepth).
+GradientColour MeanOfStops(xmlNode* gradient, const std::map<std::string, xmlNode*>& by_id) {
+  for (int depth = 0; gradient != nullptr && depth < kMaxUseDepth; ++depth) {
+    double r = 0, g = 0, b = 0, weight = 0, opacity = 0;
+    int stops = 0;
+    for (xmlNode* child = gradient->children; child != nullptr; child = child->next) {
+      if (child->type != XML_ELEMENT_NODE ||
+          xmlStrcmp(child->name, reinterpret_cast<const xmlChar*>("stop")) != 0) {
+        continue;
+      }
+      ++stops;
+      const uint32_t rgb = ParseColour(Property(child, "stop-color").value_or("black")).value_or(0);
+      double alpha = 1.0;
+      if (std::optional<std::string> a = Property(child, "stop-opacity")) {
+        if (!absl::SimpleAtod(*a, &alpha) || !std::isfinite(alpha)) alpha = 1.0;
+      }
+      alpha = std::clamp(alpha, 0.0, 1.0);
+      // Colours averaged weighted by their opacity (a transparent stop adds no colour).
+      const double w = std::max(alpha, 1e-6);
+      r += w * ((rgb >> 16) & 0xff), g += w * ((rgb >> 8) & 0xff), b += w * (rgb & 0xff);
+      weight += w;
+      opacity += alpha;
+    }
+    if (stops > 0) {
+      auto channel = [&](double v) {
+        return static_cast<uint32_t>(std::clamp(std::lround(v / weight), 0L, 255L));
+      };
+      return {(channel(r) << 16) | (channel(g) << 8) | channel(b), opacity / stops};
+    }
+    std::optional<std::string> href = UseHref(gradient);
+    if (!href || href->size() < 2 || (*href)[0] != '#') break;
+    auto it = by_id.find(href->substr(1));
+    gradient = it == by_id.end() ? nullptr : it->second;
+  }
+  return {};
+}
+
+// A paint as written (fill or stroke); resolved to a colour when the layer is emitted.
+struct PaintSpec {
+  enum class Kind { kNone, kColour, kCurrentColour, kServer };
+  Kind kind = Kind::kColour;
+  uint32_t rgb = 0;                  // kColour
+  std::string server;                // kServer: the referenced id
+  std::optional<uint32_t> fallback;  // kServer: the fallback colour, if given
+  bool fallback_none = false;        // kServer: "url(#x) none"
+  bool given = false;                // set by the document (not SVG's initial black)
+
+  static PaintSpec Of(Kind kind, uint32_t rgb = 0) {
+    PaintSpec paint;
+    paint.kind = kind;
+    paint.rgb = rgb;
+    paint.given = true;
+    return paint;
+  }
+};
+
 // A subpath as the pen drew it, in the element's local coordinates. A cubic segment is stored
 // as its three points, the two control points flagged.
 struct Subpath {
@@ -156,13 +287,28 @@ class Context {
     ctm_.setZero();
     ctm_(0, 0) = ctm_(1, 1) = 1.0;
   }
+  // Inherited properties are copied; opacity is not inherited but multiplies into the
+  // children's (group opacity), display:none hides the subtree.
   Context(const Context& parent, xmlNode* node)
       : collector_(parent.collector_),
         node_(node),
         ctm_(parent.ctm_),
-        filled_(parent.filled_),
-        fill_rgb_(parent.fill_rgb_),
-        evenodd_(parent.evenodd_) {}
+        fill_(parent.fill_),
+        stroke_(parent.stroke_),
+        evenodd_(parent.evenodd_),
+        colour_(parent.colour_),
+        fill_opacity_(parent.fill_opacity_),
+        stroke_opacity_(parent.stroke_opacity_),
+        stroke_width_(parent.stroke_width_),
+        cap_(parent.cap_),
+        join_(parent.join_),
+        miter_limit_(parent.miter_limit_),
+        dashes_(parent.dashes_),
+        dash_offset_(parent.dash_offset_),
+        group_opacity_(parent.group_opacity_ * parent.opacity_),
+        displayed_(parent.displayed_),
+        visible_(parent.visible_),
+        outline_class_(parent.outline_class_ || (node != nullptr && HasClass(node, "outline"))) {}
 
   // Transform (SVG++ composes the attribute's list into one matrix [a b c d e f]).
   void transform_matrix(const boost::array<double, 6>& m) {
@@ -175,25 +321,61 @@ class Context {
     ctm_ = composed;
   }
 
-  // Paint: "none" does not fill; any colour, paint server or currentColor fills. A plain colour
-  // (SVG++'s integer colour 0xRRGGBB) is kept for renderers.
-  void set(sv::tag::attribute::fill, sv::tag::value::none) {
-    filled_ = false;
-    fill_rgb_.reset();
-  }
-  void set(sv::tag::attribute::fill, int rgb) {
-    filled_ = true;
-    fill_rgb_ = static_cast<uint32_t>(rgb) & 0xffffffu;
-  }
-  template <class... Args>
-  void set(sv::tag::attribute::fill, Args&&...) {
-    filled_ = true;
-    fill_rgb_.reset();
-  }
   // fill-rule (inherited; SVG's initial value is nonzero).
   void set(sv::tag::attribute::fill_rule, sv::tag::value::nonzero) { evenodd_ = false; }
   void set(sv::tag::attribute::fill_rule, sv::tag::value::evenodd) { evenodd_ = true; }
   void set(sv::tag::attribute::fill_rule, sv::tag::value::inherit) {}
+  // Opacities (clamped to [0, 1], as CSS does).
+  void set(sv::tag::attribute::opacity, double v) { opacity_ = Unit(v, "opacity"); }
+  void set(sv::tag::attribute::fill_opacity, double v) { fill_opacity_ = Unit(v, "fill-opacity"); }
+  void set(sv::tag::attribute::stroke_opacity, double v) {
+    stroke_opacity_ = Unit(v, "stroke-opacity");
+  }
+  void set(sv::tag::attribute::color, int rgb) { colour_ = static_cast<uint32_t>(rgb) & 0xffffffu; }
+  void set(sv::tag::attribute::stroke_width, double v) {
+    CheckFinite(v, "stroke-width");
+    if (v < 0) throw ImportError("stroke-width is negative");
+    stroke_width_ = v;
+  }
+  void set(sv::tag::attribute::stroke_miterlimit, double v) {
+    CheckFinite(v, "stroke-miterlimit");
+    miter_limit_ = std::max(1.0, v);  // below 1 is an error in SVG; treated as 1
+  }
+  void set(sv::tag::attribute::stroke_dashoffset, double v) {
+    CheckFinite(v, "stroke-dashoffset");
+    dash_offset_ = v;
+  }
+  void set(sv::tag::attribute::stroke_dasharray, sv::tag::value::none) { dashes_.clear(); }
+  void set(sv::tag::attribute::stroke_dasharray, sv::tag::value::inherit) {}
+  template <class Range>
+  void set(sv::tag::attribute::stroke_dasharray, const Range& values) {
+    dashes_.clear();
+    for (double v : values) {
+      CheckFinite(v, "stroke-dasharray");
+      if (v < 0) throw ImportError("stroke-dasharray has a negative length");
+      dashes_.push_back(v);
+    }
+  }
+  void set(sv::tag::attribute::stroke_linecap, sv::tag::value::butt) { cap_ = LineCap::kButt; }
+  void set(sv::tag::attribute::stroke_linecap, sv::tag::value::round) { cap_ = LineCap::kRound; }
+  void set(sv::tag::attribute::stroke_linecap, sv::tag::value::square) { cap_ = LineCap::kSquare; }
+  void set(sv::tag::attribute::stroke_linejoin, sv::tag::value::miter) { join_ = LineJoin::kMiter; }
+  void set(sv::tag::attribute::stroke_linejoin, sv::tag::value::round) { join_ = LineJoin::kRound; }
+  void set(sv::tag::attribute::stroke_linejoin, sv::tag::value::bevel) { join_ = LineJoin::kBevel; }
+  void set(sv::tag::attribute::display, sv::tag::value::none) { displayed_ = false; }
+  void set(sv::tag::attribute::visibility, sv::tag::value::visible) { visible_ = true; }
+  void set(sv::tag::attribute::visibility, sv::tag::value::hidden) { visible_ = false; }
+  void set(sv::tag::attribute::visibility, sv::tag::value::collapse) { visible_ = false; }
+  // Paint (fill, stroke): none, a colour, currentColor or a paint server; anything else (inherit
+  // and the other values of the properties above) keeps the inherited state.
+  template <class Tag, class... Args>
+  void set(Tag, Args&&... args) {
+    if constexpr (std::is_same_v<Tag, sv::tag::attribute::fill>) {
+      SetPaint(&fill_, std::forward<Args>(args)...);
+    } else if constexpr (std::is_same_v<Tag, sv::tag::attribute::stroke>) {
+      SetPaint(&stroke_, std::forward<Args>(args)...);
+    }
+  }
 
   // Path events, absolute coordinates only (policy::path::minimal).
   void path_move_to(double x, double y, sv::tag::coordinate::absolute) {
@@ -319,7 +501,28 @@ class Context {
       }
       return;
     }
-    if (!filled_) return;
+    if (subpaths_.empty()) return;  // a group, or a shape without geometry
+    const bool shown = displayed_ && visible_ && group_opacity_ * opacity_ > 0;
+    std::optional<FillPaint> fill = shown ? ResolveFill() : std::nullopt;
+    std::optional<StrokePaint> stroke = shown ? ResolveStroke() : std::nullopt;
+    if (outline_class_) {  // the silhouette, whatever its paint (docs/svg-convention.md)
+      ArtLayer shape = MakeLayer();
+      shape.fill = FillPaint{0, 1.0, evenodd_};
+      if (stroke) shape.stroke = stroke;
+      collector_->outline_class.push_back(std::move(shape));
+    }
+    if (!fill && !stroke) return;
+    if (collector_->art.size() >= collector_->max_layers) {
+      throw TooManyLayers(absl::StrCat("more than ", collector_->max_layers, " painted layers"));
+    }
+    ArtLayer layer = MakeLayer();
+    layer.fill = fill;
+    layer.stroke = stroke;
+    layer.opacity = group_opacity_ * opacity_;
+    collector_->stroked = collector_->stroked || stroke.has_value();
+    collector_->art.push_back(std::move(layer));
+    if (!fill) return;
+    // The element's own outlines, as the one-colour convention reads them.
     std::vector<Outline> outlines;
     for (const Subpath& subpath : subpaths_) Emit(subpath, &outlines);
     if (!evenodd_) DropNonzeroInnerBoundaries(&outlines);
@@ -327,7 +530,9 @@ class Context {
       const double area = std::abs(PolygonSignedArea(o.points));
       if (area > collector_->largest_area) {
         collector_->largest_area = area;
-        collector_->largest_fill = fill_rgb_;
+        collector_->largest_fill = fill_.kind == PaintSpec::Kind::kColour && fill_.given
+                                       ? std::optional<uint32_t>(fill_.rgb)
+                                       : std::nullopt;
       }
       collector_->outlines.push_back(std::move(o));
     }
@@ -482,12 +687,172 @@ class Context {
     }
   }
 
+  static double Unit(double v, const char* what) {
+    if (!std::isfinite(v)) throw ImportError(absl::StrCat(what, " is not a number"));
+    return std::clamp(v, 0.0, 1.0);
+  }
+
+  void SetPaint(PaintSpec* paint, sv::tag::value::none) {
+    *paint = PaintSpec::Of(PaintSpec::Kind::kNone);
+  }
+  void SetPaint(PaintSpec* paint, sv::tag::value::currentColor) {
+    *paint = PaintSpec::Of(PaintSpec::Kind::kCurrentColour);
+  }
+  void SetPaint(PaintSpec*, sv::tag::value::inherit) {}
+  void SetPaint(PaintSpec* paint, int rgb) {
+    *paint = PaintSpec::Of(PaintSpec::Kind::kColour, static_cast<uint32_t>(rgb) & 0xffffffu);
+  }
+  template <class Icc>
+  void SetPaint(PaintSpec* paint, int rgb, const Icc&) {
+    SetPaint(paint, rgb);
+  }
+  // url(#id) with an optional fallback.
+  template <class Range, class... Fallback>
+  void SetPaint(PaintSpec* paint, sv::tag::iri_fragment, const Range& id, Fallback&&... fallback) {
+    *paint = PaintSpec::Of(PaintSpec::Kind::kServer);
+    paint->server.assign(boost::begin(id), boost::end(id));
+    SetFallback(paint, std::forward<Fallback>(fallback)...);
+  }
+  // url(other-document#id): never fetched; its fallback, or none.
+  template <class Range, class... Fallback>
+  void SetPaint(PaintSpec* paint, const Range&, Fallback&&... fallback) {
+    *paint = PaintSpec::Of(PaintSpec::Kind::kServer);
+    SetFallback(paint, std::forward<Fallback>(fallback)...);
+  }
+  void SetFallback(PaintSpec*) {}
+  void SetFallback(PaintSpec* paint, sv::tag::value::none) { paint->fallback_none = true; }
+  void SetFallback(PaintSpec* paint, sv::tag::value::currentColor) { paint->fallback = colour_; }
+  void SetFallback(PaintSpec* paint, int rgb) {
+    paint->fallback = static_cast<uint32_t>(rgb) & 0xffffffu;
+  }
+  template <class Icc>
+  void SetFallback(PaintSpec* paint, int rgb, const Icc&) {
+    SetFallback(paint, rgb);
+  }
+
+  void Warn(const std::string& what) const {
+    collector_->warnings.push_back(absl::StrCat(Describe(node_), ": ", what));
+  }
+
+  // A paint's colour and opacity factor, or nullopt when it paints nothing.
+  std::optional<std::pair<uint32_t, double>> Resolve(const PaintSpec& paint, const char* what) {
+    switch (paint.kind) {
+      case PaintSpec::Kind::kNone:
+        return std::nullopt;
+      case PaintSpec::Kind::kColour:
+        return std::make_pair(paint.rgb, 1.0);
+      case PaintSpec::Kind::kCurrentColour:
+        return std::make_pair(colour_, 1.0);
+      case PaintSpec::Kind::kServer:
+        break;
+    }
+    auto it = collector_->by_id.find(paint.server);
+    const bool gradient =
+        it != collector_->by_id.end() &&
+        (xmlStrcmp(it->second->name, reinterpret_cast<const xmlChar*>("linearGradient")) == 0 ||
+         xmlStrcmp(it->second->name, reinterpret_cast<const xmlChar*>("radialGradient")) == 0);
+    if (gradient) {
+      auto [cached, inserted] = collector_->gradients.emplace(paint.server, GradientColour{});
+      if (inserted) cached->second = MeanOfStops(it->second, collector_->by_id);
+      if (!cached->second.rgb) {
+        Warn(absl::StrCat(what, " gradient \"", paint.server, "\" has no stops: painted as none"));
+        return std::nullopt;
+      }
+      Warn(absl::StrCat(what, " gradient \"", paint.server,
+                        "\" is drawn as the mean colour of its stops"));
+      return std::make_pair(*cached->second.rgb, cached->second.opacity);
+    }
+    if (paint.fallback_none) return std::nullopt;
+    if (paint.fallback) {
+      Warn(absl::StrCat(what, " paint server \"", paint.server, "\" drawn as its fallback"));
+      return std::make_pair(*paint.fallback, 1.0);
+    }
+    if (it == collector_->by_id.end()) {  // an error in SVG; drawn as it always was here
+      Warn(absl::StrCat(what, " references unknown paint server \"", paint.server,
+                        "\": drawn black"));
+      return std::make_pair(0u, 1.0);
+    }
+    Warn(absl::StrCat(what, " paint server \"", paint.server, "\" (a pattern) is drawn black"));
+    return std::make_pair(0u, 1.0);
+  }
+
+  std::optional<FillPaint> ResolveFill() {
+    std::optional<std::pair<uint32_t, double>> paint = Resolve(fill_, "fill");
+    if (!paint || fill_opacity_ * paint->second <= 0) return std::nullopt;
+    return FillPaint{paint->first, fill_opacity_ * paint->second, evenodd_};
+  }
+
+  std::optional<StrokePaint> ResolveStroke() {
+    if (stroke_.kind == PaintSpec::Kind::kNone) return std::nullopt;
+    if (stroke_width_ <= 0) {
+      Warn("stroke-width 0: the stroke is not painted");
+      return std::nullopt;
+    }
+    std::optional<std::pair<uint32_t, double>> paint = Resolve(stroke_, "stroke");
+    if (!paint || stroke_opacity_ * paint->second <= 0) return std::nullopt;
+    // Widths in the drawing's units: scaled by the transform's mean scale sqrt|det|.
+    const double scale = std::sqrt(std::abs(ctm_.leftCols<2>().determinant()));
+    StrokePaint out;
+    out.rgb = paint->first;
+    out.opacity = stroke_opacity_ * paint->second;
+    out.width = stroke_width_ * scale;
+    if (!(out.width > 0) || !std::isfinite(out.width)) return std::nullopt;
+    out.cap = cap_;
+    out.join = join_;
+    out.miter_limit = miter_limit_;
+    double period = 0;
+    for (double d : dashes_) period += d;
+    if (period > 0) {  // SVG: an odd count repeats; all zeros draw a solid line
+      out.dashes = dashes_;
+      if (out.dashes.size() % 2 == 1)
+        out.dashes.insert(out.dashes.end(), dashes_.begin(), dashes_.end());
+      for (double& d : out.dashes) d *= scale;
+      out.dash_offset = dash_offset_ * scale;
+    }
+    return out;
+  }
+
+  // The element's geometry as a layer without paint: flattened, transformed subpaths.
+  ArtLayer MakeLayer() const {
+    ArtLayer layer;
+    layer.id = Attribute(node_, "id").value_or("");
+    for (xmlNode* n = node_; n != nullptr && n->type == XML_ELEMENT_NODE; n = n->parent) {
+      if (std::optional<std::string> name = Attribute(n, "data-layer")) {
+        layer.name = *name;
+        break;
+      }
+    }
+    for (const Subpath& subpath : subpaths_) {
+      ArtPath path;
+      path.points = Flatten(subpath);
+      path.closed = subpath.closed;
+      while (path.closed && path.points.size() > 1 && path.points.back() == path.points.front()) {
+        path.points.pop_back();
+      }
+      if (!path.points.empty()) layer.paths.push_back(std::move(path));
+    }
+    return layer;
+  }
+
   Collector* collector_;
   xmlNode* node_;
   Affine ctm_;
-  bool filled_ = true;                // SVG's initial fill is black
-  std::optional<uint32_t> fill_rgb_;  // the fill when given as a plain colour
-  bool evenodd_ = false;              // SVG's initial fill-rule is nonzero
+  PaintSpec fill_;  // SVG's initial fill: black, not given
+  PaintSpec stroke_ = PaintSpec::Of(PaintSpec::Kind::kNone);  // and its initial stroke none
+  bool evenodd_ = false;                                      // SVG's initial fill-rule is nonzero
+  uint32_t colour_ = 0;                                       // the color property (currentColor)
+  double fill_opacity_ = 1.0, stroke_opacity_ = 1.0;          // inherited
+  double stroke_width_ = 1.0;
+  LineCap cap_ = LineCap::kButt;
+  LineJoin join_ = LineJoin::kMiter;
+  double miter_limit_ = 4.0;
+  std::vector<double> dashes_;
+  double dash_offset_ = 0.0;
+  double opacity_ = 1.0;        // this element's own opacity (not inherited)
+  double group_opacity_ = 1.0;  // the product of its ancestors' opacities
+  bool displayed_ = true;       // false under display:none (the whole subtree)
+  bool visible_ = true;         // visibility (inherited, a child may override)
+  bool outline_class_ = false;  // class="outline" on it or an ancestor
   std::vector<Subpath> subpaths_;
   Point pen_ = Point::Zero();
   bool open_ = false;
@@ -525,12 +890,25 @@ using ProcessedElements =
                     sv::tag::element::rect, sv::tag::element::circle, sv::tag::element::ellipse,
                     sv::tag::element::polygon, sv::tag::element::polyline,
                     sv::tag::element::line>::type;
-using ProcessedAttributes =
-    boost::mpl::insert<boost::mpl::insert<sv::traits::shapes_attributes_by_element,
-                                          sv::tag::attribute::transform>::type,
-                       sv::tag::attribute::fill>::type;
+// The geometry's attributes, the transform and every property of the art model.
+template <class Set, class... Tags>
+struct InsertAll {
+  using type = Set;
+};
+template <class Set, class Tag, class... Tags>
+struct InsertAll<Set, Tag, Tags...> {
+  using type = typename InsertAll<typename boost::mpl::insert<Set, Tag>::type, Tags...>::type;
+};
 using ProcessedAttributesWithFillRule =
-    boost::mpl::insert<ProcessedAttributes, sv::tag::attribute::fill_rule>::type;
+    InsertAll<sv::traits::shapes_attributes_by_element, sv::tag::attribute::transform,
+              sv::tag::attribute::fill, sv::tag::attribute::fill_rule,
+              sv::tag::attribute::fill_opacity, sv::tag::attribute::stroke,
+              sv::tag::attribute::stroke_width, sv::tag::attribute::stroke_opacity,
+              sv::tag::attribute::stroke_linecap, sv::tag::attribute::stroke_linejoin,
+              sv::tag::attribute::stroke_miterlimit, sv::tag::attribute::stroke_dasharray,
+              sv::tag::attribute::stroke_dashoffset, sv::tag::attribute::opacity,
+              sv::tag::attribute::color, sv::tag::attribute::display,
+              sv::tag::attribute::visibility>::type;
 
 // SVG++'s minimal path policy, except that arcs come to Context::path_elliptical_arc_to.
 struct PathPolicy : sv::policy::path::minimal {
@@ -594,9 +972,40 @@ const xmlNode* FindEntityReference(const xmlNode* node) {
 // attribute's name.
 std::optional<std::pair<const xmlNode*, std::string>> FindNonAsciiParsedAttribute(
     const xmlNode* root) {
-  static const std::set<std::string> kParsed = {
-      "d",  "points", "transform", "style", "fill", "fill-rule", "x",  "y",  "width", "height",
-      "cx", "cy",     "r",         "rx",    "ry",   "x1",        "y1", "x2", "y2",    "stroke"};
+  static const std::set<std::string> kParsed = {"d",
+                                                "points",
+                                                "transform",
+                                                "style",
+                                                "fill",
+                                                "fill-rule",
+                                                "x",
+                                                "y",
+                                                "width",
+                                                "height",
+                                                "cx",
+                                                "cy",
+                                                "r",
+                                                "rx",
+                                                "ry",
+                                                "x1",
+                                                "y1",
+                                                "x2",
+                                                "y2",
+                                                "stroke",
+                                                "stroke-width",
+                                                "stroke-opacity",
+                                                "stroke-linecap",
+                                                "stroke-linejoin",
+                                                "stroke-miterlimit",
+                                                "stroke-dasharray",
+                                                "stroke-dashoffset",
+                                                "opacity",
+                                                "fill-opacity",
+                                                "color",
+                                                "display",
+                                                "visibility",
+                                                "stop-color",
+                                                "stop-opacity"};
   std::vector<const xmlNode*> stack = {root};
   while (!stack.empty()) {
     const xmlNode* node = stack.back();
@@ -639,17 +1048,6 @@ struct UseError {
   std::string reason;
   absl::StatusCode code = absl::StatusCode::kInvalidArgument;
 };
-
-// A <use>'s href (or xlink:href).
-std::optional<std::string> UseHref(xmlNode* use) {
-  std::optional<std::string> href = Attribute(use, "href");
-  if (!href) {
-    xmlChar* x = xmlGetNsProp(use, reinterpret_cast<const xmlChar*>("href"),
-                              reinterpret_cast<const xmlChar*>("http://www.w3.org/1999/xlink"));
-    if (x != nullptr) href = reinterpret_cast<const char*>(x), xmlFree(x);
-  }
-  return href;
-}
 
 // Element nodes in the subtree of `node` (itself included).
 size_t CountElements(const xmlNode* node) {
@@ -746,6 +1144,69 @@ std::optional<UseError> ExpandUses(xmlDoc* doc, xmlNode* root) {
   }
 }
 
+// Warnings for what is drawn but not imported: text, images, embedded documents, filters, clip
+// paths, masks and style sheets (the subtrees of definitions are not drawn and not visited).
+void WarnUnsupported(xmlNode* root, std::vector<std::string>* warnings) {
+  static const std::set<std::string> kNotDrawn = {
+      "defs",     "symbol",         "clipPath",       "mask",  "marker", "pattern",
+      "metadata", "linearGradient", "radialGradient", "title", "desc"};
+  static const std::map<std::string, std::string> kIgnored = {
+      {"text", "text is not imported (convert it to paths)"},
+      {"image", "images are not imported"},
+      {"foreignObject", "embedded documents are not imported"},
+      {"video", "video is not imported"},
+      {"style", "style sheets are not applied (use attributes or style=\"...\")"}};
+  std::vector<xmlNode*> stack = {root};
+  while (!stack.empty()) {
+    xmlNode* node = stack.back();
+    stack.pop_back();
+    if (node->type != XML_ELEMENT_NODE) continue;
+    const std::string name = reinterpret_cast<const char*>(node->name);
+    if (kNotDrawn.count(name)) continue;
+    if (auto it = kIgnored.find(name); it != kIgnored.end()) {
+      warnings->push_back(absl::StrCat(Describe(node), ": ", it->second));
+      continue;
+    }
+    for (const char* property : {"filter", "clip-path", "mask"}) {
+      std::optional<std::string> value = Property(node, property);
+      if (value && *value != "none") {
+        warnings->push_back(absl::StrCat(Describe(node), ": ", property, " is ignored"));
+      }
+    }
+    std::vector<xmlNode*> children;
+    for (xmlNode* child = node->children; child; child = child->next) children.push_back(child);
+    stack.insert(stack.end(), children.rbegin(), children.rend());  // document order
+  }
+}
+
+// The root's viewBox (min-x, min-y, width, height), when it has a valid one.
+std::optional<Eigen::AlignedBox2d> ViewBox(xmlNode* root) {
+  std::optional<std::string> text = Attribute(root, "viewBox");
+  if (!text) return std::nullopt;
+  std::vector<double> v;
+  for (absl::string_view part :
+       absl::StrSplit(*text, absl::ByAnyChar(" ,\t\n\r"), absl::SkipEmpty())) {
+    double x = 0;
+    if (!absl::SimpleAtod(part, &x) || !std::isfinite(x)) return std::nullopt;
+    v.push_back(x);
+  }
+  if (v.size() != 4 || !(v[2] > 0) || !(v[3] > 0)) return std::nullopt;
+  return Eigen::AlignedBox2d(Point(v[0], v[1]), Point(v[0] + v[2], v[1] + v[3]));
+}
+
+// The one-colour convention: filled elements only, all of one colour and opacity, none
+// overlapping another (each layer's own area adds up to the union's). Its outlines are the
+// elements' own, as written; touching elements and specks stay as they always were.
+bool IsOneColour(const std::vector<ArtLayer>& art, const PaintRegion& region) {
+  for (const ArtLayer& layer : art) {
+    if (layer.stroke || !layer.fill || layer.fill->rgb != art[0].fill->rgb ||
+        layer.fill->opacity != art[0].fill->opacity || layer.opacity != art[0].opacity) {
+      return false;
+    }
+  }
+  return std::abs(region.layers_area - region.raw_area) <= 1e-6 * region.raw_area;
+}
+
 }  // namespace
 
 absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOptions& options,
@@ -796,10 +1257,24 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   Collector collector;
   collector.tolerance = options.tolerance;
   collector.max_points = static_cast<size_t>(options.max_points);
+  collector.max_layers = static_cast<size_t>(options.max_layers);
+  for (xmlNode* n = root; n != nullptr;) {  // ids, in document order (the first one wins)
+    if (n->type == XML_ELEMENT_NODE) {
+      if (std::optional<std::string> id = Attribute(n, "id")) collector.by_id.emplace(*id, n);
+      if (n->children != nullptr) {
+        n = n->children;
+        continue;
+      }
+    }
+    while (n != nullptr && n != root && n->next == nullptr) n = n->parent;
+    n = (n == nullptr || n == root) ? nullptr : n->next;
+  }
   try {
     Context context(&collector, root);
     Traversal::load_document(root, context);
   } catch (const TooManyPoints& e) {
+    return absl::ResourceExhaustedError(absl::StrCat("SVG has ", e.message));
+  } catch (const TooManyLayers& e) {
     return absl::ResourceExhaustedError(absl::StrCat("SVG has ", e.message));
   } catch (const boost::exception& e) {
     xmlNode* const* element = boost::get_error_info<ElementInfo>(e);
@@ -810,17 +1285,83 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   } catch (const std::exception& e) {
     return absl::InvalidArgumentError(absl::StrCat("SVG import failed: ", e.what()));
   }
-  if (collector.outlines.empty()) {
+  WarnUnsupported(root, &collector.warnings);
+  const bool by_class = !collector.outline_class.empty();
+  if (collector.art.empty() && !by_class) {
     return absl::InvalidArgumentError(
-        "SVG has no filled shape (elements with fill=\"none\" and empty paths are ignored)");
+        "SVG has no filled shape and no stroke: nothing is painted (elements with fill=\"none\" "
+        "and no stroke, hidden or fully transparent elements and empty paths are ignored)");
   }
-  if (info != nullptr) info->fill_rgb = collector.largest_fill;
-  OrientByNesting(&collector.outlines);
+
+  // The silhouette: the union of all paint, or of the class="outline" elements.
+  std::vector<const ArtLayer*> silhouette;
+  for (const ArtLayer& layer : by_class ? collector.outline_class : collector.art) {
+    silhouette.push_back(&layer);
+  }
+  Point lo(kInf, kInf), hi(-kInf, -kInf);
+  for (const ArtLayer* layer : silhouette) {
+    for (const ArtPath& path : layer->paths) {
+      for (const Point& p : path.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    }
+  }
+  PaintUnionOptions union_options;
+  union_options.arc_tolerance = options.tolerance;
+  if (lo.x() <= hi.x()) {
+    union_options.gap_width = std::max(0.0, options.gap_tolerance) * (hi - lo).norm();
+    union_options.min_area =
+        std::max(0.0, options.min_area_fraction) * (hi - lo).x() * (hi - lo).y();
+  }
+  absl::StatusOr<PaintRegion> region = UnionOfPaint(silhouette, union_options);
+  if (!region.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("SVG ", by_class ? "class=\"outline\" elements" : "paint", ": ",
+                     region.status().message()));
+  }
+  if (std::optional<Eigen::AlignedBox2d> view = ViewBox(root)) {
+    Eigen::AlignedBox2d paint;
+    for (const Outline& o : region->outlines) {
+      for (const Point& p : o.points) paint.extend(p);
+    }
+    if (!view->intersects(paint)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "SVG paint lies entirely outside the viewBox (paint spans (", paint.min().x(), ", ",
+          paint.min().y(), ") to (", paint.max().x(), ", ", paint.max().y(), "))"));
+    }
+  }
+
+  SvgImportInfo report;
+  report.fill_rgb = collector.largest_fill;
+  report.warnings = std::move(collector.warnings);
   Drawing drawing;
-  drawing.outlines = std::move(collector.outlines);
+  if (!by_class && IsOneColour(collector.art, *region)) {
+    OrientByNesting(&collector.outlines);
+    // The one-colour convention: the elements' own outlines, exactly as written.
+    report.source = SilhouetteSource::kElements;
+    report.cleaning.gap_width = region->cleaning.gap_width;
+    report.cleaning.min_area = region->cleaning.min_area;
+    drawing.outlines = std::move(collector.outlines);
+  } else {
+    if (region->hairline) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "SVG ", by_class ? "class=\"outline\" elements are" : "paint is",
+          " nowhere wider than the gap tolerance (", region->cleaning.gap_width,
+          " user units): it is all hairlines; lower the gap tolerance or paint wider shapes"));
+    }
+    if (region->outlines.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "SVG ", by_class ? "class=\"outline\" elements" : "paint",
+          ": every piece is smaller than the minimum area (", region->cleaning.min_area,
+          " square user units; SvgImportOptions::min_area_fraction)"));
+    }
+    report.source = by_class ? SilhouetteSource::kOutlineClass : SilhouetteSource::kUnion;
+    report.cleaning = region->cleaning;
+    drawing.outlines = std::move(region->outlines);
+  }
+  if (info != nullptr) *info = std::move(report);
   drawing.cuts = std::move(collector.cuts);
   drawing.openings = std::move(collector.openings);
   drawing.marks = std::move(collector.marks);
+  drawing.art = std::move(collector.art);
   return drawing;
 }
 

@@ -143,11 +143,12 @@ TEST(SvgImportTest, HolesAreNegativeByNestingDepth) {
 }
 
 TEST(SvgImportTest, UnfilledAndNonRenderingElementsAreIgnored) {
+  // Unfilled and unstroked elements paint nothing (strokes are paint: svg_import_paint_test).
   Drawing d = ImportOk(Svg(
       "<title>t</title><desc>d</desc><metadata><x/></metadata>"
       "<defs><path id=\"template\" d=\"M0 0 H5 V5 Z\"/></defs>"
-      "<path fill=\"none\" stroke=\"black\" d=\"M0 0 H50 V50 Z\"/>"
-      "<path style=\"fill:none;stroke:red\" d=\"M0 0 H60 V60 Z\"/>"
+      "<path fill=\"none\" stroke=\"none\" d=\"M0 0 H50 V50 Z\"/>"
+      "<path style=\"fill:none;stroke-width:0;stroke:red\" d=\"M0 0 H60 V60 Z\"/>"
       "<g fill=\"none\"><rect width=\"70\" height=\"70\"/></g>"
       "<g fill=\"none\"><rect fill=\"red\" data-name=\"kept\" width=\"80\" height=\"20\"/></g>"));
   ASSERT_EQ(d.outlines.size(), 1u);
