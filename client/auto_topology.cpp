@@ -23,6 +23,11 @@ solver::Points ToPoints(const XYs& line) {
 
 absl::Status ApplyAutoTopology(Project* project, const std::filesystem::path& write_to,
                                bool quiet) {
+  // The project's import settings, as the server reads them (unset = ImportSvg's default).
+  solver::SvgImportOptions options;
+  const ImportSettings& settings = project->import_settings;
+  options.gap_tolerance = settings.gap_tolerance.value_or(options.gap_tolerance);
+  options.min_area_fraction = settings.min_area_fraction.value_or(options.min_area_fraction);
   std::vector<solver::Drawing> drawings;
   for (size_t i = 0; i < project->drawings.size(); ++i) {
     const ProjectDrawing& d = project->drawings[i];
@@ -31,7 +36,7 @@ absl::Status ApplyAutoTopology(Project* project, const std::filesystem::path& wr
     if (!in) return absl::NotFoundError(absl::StrCat(where, ": cannot open"));
     std::ostringstream text;
     text << in.rdbuf();
-    absl::StatusOr<solver::Drawing> drawing = solver::ImportSvg(text.str());
+    absl::StatusOr<solver::Drawing> drawing = solver::ImportSvg(text.str(), options);
     if (!drawing.ok()) {
       return absl::Status(drawing.status().code(),
                           absl::StrCat(where, ": ", drawing.status().message()));

@@ -10,10 +10,11 @@
 
 namespace inbetween::client {
 
-// Imports every drawing (client-side, with the project's cuts and openings), proposes cuts and,
-// when there are any, appends them to the drawings' cuts and writes the project to `write_to`
-// (drawing paths relative to it). Prints each proposal and the file written on stderr unless
-// `quiet`. Errors name the drawing; FAILED_PRECONDITION when no proposal is possible.
+// Imports every drawing (client-side, with the project's import settings, cuts and openings),
+// proposes cuts and, when there are any, appends them to the drawings' cuts and writes the
+// project to `write_to` (drawing paths relative to it). Prints each proposal and the file written
+// on stderr unless `quiet`. Errors name the drawing; FAILED_PRECONDITION when no proposal is
+// possible.
 absl::Status ApplyAutoTopology(Project* project, const std::filesystem::path& write_to, bool quiet);
 
 // Appends advice to a build error caused by differing topology ("... or pass --auto-topology").

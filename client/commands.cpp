@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -115,12 +116,22 @@ void FinishProgress(const RunContext& ctx) {
   if (ctx.progress) ctx.progress->Finish();
 }
 
-// A project drawing as a PutDrawing request: its SVG text, name, key time, cuts and openings.
-v1::PutDrawingRequest DrawingRequest(const ProjectDrawing& d, const v1::Session& session,
-                                     std::string svg) {
+// An import setting as PutDrawingRequest takes it: unset = 0 (the server's default), 0 (off) =
+// a negative value.
+double RequestFraction(const std::optional<double>& value) {
+  if (!value) return 0;
+  return *value > 0 ? *value : -1;
+}
+
+// A project drawing as a PutDrawing request: its SVG text, name, key time, cuts and openings,
+// and the project's import settings.
+v1::PutDrawingRequest DrawingRequest(const ProjectDrawing& d, const ImportSettings& import,
+                                     const v1::Session& session, std::string svg) {
   v1::PutDrawingRequest request;
   request.set_session_id(session.id());
   request.set_expected_version(session.version());
+  request.set_gap_tolerance(RequestFraction(import.gap_tolerance));
+  request.set_min_area_fraction(RequestFraction(import.min_area_fraction));
   request.mutable_drawing()->set_name(d.file.filename().string());
   request.mutable_drawing()->set_svg(std::move(svg));
   if (d.key_time) request.mutable_drawing()->set_key_time(*d.key_time);
@@ -173,7 +184,8 @@ absl::StatusOr<v1::Session> UploadProject(const Project& project, const std::str
     auto svg = ReadSvg(d.file);
     if (!svg.ok()) return Annotate(svg.status(), where);
     svgs.push_back(*svg);
-    auto put = ctx.client->PutDrawing(DrawingRequest(d, *session, *std::move(svg)));
+    auto put = ctx.client->PutDrawing(
+        DrawingRequest(d, project.import_settings, *session, *std::move(svg)));
     if (!put.ok()) return Annotate(put.status(), where);
     *session = put->session();
     if (classes != nullptr) classes->push_back(put->equivalence_class());
@@ -365,6 +377,18 @@ absl::StatusOr<Project> ResolveProject(const Inputs& inputs) {
       project.drawings.push_back(std::move(d));
     }
   }
+  const ImportSettings& flags = inputs.import_flags;
+  for (const auto& [flag, value, setting] :
+       {std::tuple{"--gap-tolerance", flags.gap_tolerance, &project.import_settings.gap_tolerance},
+        std::tuple{"--min-area-fraction", flags.min_area_fraction,
+                   &project.import_settings.min_area_fraction}}) {
+    if (!value) continue;
+    if (!(*value >= 0 && *value <= kMaxImportFraction)) {  // false for NaN
+      return FlagError(flag, absl::StrCat("value ", *value, " is not in [0, ", kMaxImportFraction,
+                                          "] (0 = off)"));
+    }
+    *setting = *value;
+  }
   if (project.drawings.size() < 2 || project.drawings.size() > 16) {
     return absl::InvalidArgumentError(
         absl::StrCat("need 2 to 16 drawings (on the command line or in --project), got ",
@@ -551,6 +575,33 @@ absl::Status RunRender(const RenderOptions& options, ProgressBar& progress) {
 
 namespace {
 
+constexpr const char* SilhouetteSourceName(v1::SilhouetteSource source) {
+  switch (source) {
+    case v1::SILHOUETTE_SOURCE_ELEMENTS:
+      return "elements";
+    case v1::SILHOUETTE_SOURCE_UNION:
+      return "union";
+    case v1::SILHOUETTE_SOURCE_OUTLINE_CLASS:
+      return "outline class";
+    default:
+      return "unspecified";
+  }
+}
+
+// What importing a drawing did (validate): one line of facts, then one line per warning, each
+// starting with `where` ("drawing 1 (face.svg)").
+void PrintImportReport(const std::string& where, const v1::ImportReport& r) {
+  std::printf(
+      "%s: silhouette %s; %u art layer%s; gaps closed %u, slits closed %u, islands dropped %u, "
+      "holes dropped %u (gap width %g, area threshold %g)\n",
+      where.c_str(), SilhouetteSourceName(r.silhouette_source()), r.art_layers(),
+      r.art_layers() == 1 ? "" : "s", r.gaps_closed(), r.slits_closed(), r.islands_dropped(),
+      r.holes_dropped(), r.gap_width(), r.min_area());
+  for (const std::string& warning : r.warnings()) {
+    std::printf("%s: warning: %s\n", where.c_str(), warning.c_str());
+  }
+}
+
 std::string ClassText(const v1::EquivalenceClass& c) {
   return absl::StrCat(c.components(), c.components() == 1 ? " component, " : " components, ",
                       c.holes(), c.holes() == 1 ? " hole" : " holes");
@@ -641,11 +692,13 @@ absl::Status RunValidate(const Inputs& inputs, const RunContext& ctx) {
         continue;
       }
       svgs.push_back(*svg);
-      auto put = ctx.client->PutDrawing(DrawingRequest(d, *session, *std::move(svg)));
+      auto put = ctx.client->PutDrawing(
+          DrawingRequest(d, project->import_settings, *session, *std::move(svg)));
       if (!put.ok()) {
         problems.push_back(absl::StrCat(where, ": ", put.status().message()));
         continue;
       }
+      PrintImportReport(where, put->import_report());
       *session = put->session();
       ++imported;
     }

@@ -19,8 +19,12 @@ namespace inbetween::client {
 struct Inputs {
   std::vector<std::filesystem::path> drawings;
   std::filesystem::path project;  // empty = none
+  // --gap-tolerance, --min-area-fraction: override the project's "import" settings.
+  ImportSettings import_flags;
 };
 
+// The project of `inputs`, with the command line's drawings and import flags applied. A flag out
+// of range is INVALID_ARGUMENT naming it ("--gap-tolerance: value 0.5 is not in [0, 0.1]").
 absl::StatusOr<Project> ResolveProject(const Inputs& inputs);
 
 // Overrides from the command line (unset = the project's value, then the server default).
@@ -94,7 +98,9 @@ absl::Status RunInspect(const std::string& session_id, const RunContext& ctx);
 absl::Status RunInspectProject(const Inputs& inputs, const RunContext& ctx);
 
 // Checks the project file and every drawing and reports every problem at once (stdout, one per
-// line); fails with INVALID_ARGUMENT carrying the count when there is any.
+// line); fails with INVALID_ARGUMENT carrying the count when there is any. Each drawing that
+// imports is reported first: its silhouette source, art layers, what cleaning did and every
+// import warning (ImportReport).
 absl::Status RunValidate(const Inputs& inputs, const RunContext& ctx);
 
 // Writes a project file for the drawings (paths relative to the file).

@@ -47,12 +47,26 @@ std::shared_ptr<grpc::ChannelCredentials> Credentials(const std::string& tls_ca)
   return grpc::SslCredentials(options);
 }
 
+// --gap-tolerance and --min-area-fraction: how the drawings' SVG is imported (they override the
+// project's "import" settings; ResolveProject checks the range).
+void AddImportFlags(CLI::App* cmd, inbetween::client::ImportSettings* flags) {
+  cmd->add_option_function<double>(
+      "--gap-tolerance", [flags](double v) { flags->gap_tolerance = v; },
+      "Close gaps in the paint narrower than this fraction of its bounding-box diagonal, "
+      "[0, 0.1], 0 = off (default 0.002)");
+  cmd->add_option_function<double>(
+      "--min-area-fraction", [flags](double v) { flags->min_area_fraction = v; },
+      "Drop pieces of paint and holes smaller than this fraction of its bounding-box area, "
+      "[0, 0.1], 0 = off (default 1e-4)");
+}
+
 // Adds the drawings/--project inputs shared by several subcommands.
 void AddInputs(CLI::App* cmd, inbetween::client::Inputs* inputs) {
   cmd->add_option("drawings", inputs->drawings, "SVG drawings in key order (2 to 16)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--project", inputs->project, "Project file (docs/project-file.md)")
       ->check(CLI::ExistingFile);
+  AddImportFlags(cmd, &inputs->import_flags);
 }
 
 // The inbetween parameters animate and init accept (docs/cli.md); flags override the project.
@@ -232,6 +246,7 @@ int main(int argc, char** argv) {
                    "Inspect a project file instead: classes, multimesh size and energies")
       ->check(CLI::ExistingFile)
       ->excludes(inspect_cmd->get_option("session"));
+  AddImportFlags(inspect_cmd, &inspect_project.import_flags);
   inspect_cmd->footer(
       "Examples:\n  inbetween --server 127.0.0.1:50051 inspect\n"
       "  inbetween --server 127.0.0.1:50051 inspect 4f2a9c...\n"
@@ -260,6 +275,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"linear", "alexa", "zhu17"}));
   InbetweenFlags init_flags;
   AddInbetweenFlags(init_cmd, &init_flags);
+  AddImportFlags(init_cmd, &init.import_flags);
   init_cmd->add_flag("--force", force, "Overwrite an existing file");
   init_cmd->footer("Examples:\n  inbetween init pose*.svg -o walk.json --frames 48");
 

@@ -300,6 +300,17 @@ absl::Status ParseInbetween(const Node& node, v1::InbetweenParameters* out) {
   return absl::OkStatus();
 }
 
+absl::Status ParseImport(const Node& node, ImportSettings* out) {
+  if (absl::Status s = node.CheckKeys({"gap_tolerance", "min_area_fraction"}); !s.ok()) return s;
+  for (auto [key, value] : {std::pair{"gap_tolerance", &out->gap_tolerance},
+                            std::pair{"min_area_fraction", &out->min_area_fraction}}) {
+    if (!node.Has(key)) continue;
+    PROJECT_ASSIGN_OR_RETURN(v, node.Child(key).Number(0.0, kMaxImportFraction));
+    *value = v;
+  }
+  return absl::OkStatus();
+}
+
 absl::Status ParseOutput(const Node& node, OutputSettings* out) {
   if (absl::Status s = node.CheckKeys({"formats", "width", "fps", "fill", "mesh_overlay"});
       !s.ok()) {
@@ -345,8 +356,8 @@ json PolylinesToJson(const std::vector<XYs>& lines) {
 
 absl::StatusOr<Project> ParseProject(const json& doc, const std::filesystem::path& base_dir) {
   Node root(doc, "$");
-  if (absl::Status s = root.CheckKeys(
-          {"version", "drawings", "correspondences", "meshing", "comesh", "inbetween", "output"});
+  if (absl::Status s = root.CheckKeys({"version", "drawings", "correspondences", "import",
+                                       "meshing", "comesh", "inbetween", "output"});
       !s.ok()) {
     return s;
   }
@@ -394,6 +405,10 @@ absl::StatusOr<Project> ParseProject(const json& doc, const std::filesystem::pat
       }
       project.correspondences.push_back(std::move(points));
     }
+  }
+  if (root.Has("import")) {
+    absl::Status s = ParseImport(root.Child("import"), &project.import_settings);
+    if (!s.ok()) return s;
   }
   if (root.Has("meshing")) {
     absl::Status s = ParseMeshing(root.Child("meshing"), project.parameters.mutable_meshing());
@@ -475,6 +490,14 @@ json ProjectToJson(const Project& project, const std::filesystem::path& base_dir
   if (!project.correspondences.empty()) {
     doc["correspondences"] = PolylinesToJson(project.correspondences);
   }
+  json import_settings = json::object();
+  if (project.import_settings.gap_tolerance) {
+    import_settings["gap_tolerance"] = *project.import_settings.gap_tolerance;
+  }
+  if (project.import_settings.min_area_fraction) {
+    import_settings["min_area_fraction"] = *project.import_settings.min_area_fraction;
+  }
+  if (!import_settings.empty()) doc["import"] = std::move(import_settings);
   const v1::MeshingParameters& m = project.parameters.meshing();
   json meshing = json::object();
   if (m.boundary_vertices()) meshing["boundary_vertices"] = m.boundary_vertices();

@@ -27,6 +27,18 @@ struct ProjectDrawing {
   std::vector<XYs> openings;       // open polylines
 };
 
+// Largest gap_tolerance and min_area_fraction (PutDrawingRequest's range).
+inline constexpr double kMaxImportFraction = 0.1;
+
+// How the drawings' SVG is imported (PutDrawingRequest); unset = the server's default. Each in
+// [0, kMaxImportFraction], 0 = off, as solver::SvgImportOptions reads them.
+struct ImportSettings {
+  // Gaps in the paint narrower than this fraction of its bounding-box diagonal are closed.
+  std::optional<double> gap_tolerance;
+  // Pieces of paint and holes smaller than this fraction of its bounding-box area are dropped.
+  std::optional<double> min_area_fraction;
+};
+
 struct OutputSettings {
   std::vector<std::string> formats = {"svg", "json", "gif"};
   int width = 512;                  // raster width in pixels
@@ -40,6 +52,7 @@ struct Project {
   std::vector<ProjectDrawing> drawings;
   std::vector<XYs> correspondences;  // each: one point per drawing
   v1::Parameters parameters;         // meshing, comesh, inbetween (unset = server defaults)
+  ImportSettings import_settings;    // "import"
   OutputSettings output;
 };
 

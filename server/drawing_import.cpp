@@ -189,6 +189,89 @@ absl::Status CheckDrawingFields(const v1::Drawing& drawing, absl::string_view fi
   return absl::OkStatus();
 }
 
+// A stored drawing's art is what ImportSvg guarantees (solver/core/art.h); an archive is
+// untrusted, so it is checked like any input: finite numbers, |coordinate| <= 1e9, at most
+// `max_points` points and SvgImportOptions::max_layers layers, colours 0xRRGGBB, opacities in
+// [0, 1], positive stroke widths, non-negative dashes.
+absl::Status CheckArt(const std::vector<solver::ArtLayer>& art, absl::string_view field,
+                      int max_points) {
+  const int max_layers = solver::SvgImportOptions().max_layers;
+  if (art.size() > static_cast<size_t>(max_layers)) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat(field, ".art has ", art.size(), " layers, the limit is ", max_layers));
+  }
+  size_t total_points = 0;
+  for (size_t i = 0; i < art.size(); ++i) {
+    const solver::ArtLayer& layer = art[i];
+    const std::string where =
+        absl::StrCat(field, ".art[", i, "]", layer.id.empty() ? "" : " (id \"", layer.id,
+                     layer.id.empty() ? "" : "\")");
+    auto bad = [&](absl::string_view what, double value, absl::string_view range) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(where, ".", what, " = ", value, " is not ", range));
+    };
+    for (size_t k = 0; k < layer.paths.size(); ++k) {
+      total_points += layer.paths[k].points.size();
+      if (total_points > static_cast<size_t>(max_points)) {
+        return absl::ResourceExhaustedError(
+            absl::StrCat(field, ".art has more than ", max_points,
+                         " points (limit per drawing, --max-drawing-points)"));
+      }
+      if (absl::Status s =
+              CheckPoints(layer.paths[k].points, absl::StrCat(where, ".paths[", k, "]"));
+          !s.ok()) {
+        return s;
+      }
+    }
+    auto unit = [](double v) { return v >= 0 && v <= 1; };  // false for NaN
+    if (!unit(layer.opacity)) return bad("opacity", layer.opacity, "in [0, 1]");
+    auto bad_rgb = [&](absl::string_view what, uint32_t rgb) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(where, ".", what, " = 0x", absl::Hex(rgb), " is not 0xRRGGBB"));
+    };
+    if (layer.fill) {
+      if (layer.fill->rgb > 0xffffff) return bad_rgb("fill.rgb", layer.fill->rgb);
+      if (!unit(layer.fill->opacity)) return bad("fill.opacity", layer.fill->opacity, "in [0, 1]");
+    }
+    if (layer.stroke) {
+      const solver::StrokePaint& stroke = *layer.stroke;
+      if (stroke.rgb > 0xffffff) return bad_rgb("stroke.rgb", stroke.rgb);
+      if (!unit(stroke.opacity)) return bad("stroke.opacity", stroke.opacity, "in [0, 1]");
+      if (!(std::isfinite(stroke.width) && stroke.width > 0)) {
+        return bad("stroke.width", stroke.width, "finite and positive");
+      }
+      if (!std::isfinite(stroke.miter_limit)) {
+        return bad("stroke.miter_limit", stroke.miter_limit, "finite");
+      }
+      if (!std::isfinite(stroke.dash_offset)) {
+        return bad("stroke.dash_offset", stroke.dash_offset, "finite");
+      }
+      for (size_t k = 0; k < stroke.dashes.size(); ++k) {
+        if (!(std::isfinite(stroke.dashes[k]) && stroke.dashes[k] >= 0)) {
+          return bad(absl::StrCat("stroke.dashes[", k, "]"), stroke.dashes[k],
+                     "finite and non-negative");
+        }
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+// PutDrawingRequest.gap_tolerance or .min_area_fraction (`name`) for ImportSvg: 0 -> `fallback`
+// (SvgImportOptions' default), negative -> 0 (off), else checked against (0, kMaxImportFraction].
+absl::StatusOr<double> ImportFraction(double value, double fallback, absl::string_view name) {
+  if (value == 0) return fallback;
+  if (!std::isfinite(value)) {
+    return absl::InvalidArgumentError(absl::StrCat(name, " = ", value, " is not finite"));
+  }
+  if (value > kMaxImportFraction) {
+    return absl::InvalidArgumentError(absl::StrCat(name, " = ", value, " is not in (0, ",
+                                                   kMaxImportFraction, "] (0 = the default ",
+                                                   fallback, ", negative = off)"));
+  }
+  return value < 0 ? 0.0 : value;
+}
+
 void AddElement(v1::ElementKind kind, const solver::Points& points, TopologyElements* out) {
   v1::TopologyElement* element = out->Add();
   element->set_id(static_cast<uint32_t>(out->size()));
@@ -205,16 +288,30 @@ v1::EquivalenceClass ToProto(const solver::EquivalenceClass& equivalence) {
   return out;
 }
 
-absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing, double flatten_tolerance,
+absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing,
+                                              const DrawingImportOptions& import_options,
                                               absl::string_view field, int drawing_number,
                                               const TopologyElements& topology,
                                               absl::string_view topology_field, int max_points) {
   if (absl::Status s = CheckDrawingFields(drawing, field); !s.ok()) return s;
-  if (flatten_tolerance == 0) flatten_tolerance = kDefaultFlattenTolerance;
+  solver::SvgImportOptions options;
+  const double flatten_tolerance = import_options.flatten_tolerance == 0
+                                       ? kDefaultFlattenTolerance
+                                       : import_options.flatten_tolerance;
   if (!(std::isfinite(flatten_tolerance) && flatten_tolerance > 0 && flatten_tolerance <= 1e6)) {
     return absl::InvalidArgumentError(
         absl::StrCat("flatten_tolerance = ", flatten_tolerance, " is not in (0, 1e6]"));
   }
+  options.tolerance = flatten_tolerance;
+  options.max_points = max_points;
+  absl::StatusOr<double> gap =
+      ImportFraction(import_options.gap_tolerance, options.gap_tolerance, "gap_tolerance");
+  if (!gap.ok()) return gap.status();
+  options.gap_tolerance = *gap;
+  absl::StatusOr<double> min_area = ImportFraction(import_options.min_area_fraction,
+                                                   options.min_area_fraction, "min_area_fraction");
+  if (!min_area.ok()) return min_area.status();
+  options.min_area_fraction = *min_area;
   for (int i = 0; i < topology.size(); ++i) {
     const v1::TopologyElement& element = topology[i];
     if (element.kind() != v1::ELEMENT_KIND_CUT && element.kind() != v1::ELEMENT_KIND_OPENING) {
@@ -228,16 +325,15 @@ absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing, double
   }
   TopologyElements elements;
   std::vector<solver::CorrespondenceMark> svg_marks;
+  std::vector<solver::ArtLayer> art;
+  solver::SvgImportInfo info;  // polylines: source ELEMENTS, no cleaning, no warnings
   std::string element_field;
   switch (drawing.source_case()) {
     case v1::Drawing::kSvg: {
       if (drawing.svg().empty()) {
         return absl::InvalidArgumentError(absl::StrCat(field, ".svg is empty"));
       }
-      solver::SvgImportOptions options;
-      options.tolerance = flatten_tolerance;
-      options.max_points = max_points;
-      absl::StatusOr<solver::Drawing> parsed = solver::ImportSvg(drawing.svg(), options);
+      absl::StatusOr<solver::Drawing> parsed = solver::ImportSvg(drawing.svg(), options, &info);
       if (!parsed.ok()) {
         const bool limit = absl::IsResourceExhausted(parsed.status()) &&
                            absl::StrContains(parsed.status().message(), " points");
@@ -249,7 +345,9 @@ absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing, double
       if (parsed->outlines.empty()) {
         return absl::InvalidArgumentError(absl::StrCat(field, ".svg has no filled shapes"));
       }
+      if (absl::Status s = CheckArt(parsed->art, field, max_points); !s.ok()) return s;
       svg_marks = parsed->marks;
+      art = std::move(parsed->art);
       for (const solver::Outline& o : parsed->outlines) {
         AddElement(v1::ELEMENT_KIND_OUTLINE, o.points, &elements);
       }
@@ -286,6 +384,8 @@ absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing, double
       Analyze(std::move(elements), field, element_field, false, drawing_number, max_points);
   if (out.ok()) {
     out->parsed.marks = drawing.has_svg() ? svg_marks : MarksOf(drawing);
+    out->import_report = ToProto(info, static_cast<int>(art.size()));
+    out->parsed.art = std::move(art);
   }
   return out;
 }
@@ -309,10 +409,25 @@ absl::StatusOr<ImportedDrawing> ImportDrawingElements(const v1::Drawing& drawing
   for (v1::TopologyElement& element : elements) {
     if (element.id() == 0) element.set_id(++max_id);
   }
+  std::vector<solver::ArtLayer> art = FromProto(drawing.art());
+  if (absl::Status s = CheckArt(art, field, max_points); !s.ok()) return s;
   absl::StatusOr<ImportedDrawing> out = Analyze(
       std::move(elements), field, absl::StrCat(field, ".elements"), true, drawing_number, max_points);
-  if (out.ok()) out->parsed.marks = MarksOf(drawing);
+  if (out.ok()) {
+    out->parsed.marks = MarksOf(drawing);
+    out->parsed.art = std::move(art);
+    out->import_report = drawing.import_report();
+    out->import_report.set_art_layers(static_cast<uint32_t>(out->parsed.art.size()));
+  }
   return out;
+}
+
+void StoreImport(const ImportedDrawing& imported, v1::Drawing* drawing) {
+  *drawing->mutable_elements() = imported.elements;
+  SetMarks(imported.parsed.marks, drawing);
+  drawing->clear_art();
+  ToProto(imported.parsed.art, drawing->mutable_art());
+  *drawing->mutable_import_report() = imported.import_report;
 }
 
 std::vector<solver::CorrespondenceMark> MarksOf(const v1::Drawing& drawing) {

@@ -159,10 +159,13 @@ absl::StatusOr<SessionState> LoadForUpdate(const SessionStore& store, const std:
   return state;
 }
 
-// The session without drawing sources (SVG text can be large); elements stay.
+// The session without drawing sources and art (both can be large); elements stay.
 v1::Session Compact(const v1::Session& session) {
   v1::Session out = session;
-  for (v1::Drawing& drawing : *out.mutable_drawings()) drawing.clear_source();
+  for (v1::Drawing& drawing : *out.mutable_drawings()) {
+    drawing.clear_source();
+    drawing.clear_art();
+  }
   return out;
 }
 
@@ -599,12 +602,11 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext* context,
       max_id = std::max(max_id, drawing.id());
       absl::StatusOr<ImportedDrawing> imported =
           drawing.elements().empty()
-              ? ImportDrawing(drawing, kDefaultFlattenTolerance, field, i + 1, {}, "topology",
+              ? ImportDrawing(drawing, {}, field, i + 1, {}, "topology",
                               options_.limits.max_drawing_points)
               : ImportDrawingElements(drawing, field, i + 1, options_.limits.max_drawing_points);
       if (!imported.ok()) return imported.status();
-      *drawing.mutable_elements() = imported->elements;
-      SetMarks(imported->parsed.marks, &drawing);
+      StoreImport(*imported, &drawing);
       state.parsed.push_back(std::move(imported->parsed));
     }
     state.next_drawing_id = max_id + 1;
@@ -672,14 +674,17 @@ grpc::Status InbetweenService::PutDrawing(grpc::ServerContext* context,
               absl::StrCat("drawing ", drawing_id, " not found in session ", session.id()));
         }
         // SVG parsing and graph flow run here, outside the store's lock.
+        const DrawingImportOptions import_options{
+            .flatten_tolerance = request->flatten_tolerance(),
+            .gap_tolerance = request->gap_tolerance(),
+            .min_area_fraction = request->min_area_fraction()};
         absl::StatusOr<ImportedDrawing> imported =
-            ImportDrawing(request->drawing(), request->flatten_tolerance(), "drawing", index + 1,
+            ImportDrawing(request->drawing(), import_options, "drawing", index + 1,
                           request->topology(), "topology", options_.limits.max_drawing_points);
         if (!imported.ok()) return imported.status();
 
         v1::Drawing drawing = request->drawing();
-        *drawing.mutable_elements() = imported->elements;
-        SetMarks(imported->parsed.marks, &drawing);
+        StoreImport(*imported, &drawing);
         if (add) {
           drawing.set_id(state->next_drawing_id++);
           *session.add_drawings() = drawing;
@@ -698,6 +703,7 @@ grpc::Status InbetweenService::PutDrawing(grpc::ServerContext* context,
         *response->mutable_drawing() = stored->session.drawings(index);
         response->mutable_drawing()->clear_source();
         *response->mutable_equivalence_class() = imported->equivalence_class;
+        *response->mutable_import_report() = imported->import_report;
         return absl::OkStatus();
       });
 }

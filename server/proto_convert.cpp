@@ -105,6 +105,128 @@ solver::Points FromProto(const google::protobuf::RepeatedPtrField<inbetween::v1:
   return out;
 }
 
+void ToProto(const solver::ArtLayer& layer, inbetween::v1::ArtLayer* out) {
+  out->set_id(layer.id);
+  out->set_name(layer.name);
+  out->mutable_paths()->Reserve(static_cast<int>(layer.paths.size()));
+  for (const solver::ArtPath& path : layer.paths) {
+    inbetween::v1::ArtPath* p = out->add_paths();
+    ToProto(path.points, p->mutable_points());
+    p->set_closed(path.closed);
+  }
+  if (layer.fill) {
+    inbetween::v1::FillPaint* fill = out->mutable_fill();
+    fill->set_rgb(layer.fill->rgb);
+    fill->set_opacity(layer.fill->opacity);
+    fill->set_even_odd(layer.fill->even_odd);
+  }
+  if (layer.stroke) {
+    const solver::StrokePaint& s = *layer.stroke;
+    inbetween::v1::StrokePaint* stroke = out->mutable_stroke();
+    stroke->set_rgb(s.rgb);
+    stroke->set_opacity(s.opacity);
+    stroke->set_width(s.width);
+    switch (s.cap) {
+      case solver::LineCap::kButt:
+        stroke->set_cap(inbetween::v1::LINE_CAP_BUTT);
+        break;
+      case solver::LineCap::kRound:
+        stroke->set_cap(inbetween::v1::LINE_CAP_ROUND);
+        break;
+      case solver::LineCap::kSquare:
+        stroke->set_cap(inbetween::v1::LINE_CAP_SQUARE);
+        break;
+    }
+    switch (s.join) {
+      case solver::LineJoin::kMiter:
+        stroke->set_join(inbetween::v1::LINE_JOIN_MITER);
+        break;
+      case solver::LineJoin::kRound:
+        stroke->set_join(inbetween::v1::LINE_JOIN_ROUND);
+        break;
+      case solver::LineJoin::kBevel:
+        stroke->set_join(inbetween::v1::LINE_JOIN_BEVEL);
+        break;
+    }
+    stroke->set_miter_limit(s.miter_limit);
+    stroke->mutable_dashes()->Add(s.dashes.begin(), s.dashes.end());
+    stroke->set_dash_offset(s.dash_offset);
+  }
+  out->set_opacity(layer.opacity);
+}
+
+void ToProto(const std::vector<solver::ArtLayer>& art,
+             google::protobuf::RepeatedPtrField<inbetween::v1::ArtLayer>* out) {
+  out->Reserve(out->size() + static_cast<int>(art.size()));
+  for (const solver::ArtLayer& layer : art) ToProto(layer, out->Add());
+}
+
+solver::ArtLayer FromProto(const inbetween::v1::ArtLayer& layer) {
+  solver::ArtLayer out;
+  out.id = layer.id();
+  out.name = layer.name();
+  out.paths.reserve(layer.paths_size());
+  for (const inbetween::v1::ArtPath& path : layer.paths()) {
+    out.paths.push_back({FromProto(path.points()), path.closed()});
+  }
+  if (layer.has_fill()) {
+    out.fill = solver::FillPaint{.rgb = layer.fill().rgb(),
+                                 .opacity = layer.fill().opacity(),
+                                 .even_odd = layer.fill().even_odd()};
+  }
+  if (layer.has_stroke()) {
+    const inbetween::v1::StrokePaint& s = layer.stroke();
+    solver::StrokePaint& stroke = out.stroke.emplace();
+    stroke.rgb = s.rgb();
+    stroke.opacity = s.opacity();
+    stroke.width = s.width();
+    stroke.cap = s.cap() == inbetween::v1::LINE_CAP_ROUND    ? solver::LineCap::kRound
+                 : s.cap() == inbetween::v1::LINE_CAP_SQUARE ? solver::LineCap::kSquare
+                                                             : solver::LineCap::kButt;
+    stroke.join = s.join() == inbetween::v1::LINE_JOIN_ROUND   ? solver::LineJoin::kRound
+                  : s.join() == inbetween::v1::LINE_JOIN_BEVEL ? solver::LineJoin::kBevel
+                                                               : solver::LineJoin::kMiter;
+    stroke.miter_limit = s.miter_limit();
+    stroke.dashes.assign(s.dashes().begin(), s.dashes().end());
+    stroke.dash_offset = s.dash_offset();
+  }
+  out.opacity = layer.opacity();
+  return out;
+}
+
+std::vector<solver::ArtLayer> FromProto(
+    const google::protobuf::RepeatedPtrField<inbetween::v1::ArtLayer>& art) {
+  std::vector<solver::ArtLayer> out;
+  out.reserve(art.size());
+  for (const inbetween::v1::ArtLayer& layer : art) out.push_back(FromProto(layer));
+  return out;
+}
+
+inbetween::v1::ImportReport ToProto(const solver::SvgImportInfo& info, int art_layers) {
+  inbetween::v1::ImportReport out;
+  switch (info.source) {
+    case solver::SilhouetteSource::kElements:
+      out.set_silhouette_source(inbetween::v1::SILHOUETTE_SOURCE_ELEMENTS);
+      break;
+    case solver::SilhouetteSource::kUnion:
+      out.set_silhouette_source(inbetween::v1::SILHOUETTE_SOURCE_UNION);
+      break;
+    case solver::SilhouetteSource::kOutlineClass:
+      out.set_silhouette_source(inbetween::v1::SILHOUETTE_SOURCE_OUTLINE_CLASS);
+      break;
+  }
+  const solver::PaintCleaning& c = info.cleaning;
+  out.set_gaps_closed(static_cast<uint32_t>(c.gaps_closed));
+  out.set_slits_closed(static_cast<uint32_t>(c.slits_closed));
+  out.set_islands_dropped(static_cast<uint32_t>(c.islands_dropped));
+  out.set_holes_dropped(static_cast<uint32_t>(c.holes_dropped));
+  out.set_gap_width(c.gap_width);
+  out.set_min_area(c.min_area);
+  for (const std::string& warning : info.warnings) out.add_warnings(warning);
+  out.set_art_layers(static_cast<uint32_t>(art_layers));
+  return out;
+}
+
 solver::Drawing SolverDrawing(
     const google::protobuf::RepeatedPtrField<inbetween::v1::TopologyElement>& elements) {
   solver::Drawing out;

@@ -5,6 +5,7 @@
 #include "absl/strings/string_view.h"
 #include "inbetween/v1/inbetween.pb.h"
 #include "solver/core/types.h"
+#include "solver/io/svg_import.h"
 #include "solver/mesh/multimesh.h"
 
 namespace inbetween::server {
@@ -25,5 +26,18 @@ solver::Drawing SolverDrawing(
     const google::protobuf::RepeatedPtrField<inbetween::v1::TopologyElement>& elements);
 
 solver::Points FromProto(const google::protobuf::RepeatedPtrField<inbetween::v1::Point>& points);
+
+// A drawing's art (Drawing.art), both ways. FromProto reads UNSPECIFIED cap and join as SVG's
+// initial values (butt, miter), as it reads any value it does not know; it checks nothing
+// (CheckArt in drawing_import.h does).
+void ToProto(const solver::ArtLayer& layer, inbetween::v1::ArtLayer* out);
+void ToProto(const std::vector<solver::ArtLayer>& art,
+             google::protobuf::RepeatedPtrField<inbetween::v1::ArtLayer>* out);
+solver::ArtLayer FromProto(const inbetween::v1::ArtLayer& layer);
+std::vector<solver::ArtLayer> FromProto(
+    const google::protobuf::RepeatedPtrField<inbetween::v1::ArtLayer>& art);
+
+// What ImportSvg saw, as the API reports it; `art_layers` is the size of the drawing's art.
+inbetween::v1::ImportReport ToProto(const solver::SvgImportInfo& info, int art_layers);
 
 }  // namespace inbetween::server

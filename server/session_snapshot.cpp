@@ -1,5 +1,6 @@
-// Snapshot encoding. The parsed solver drawings are rebuilt from the stored elements (they are
-// the same numbers), the multimesh from the archive plus its loops and closed cohesive edges.
+// Snapshot encoding. The parsed solver drawings are rebuilt from the stored elements, marks and
+// art (they are the same numbers), the multimesh from the archive plus its loops and closed
+// cohesive edges.
 #include "server/session_snapshot.h"
 
 #include <cstdint>
@@ -278,6 +279,7 @@ absl::StatusOr<SessionState> DecodeSnapshot(absl::string_view bytes, absl::strin
   for (const v1::Drawing& drawing : state.session.drawings()) {
     state.parsed.push_back(SolverDrawing(drawing.elements()));
     state.parsed.back().marks = MarksOf(drawing);
+    state.parsed.back().art = FromProto(drawing.art());
   }
   if (archive.has_multimesh() && archive.multimesh().shapes_size() > 0) {
     absl::StatusOr<solver::Multimesh> mesh = MultimeshFromProto(archive.multimesh(), where);

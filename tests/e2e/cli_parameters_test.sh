@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Inbetween parameters from the project file and the command line: `init` writes the flags into
 # the project; stiffness regions (project only) reach the solver (a stiff left half changes the
-# inbetweens but never the keys); a flag overrides the project's value.
+# inbetweens but never the keys); a flag overrides the project's value. Import settings likewise:
+# `init` writes them, `validate` reports each drawing's import with them, a flag overrides them
+# and a value out of range is refused naming the flag.
 source "$(dirname "$0")/lib/common.sh"
 ex="$INBETWEEN_SRC/examples/principles_squash_stretch"
 lib="$INBETWEEN_SRC/tests/e2e/lib"
@@ -48,4 +50,40 @@ PY
 # A flag overrides the project: --key-times moves the middle key back to the centre.
 "$CLI_BIN" animate --project p.json --key-times 0,0.5,1 --format json --out keyed -q > /dev/null
 python3 -c "import json; k = json.load(open('keyed/frames.json'))['keys']; assert k == [0, 3, 6], k"
+
+# Import settings. A face with an eye painted on it, and text (not imported: a warning).
+cat > face.svg <<'SVG'
+<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100">
+  <circle id="face" cx="50" cy="50" r="40" fill="#f0c080"/>
+  <circle id="eye" cx="35" cy="40" r="6" fill="#203040" stroke="#000000" stroke-width="1.5"/>
+  <text id="label" x="10" y="95">face</text>
+</svg>
+SVG
+"$CLI_BIN" init face.svg face.svg -o imp.json --gap-tolerance 0.01 --min-area-fraction 0 > /dev/null
+python3 - <<'PY'
+import json
+i = json.load(open("imp.json"))["import"]
+assert i == {"gap_tolerance": 0.01, "min_area_fraction": 0}, i
+PY
+"$CLI_BIN" validate --project imp.json -q > imp.out 2>/dev/null || { cat imp.out; exit 1; }
+facts='silhouette [a-z ]+; [0-9]+ art layers?; gaps closed [0-9]+, slits closed [0-9]+, islands dropped [0-9]+, holes dropped [0-9]+'
+for n in 1 2; do
+  grep -qE "^drawing $n \(.*face.svg\): $facts \(gap width [0-9.e+-]*[1-9][0-9.e+-]*, area threshold 0\)$" imp.out &&
+    grep -q "^drawing $n (.*face.svg): warning: .*text" imp.out || { cat imp.out; exit 1; }
+done
+grep -qx ok imp.out || { cat imp.out; exit 1; }
+# The flag overrides the project: no gap closing.
+"$CLI_BIN" validate --project imp.json --gap-tolerance 0 -q > imp0.out 2>/dev/null || { cat imp0.out; exit 1; }
+grep -qE "^drawing 1 .*\(gap width 0, area threshold 0\)$" imp0.out || { cat imp0.out; exit 1; }
+# Out of range: exit 3 naming the flag (validate and animate alike); not a number: usage, exit 2.
+set +e
+"$CLI_BIN" validate --project imp.json --gap-tolerance 0.2 -q > bad_gap.out 2>&1; code=$?
+"$CLI_BIN" animate face.svg face.svg --min-area-fraction 1 --out never -q 2> bad_area.err; code2=$?
+"$CLI_BIN" animate face.svg face.svg --gap-tolerance wide --out never -q 2> bad_nan.err; code3=$?
+set -e
+[[ $code -eq 3 && $code2 -eq 3 && $code3 -eq 2 ]] || { echo "exit codes $code $code2 $code3"; exit 1; }
+grep -qF -- "--gap-tolerance: value 0.2 is not in [0, 0.1]" bad_gap.out || { cat bad_gap.out; exit 1; }
+grep -qF -- "--min-area-fraction: value 1 is not in [0, 0.1]" bad_area.err || { cat bad_area.err; exit 1; }
+grep -qF -- "--gap-tolerance" bad_nan.err || { cat bad_nan.err; exit 1; }
+[[ ! -e never ]] || { echo "a refused animate wrote output"; exit 1; }
 echo ok

@@ -1,7 +1,12 @@
 // Tests ApplyInbetweenOverrides (client/commands.cpp): command-line inbetween parameters land in
-// InbetweenParameters, win over the project file, and bad values are refused naming the flag.
+// InbetweenParameters, win over the project file, and bad values are refused naming the flag;
+// likewise the import flags ResolveProject applies.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+#include <utility>
 
 #include "client/commands.h"
 
@@ -116,6 +121,31 @@ INSTANTIATE_TEST_SUITE_P(
         BadFlag{"timestep", {.timestep = 11}, "--timestep"},
         BadFlag{"iterations", {.max_iterations = 0}, "--max-iterations"}),
     [](const auto& info) { return std::string(info.param.name); });
+
+TEST(ImportFlagsTest, FlagsWinOverTheProjectAndAreChecked) {
+  Inputs inputs{.drawings = {"a.svg", "b.svg"}};
+  absl::StatusOr<Project> p = ResolveProject(inputs);
+  ASSERT_TRUE(p.ok()) << p.status();
+  EXPECT_FALSE(p->import_settings.gap_tolerance.has_value());  // the server's default
+  EXPECT_FALSE(p->import_settings.min_area_fraction.has_value());
+
+  inputs.import_flags = {.gap_tolerance = 0.0, .min_area_fraction = 0.1};
+  p = ResolveProject(inputs);
+  ASSERT_TRUE(p.ok()) << p.status();
+  EXPECT_EQ(p->import_settings.gap_tolerance, 0.0);
+  EXPECT_EQ(p->import_settings.min_area_fraction, 0.1);
+
+  for (auto [flags, message] :
+       {std::pair{ImportSettings{.gap_tolerance = 0.5}, "--gap-tolerance: value 0.5 is not in"},
+        {ImportSettings{.gap_tolerance = -0.001}, "--gap-tolerance: value -0.001"},
+        {ImportSettings{.min_area_fraction = std::numeric_limits<double>::quiet_NaN()},
+         "--min-area-fraction: value nan"}}) {
+    inputs.import_flags = flags;
+    absl::Status s = ResolveProject(inputs).status();
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << message;
+    EXPECT_THAT(std::string(s.message()), HasSubstr(message));
+  }
+}
 
 }  // namespace
 }  // namespace inbetween::client

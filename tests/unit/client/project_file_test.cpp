@@ -27,6 +27,7 @@ TEST(ProjectFileTest, FullProjectRoundTrips) {
     "drawings": [{"file": "a.svg", "key_time": 0, "cuts": [[[0,0],[1,1]]]},
                  {"file": "b.svg", "key_time": 1, "openings": [[[2,2],[3,3],[4,2]]]}],
     "correspondences": [[[0,0],[5,5]]],
+    "import": {"gap_tolerance": 0.01, "min_area_fraction": 0},
     "meshing": {"boundary_vertices": 96, "shape_bound": 0.1, "corner_matching": "always"},
     "comesh": {"map_weight": 0.3, "max_outer_iterations": 7, "outline_corner_degrees": 40,
                "min_quality": 0.05},
@@ -47,6 +48,8 @@ TEST(ProjectFileTest, FullProjectRoundTrips) {
   EXPECT_EQ(p->drawings[0].cuts.size(), 1u);
   EXPECT_EQ(p->drawings[1].openings[0].size(), 3u);
   EXPECT_EQ(p->output.width, 256);
+  EXPECT_EQ(p->import_settings.gap_tolerance, 0.01);
+  EXPECT_EQ(p->import_settings.min_area_fraction, 0.0);  // set: 0 = off, not the default
   json again = ProjectToJson(*p, "/base");
   EXPECT_EQ(again, doc) << again.dump(2);
 }
@@ -83,6 +86,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{R"({"version": 1, "drawings": ["a", "b"],
                     "comesh": {"outline_corner_degrees": 200}})",
                 "$.comesh.outline_corner_degrees: value 200 out of range [0, 180]"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "import": {"gap_tolerance": 0.5}})",
+                "$.import.gap_tolerance: value 0.5 out of range [0, 0.1]"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"],
+                    "import": {"min_area_fraction": -1}})",
+                "$.import.min_area_fraction: value -1 out of range [0, 0.1]"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"], "import": {"flatten": 1}})",
+                "$.import.flatten: unknown field"},
         BadCase{R"({"version": 1, "drawings": ["a", "b"], "inbetween": {"method": "x"}})",
                 "$.inbetween.method: unknown method 'x'"},
         BadCase{R"({"version": 1, "drawings": ["a", "b"],

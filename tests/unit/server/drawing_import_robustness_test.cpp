@@ -33,7 +33,7 @@ TEST(DrawingImportRobustnessTest, DuplicateAndRepeatedClosingPointsAreMerged) {
   // tests/data/bad/outline_duplicate_points.json: used to be "crosses itself".
   const v1::Drawing drawing = PolylineDrawing(
       {{10, 10}, {110, 10}, {110, 10}, {110, 110}, {110, 110 + 1e-12}, {10, 110}, {10, 10}});
-  absl::StatusOr<ImportedDrawing> imported = ImportDrawing(drawing, 0, "drawing", 1);
+  absl::StatusOr<ImportedDrawing> imported = ImportDrawing(drawing, {}, "drawing", 1);
   ASSERT_TRUE(imported.ok()) << imported.status();
   ASSERT_EQ(imported->parsed.outlines.size(), 1u);
   EXPECT_EQ(imported->parsed.outlines[0].points.size(), 4u);
@@ -44,23 +44,24 @@ TEST(DrawingImportRobustnessTest, DuplicateAndRepeatedClosingPointsAreMerged) {
 
 TEST(DrawingImportRobustnessTest, PointsFartherThanTheToleranceAreKept) {
   const v1::Drawing drawing = PolylineDrawing({{0, 0}, {1e-3, 0}, {100, 0}, {100, 100}, {0, 100}});
-  absl::StatusOr<ImportedDrawing> imported = ImportDrawing(drawing, 0, "drawing", 1);
+  absl::StatusOr<ImportedDrawing> imported = ImportDrawing(drawing, {}, "drawing", 1);
   ASSERT_TRUE(imported.ok()) << imported.status();
   EXPECT_EQ(imported->parsed.outlines[0].points.size(), 5u);
 }
 
 TEST(DrawingImportRobustnessTest, CleaningNeverHidesADegenerateOutline) {
   absl::Status same =
-      ImportDrawing(PolylineDrawing({{3, 3}, {3, 3}, {3, 3}, {3, 3}}), 0, "drawing", 1).status();
+      ImportDrawing(PolylineDrawing({{3, 3}, {3, 3}, {3, 3}, {3, 3}}), {}, "drawing", 1).status();
   EXPECT_EQ(same.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(same.message(),
               HasSubstr("(4 points, 1 after merging near-duplicates) has 1 points"));
   absl::Status line =
-      ImportDrawing(PolylineDrawing({{0, 0}, {10, 0}, {10, 0}, {20, 0}}), 0, "drawing", 1).status();
+      ImportDrawing(PolylineDrawing({{0, 0}, {10, 0}, {10, 0}, {20, 0}}), {}, "drawing", 1)
+          .status();
   EXPECT_EQ(line.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(line.message(), HasSubstr("zero area"));
   absl::Status bowtie =
-      ImportDrawing(PolylineDrawing({{0, 0}, {10, 10}, {10, 10}, {10, 0}, {0, 20}}), 0, "drawing",
+      ImportDrawing(PolylineDrawing({{0, 0}, {10, 10}, {10, 10}, {10, 0}, {0, 20}}), {}, "drawing",
                     1)
           .status();
   EXPECT_EQ(bowtie.code(), absl::StatusCode::kInvalidArgument);
@@ -72,7 +73,9 @@ TEST(DrawingImportRobustnessTest, SvgFlattenBombIsResourceExhaustedNamingTheFlag
   drawing.set_svg(
       "<svg xmlns=\"http://www.w3.org/2000/svg\"><circle cx=\"0\" cy=\"0\" r=\"1e8\"/>"
       "<circle cx=\"3e8\" cy=\"0\" r=\"1e8\"/></svg>");
-  absl::Status s = ImportDrawing(drawing, 1e-6, "drawing", 1, {}, "topology", 50000).status();
+  absl::Status s =
+      ImportDrawing(drawing, {.flatten_tolerance = 1e-6}, "drawing", 1, {}, "topology", 50000)
+          .status();
   EXPECT_EQ(s.code(), absl::StatusCode::kResourceExhausted);
   EXPECT_THAT(s.message(), HasSubstr("drawing.svg: SVG has more than 50000 points"));
   EXPECT_THAT(s.message(), HasSubstr("--max-drawing-points"));
@@ -90,7 +93,7 @@ TEST(DrawingImportRobustnessTest, UseFanOutIsResourceExhaustedWithoutThePointsFl
   s += "</defs><use href=\"#l8\"/></svg>";
   v1::Drawing drawing;
   drawing.set_svg(s);
-  absl::Status status = ImportDrawing(drawing, 0, "drawing", 1).status();
+  absl::Status status = ImportDrawing(drawing, {}, "drawing", 1).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kResourceExhausted);
   EXPECT_THAT(status.message(), HasSubstr("more than 100000 elements"));
   EXPECT_THAT(status.message(), ::testing::Not(HasSubstr("--max-drawing-points")));

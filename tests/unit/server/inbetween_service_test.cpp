@@ -9,11 +9,14 @@
 #include <limits>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "server/parameters.h"
+#include "server/proto_convert.h"
 #include "solver/comesh/comesh_topology.h"
 #include "solver/core/types.h"
+#include "solver/io/svg_import.h"
 #include "solver/mesh/validate.h"
 #include "tests/unit/server/test_server.h"
 
@@ -409,6 +412,27 @@ TEST_F(InbetweenServiceTest, SetCorrespondences) {
 // ---------------------------------------------------------------------------------------------
 // Export / import
 
+// ExportSession's archive of session `id`.
+v1::SessionArchive Export(v1::Inbetween::Stub& stub, const std::string& id) {
+  grpc::ClientContext context;
+  v1::ExportSessionRequest request;
+  request.set_session_id(id);
+  v1::ExportSessionResponse exported;
+  grpc::Status status = stub.ExportSession(&context, request, &exported);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  v1::SessionArchive archive;
+  EXPECT_TRUE(archive.ParseFromString(exported.data()));
+  return archive;
+}
+
+grpc::Status Import(v1::Inbetween::Stub& stub, const v1::SessionArchive& archive,
+                    v1::ImportSessionResponse* response) {
+  grpc::ClientContext context;
+  v1::ImportSessionRequest request;
+  archive.SerializeToString(request.mutable_data());
+  return stub.ImportSession(&context, request, response);
+}
+
 TEST_F(InbetweenServiceTest, ExportImportRoundTrip) {
   v1::Session original = ImportTwoSquares();
   grpc::ClientContext context;
@@ -473,25 +497,232 @@ TEST_F(InbetweenServiceTest, ImportRejectsGarbage) {
 
 TEST_F(InbetweenServiceTest, ImportRejectsAnInvertedMultimesh) {
   v1::Session original = ImportTwoSquares();
-  grpc::ClientContext context;
-  v1::ExportSessionRequest request;
-  request.set_session_id(original.id());
-  v1::ExportSessionResponse exported;
-  ASSERT_TRUE(stub_->ExportSession(&context, request, &exported).ok());
-  v1::SessionArchive archive;
-  ASSERT_TRUE(archive.ParseFromString(exported.data()));
+  v1::SessionArchive archive = Export(*stub_, original.id());
   v1::Triangle* t = archive.mutable_multimesh()->mutable_triangles(0);
   const uint32_t a = t->a();
   t->set_a(t->b());
   t->set_b(a);
 
-  grpc::ClientContext context2;
-  v1::ImportSessionRequest import;
-  archive.SerializeToString(import.mutable_data());
   v1::ImportSessionResponse imported;
-  grpc::Status status = stub_->ImportSession(&context2, import, &imported);
+  grpc::Status status = Import(*stub_, archive, &imported);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("data: multimesh"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Art and import report: what PutDrawing stores is exactly what solver::ImportSvg returns for
+// the same options, and sessions keep it through every path.
+
+// A face with an eye painted on it (two filled elements that overlap; the eye also stroked).
+constexpr char kFaceSvg[] = R"(<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100">
+  <circle id="face" data-layer="face" cx="50" cy="50" r="40" fill="#f0c080"/>
+  <circle id="eye" data-layer="eye" cx="35" cy="40" r="6" fill="#203040" stroke="#000000"
+          stroke-width="1.5"/>
+</svg>)";
+
+v1::PutDrawingRequest FaceRequest(const v1::Session& session, double gap_tolerance = 0,
+                                  double min_area_fraction = 0) {
+  v1::PutDrawingRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  request.mutable_drawing()->set_name("face");
+  request.mutable_drawing()->set_svg(kFaceSvg);
+  request.set_gap_tolerance(gap_tolerance);
+  request.set_min_area_fraction(min_area_fraction);
+  return request;
+}
+
+// The report's fields one by one against what ImportSvg said.
+void ExpectReportOf(const v1::ImportReport& got, const solver::SvgImportInfo& info,
+                    size_t art_layers) {
+  const v1::SilhouetteSource sources[] = {v1::SILHOUETTE_SOURCE_ELEMENTS,
+                                          v1::SILHOUETTE_SOURCE_UNION,
+                                          v1::SILHOUETTE_SOURCE_OUTLINE_CLASS};
+  EXPECT_EQ(got.silhouette_source(), sources[static_cast<int>(info.source)]);
+  EXPECT_EQ(got.gaps_closed(), static_cast<uint32_t>(info.cleaning.gaps_closed));
+  EXPECT_EQ(got.slits_closed(), static_cast<uint32_t>(info.cleaning.slits_closed));
+  EXPECT_EQ(got.islands_dropped(), static_cast<uint32_t>(info.cleaning.islands_dropped));
+  EXPECT_EQ(got.holes_dropped(), static_cast<uint32_t>(info.cleaning.holes_dropped));
+  EXPECT_EQ(got.gap_width(), info.cleaning.gap_width);
+  EXPECT_EQ(got.min_area(), info.cleaning.min_area);
+  EXPECT_EQ(std::vector<std::string>(got.warnings().begin(), got.warnings().end()), info.warnings);
+  EXPECT_EQ(got.art_layers(), art_layers);
+}
+
+// A drawing's art, serialized (equal bytes = equal art).
+std::string ArtBytes(const v1::Drawing& drawing) {
+  v1::Drawing art;
+  *art.mutable_art() = drawing.art();
+  return art.SerializeAsString();
+}
+
+v1::GetSessionResponse GetFull(v1::Inbetween::Stub& stub, const std::string& id, bool full = true) {
+  grpc::ClientContext context;
+  v1::GetSessionRequest request;
+  request.set_session_id(id);
+  request.set_full(full);
+  v1::GetSessionResponse response;
+  grpc::Status status = stub.GetSession(&context, request, &response);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  return response;
+}
+
+TEST_F(InbetweenServiceTest, PutDrawingStoresTheArtAndReportOfImportSvg) {
+  // Request values -> ImportSvg's: 0 = the default, negative = off.
+  const solver::SvgImportOptions defaults;
+  struct Case {
+    double gap_tolerance, min_area_fraction;  // in the request
+    double import_gap, import_min_area;       // what ImportSvg gets
+  };
+  for (const Case& c : {Case{0, 0, defaults.gap_tolerance, defaults.min_area_fraction},
+                        Case{0.01, -1, 0.01, 0}, Case{-0.5, 0.05, 0, 0.05}}) {
+    SCOPED_TRACE(::testing::Message()
+                 << "gap " << c.gap_tolerance << " min area " << c.min_area_fraction);
+    solver::SvgImportOptions options;
+    options.gap_tolerance = c.import_gap;
+    options.min_area_fraction = c.import_min_area;
+    solver::SvgImportInfo info;
+    absl::StatusOr<solver::Drawing> expected = solver::ImportSvg(kFaceSvg, options, &info);
+    ASSERT_TRUE(expected.ok()) << expected.status();
+
+    const v1::Session session = CreateSession();
+    grpc::ClientContext context;
+    v1::PutDrawingResponse response;
+    grpc::Status status = stub_->PutDrawing(
+        &context, FaceRequest(session, c.gap_tolerance, c.min_area_fraction), &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    const v1::Drawing& drawing = response.drawing();
+    ASSERT_EQ(drawing.art_size(), static_cast<int>(expected->art.size()));
+    ExpectSameArt(FromProto(drawing.art()), expected->art);
+    ExpectReportOf(drawing.import_report(), info, expected->art.size());
+    EXPECT_EQ(response.import_report().SerializeAsString(),
+              drawing.import_report().SerializeAsString());
+
+    // Stored with the session: the full session has it, the compact one only the report.
+    const v1::Drawing stored = GetFull(*stub_, session.id()).session().drawings(0);
+    EXPECT_EQ(stored.art_size(), drawing.art_size());
+    ExpectSameArt(FromProto(stored.art()), expected->art);
+    const v1::Drawing compact = GetFull(*stub_, session.id(), false).session().drawings(0);
+    EXPECT_EQ(compact.art_size(), 0);
+    EXPECT_EQ(compact.import_report().SerializeAsString(),
+              drawing.import_report().SerializeAsString());
+    EXPECT_EQ(response.session().drawings(0).art_size(), 0);  // replies carry the compact session
+  }
+}
+
+TEST_F(InbetweenServiceTest, ImportOptionsOutOfRangeAreInvalidArgumentNamingTheField) {
+  const v1::Session session = CreateSession();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (auto [gap, min_area, field] : {std::tuple{0.5, 0.0, "gap_tolerance"},
+                                      {nan, 0.0, "gap_tolerance"},
+                                      {-inf, 0.0, "gap_tolerance"},
+                                      {0.0, 0.2, "min_area_fraction"},
+                                      {0.0, inf, "min_area_fraction"},
+                                      {0.0, nan, "min_area_fraction"}}) {
+    grpc::ClientContext context;
+    v1::PutDrawingResponse response;
+    grpc::Status status =
+        stub_->PutDrawing(&context, FaceRequest(session, gap, min_area), &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
+    EXPECT_THAT(status.error_message(), HasSubstr(std::string(field) + " = ")) << field;
+  }
+  EXPECT_EQ(GetFull(*stub_, session.id()).session().drawings_size(), 0);
+}
+
+TEST_F(InbetweenServiceTest, PolylineDrawingsHaveNoArtAndReportElements) {
+  const v1::Session session = CreateSession();
+  grpc::ClientContext context;
+  v1::PutDrawingRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(session.version());
+  *request.mutable_drawing()->mutable_polylines()->add_elements() = SquareOutline(0, 0, 10);
+  ToProto(SampleArt(), request.mutable_drawing()->mutable_art());  // output only: ignored
+  request.mutable_drawing()->mutable_import_report()->set_art_layers(2);
+  v1::PutDrawingResponse response;
+  grpc::Status status = stub_->PutDrawing(&context, request, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.drawing().art_size(), 0);
+  v1::ImportReport want;
+  want.set_silhouette_source(v1::SILHOUETTE_SOURCE_ELEMENTS);
+  EXPECT_EQ(response.drawing().import_report().SerializeAsString(), want.SerializeAsString());
+  EXPECT_EQ(response.import_report().SerializeAsString(), want.SerializeAsString());
+  EXPECT_EQ(GetFull(*stub_, session.id()).session().drawings(0).art_size(), 0);
+}
+
+TEST_F(InbetweenServiceTest, ArtSurvivesExportImportAndTopologyEdits) {
+  v1::Session session = CreateSession();
+  grpc::ClientContext put_context;
+  v1::PutDrawingResponse put;
+  ASSERT_TRUE(stub_->PutDrawing(&put_context, FaceRequest(session, 0.01), &put).ok());
+  session = put.session();
+  const v1::Drawing original = GetFull(*stub_, session.id()).session().drawings(0);
+  EXPECT_EQ(ArtBytes(original), ArtBytes(put.drawing()));
+
+  // An edit re-analyses the drawing from its elements: the art and report stay as they were.
+  {
+    grpc::ClientContext context;
+    auto stream = stub_->EditTopology(&context);
+    v1::TopologyEdit edit;
+    edit.set_session_id(session.id());
+    edit.set_expected_version(session.version());
+    edit.set_drawing_id(original.id());
+    *edit.mutable_move() = original.elements(0);  // moved onto itself
+    ASSERT_TRUE(stream->Write(edit));
+    v1::TopologyState state;
+    ASSERT_TRUE(stream->Read(&state));
+    stream->WritesDone();
+    ASSERT_TRUE(stream->Finish().ok());
+  }
+  v1::Drawing edited = GetFull(*stub_, session.id()).session().drawings(0);
+  EXPECT_EQ(ArtBytes(edited), ArtBytes(original));
+  EXPECT_EQ(edited.import_report().SerializeAsString(),
+            original.import_report().SerializeAsString());
+
+  v1::ImportSessionResponse imported;
+  grpc::Status status = Import(*stub_, Export(*stub_, session.id()), &imported);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  const v1::Drawing copy = GetFull(*stub_, imported.session().id()).session().drawings(0);
+  EXPECT_EQ(copy.art_size(), original.art_size());
+  EXPECT_EQ(ArtBytes(copy), ArtBytes(original));
+  EXPECT_EQ(copy.import_report().SerializeAsString(), original.import_report().SerializeAsString());
+}
+
+TEST_F(InbetweenServiceTest, ImportSessionReimportsADrawingWithoutElementsOnce) {
+  // An archive whose drawing has its SVG but no elements is imported again (default options):
+  // the archive's stale art is replaced, not added to.
+  v1::SessionArchive archive;
+  archive.set_format_version(1);
+  v1::Drawing* drawing = archive.mutable_session()->add_drawings();
+  drawing->set_id(1);
+  drawing->set_svg(kFaceSvg);
+  ToProto(SampleArt(), drawing->mutable_art());
+  drawing->mutable_import_report()->set_gaps_closed(42);
+  v1::ImportSessionResponse response;
+  grpc::Status status = Import(*stub_, archive, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+
+  solver::SvgImportInfo info;
+  absl::StatusOr<solver::Drawing> expected = solver::ImportSvg(kFaceSvg, {}, &info);
+  ASSERT_TRUE(expected.ok()) << expected.status();
+  const v1::Drawing stored = GetFull(*stub_, response.session().id()).session().drawings(0);
+  EXPECT_GT(stored.elements_size(), 0);
+  ExpectSameArt(FromProto(stored.art()), expected->art);
+  ExpectReportOf(stored.import_report(), info, expected->art.size());
+}
+
+TEST_F(InbetweenServiceTest, ImportSessionRefusesBadArt) {
+  const v1::Session original = ImportTwoSquares();
+  v1::SessionArchive archive = Export(*stub_, original.id());
+  v1::Drawing* drawing = archive.mutable_session()->mutable_drawings(1);
+  ToProto(SampleArt(), drawing->mutable_art());
+  drawing->mutable_art(1)->mutable_paths(0)->mutable_points(0)->set_x(
+      std::numeric_limits<double>::infinity());
+
+  v1::ImportSessionResponse imported;
+  grpc::Status status = Import(*stub_, archive, &imported);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("data: session.drawings[1].art[1].paths[0]"));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,6 +1,7 @@
 // Session snapshots (server/session_snapshot.cpp): a comesh checkpoint comes back bit for bit,
 // a snapshot without one is unchanged, the checkpoint section after the end marker is what an
-// older reader skips, and a damaged section is DATA_LOSS.
+// older reader skips, and a damaged section is DATA_LOSS; drawings keep their art and import
+// report, and the parsed drawings get the art back.
 #include "server/session_snapshot.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "server/proto_convert.h"
 #include "tests/unit/server/test_server.h"
 
 namespace inbetween::server::testing {
@@ -69,6 +71,25 @@ TEST(SessionSnapshotTest, ComeshCheckpointRoundTripsBitForBit) {
   // The session's own multimesh is the input, not the checkpoint's.
   ASSERT_TRUE(decoded->multimesh);
   EXPECT_EQ(decoded->multimesh->shapes, state.multimesh->shapes);
+}
+
+TEST(SessionSnapshotTest, ArtAndImportReportRoundTrip) {
+  SessionState state = StoredSessionState("alice");
+  state.session.set_id("0123456789abcdef");
+  v1::Drawing& drawing = *state.session.mutable_drawings(0);
+  ToProto(SampleArt(), drawing.mutable_art());
+  drawing.mutable_import_report()->set_silhouette_source(v1::SILHOUETTE_SOURCE_UNION);
+  drawing.mutable_import_report()->set_islands_dropped(3);
+  drawing.mutable_import_report()->set_min_area(0.1 + 0.2);
+  drawing.mutable_import_report()->add_warnings("a gradient became its mean colour");
+  drawing.mutable_import_report()->set_art_layers(2);
+  state.parsed[0].art = SampleArt();
+  absl::StatusOr<SessionState> decoded = DecodeSnapshot(EncodeSnapshot(state), "test");
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  ASSERT_EQ(decoded->session.drawings_size(), 1);
+  EXPECT_EQ(decoded->session.drawings(0).SerializeAsString(), drawing.SerializeAsString());
+  ASSERT_EQ(decoded->parsed.size(), 1u);
+  ExpectSameArt(decoded->parsed[0].art, SampleArt());
 }
 
 TEST(SessionSnapshotTest, WithoutACheckpointTheLayoutIsUnchanged) {

@@ -74,6 +74,64 @@ inline v1::TopologyElement SquareOutline(double x0, double y0, double size) {
   return element;
 }
 
+// Two art layers using every field: a filled square (even-odd) and a dashed, round-capped
+// stroke with bevel joins, whose coordinates are not exact decimals.
+inline std::vector<solver::ArtLayer> SampleArt() {
+  solver::ArtLayer fill;
+  fill.id = "body";
+  fill.name = "torso";
+  fill.paths = {{{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, true}};
+  fill.fill = solver::FillPaint{.rgb = 0x3b7dd8, .opacity = 0.5, .even_odd = true};
+  fill.opacity = 0.75;
+  solver::ArtLayer stroke;
+  stroke.paths = {{{{0.1 + 0.2, 1.0 / 3.0}, {2, 2}}, false}, {{{3, 3}, {4, 3}, {4, 4}}, true}};
+  stroke.stroke = solver::StrokePaint{.rgb = 0x102030,
+                                      .opacity = 0.25,
+                                      .width = 1.5,
+                                      .cap = solver::LineCap::kRound,
+                                      .join = solver::LineJoin::kBevel,
+                                      .miter_limit = 10,
+                                      .dashes = {2, 1},
+                                      .dash_offset = 0.5};
+  return {fill, stroke};
+}
+
+// Every field of two drawings' art is equal (doubles exactly).
+inline void ExpectSameArt(const std::vector<solver::ArtLayer>& got,
+                          const std::vector<solver::ArtLayer>& want) {
+  ASSERT_EQ(got.size(), want.size());
+  for (size_t i = 0; i < got.size(); ++i) {
+    SCOPED_TRACE(::testing::Message() << "layer " << i);
+    const solver::ArtLayer& a = got[i];
+    const solver::ArtLayer& b = want[i];
+    EXPECT_EQ(a.id, b.id);
+    EXPECT_EQ(a.name, b.name);
+    ASSERT_EQ(a.paths.size(), b.paths.size());
+    for (size_t k = 0; k < a.paths.size(); ++k) {
+      EXPECT_EQ(a.paths[k].points, b.paths[k].points) << "path " << k;
+      EXPECT_EQ(a.paths[k].closed, b.paths[k].closed) << "path " << k;
+    }
+    EXPECT_EQ(a.opacity, b.opacity);
+    ASSERT_EQ(a.fill.has_value(), b.fill.has_value());
+    if (a.fill) {
+      EXPECT_EQ(a.fill->rgb, b.fill->rgb);
+      EXPECT_EQ(a.fill->opacity, b.fill->opacity);
+      EXPECT_EQ(a.fill->even_odd, b.fill->even_odd);
+    }
+    ASSERT_EQ(a.stroke.has_value(), b.stroke.has_value());
+    if (a.stroke) {
+      EXPECT_EQ(a.stroke->rgb, b.stroke->rgb);
+      EXPECT_EQ(a.stroke->opacity, b.stroke->opacity);
+      EXPECT_EQ(a.stroke->width, b.stroke->width);
+      EXPECT_EQ(a.stroke->cap, b.stroke->cap);
+      EXPECT_EQ(a.stroke->join, b.stroke->join);
+      EXPECT_EQ(a.stroke->miter_limit, b.stroke->miter_limit);
+      EXPECT_EQ(a.stroke->dashes, b.stroke->dashes);
+      EXPECT_EQ(a.stroke->dash_offset, b.stroke->dash_offset);
+    }
+  }
+}
+
 // A stored state (for store tests): one drawing (a unit square) and a two-triangle multimesh.
 inline SessionState StoredSessionState(const std::string& owner) {
   SessionState state;
