@@ -191,6 +191,18 @@ std::string SvgFlattenBomb(int circles, double radius) {
   return s + "</svg>";
 }
 
+// `layers` painted layers: small squares on a grid, each drawn over its neighbours (a layered
+// drawing: every one is an art layer and the union has work to do).
+std::string SvgManyLayers(int layers) {
+  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\">";
+  s.reserve(static_cast<size_t>(layers) * 44 + 64);
+  for (int i = 0; i < layers; ++i) {
+    s += "<rect x=\"" + std::to_string(i % 1000) + "\" y=\"" + std::to_string(i / 1000) +
+         "\" width=\"2\" height=\"2\"/>";
+  }
+  return s + "</svg>";
+}
+
 // <use> fan-out: level k holds `fanout` uses of level k-1 (fanout^levels copies of one rect).
 std::string SvgUseBomb(int levels, int fanout) {
   std::string s =
@@ -368,6 +380,8 @@ void Runner::ApplyGenerator(const json& gen, const Session& s, v1::PutDrawingReq
     d->set_svg(SvgHugePath(gen.at("commands")));
   } else if (name == "svg_flatten_bomb") {
     d->set_svg(SvgFlattenBomb(gen.at("circles"), gen.at("radius")));
+  } else if (name == "svg_many_layers") {
+    d->set_svg(SvgManyLayers(gen.at("layers")));
   } else if (name == "svg_use_bomb") {
     d->set_svg(SvgUseBomb(gen.at("levels"), gen.at("fanout")));
   } else if (name == "long_name") {

@@ -49,6 +49,10 @@ case("key_time_nan", "drawing.key_time = NaN",
      [step("PutDrawing", dict(put_svg("${svg:square}"), drawing={"name": "k", "svg": "${svg:square}", "key_time": "NaN"}), message="key_time")])
 case("flatten_tolerance_negative", "flatten_tolerance < 0",
      [step("PutDrawing", put_svg("${svg:square}", tol=-1), message="flatten_tolerance")])
+case("gap_tolerance_too_large", "gap_tolerance above 0.1",
+     [step("PutDrawing", dict(put_svg("${svg:square}"), gap_tolerance=0.5), message="gap_tolerance = 0.5 is not in (0, 0.1]")])
+case("min_area_fraction_nan", "min_area_fraction = NaN",
+     [step("PutDrawing", dict(put_svg("${svg:square}"), min_area_fraction="NaN"), message="min_area_fraction = nan is not finite")])
 # --- paths
 case("outline_empty", "an outline with no points",
      [step("PutDrawing", put_poly([outline()]), message="has 0 points, an outline needs at least 3")])
@@ -159,6 +163,18 @@ case("svg_flatten_bomb", "400 bytes of SVG (huge circles, tiny tolerance) that w
 case("svg_huge_path", "an SVG path of 2,000,000 commands",
      [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "path.svg"}}, code="RESOURCE_EXHAUSTED", message="drawing.svg: SVG has more than 1000000 points in its path data (limit per drawing, --max-drawing-points)",
            generate={"name": "svg_huge_path", "commands": 2000000})])
+# --- layered paint (docs/svg-convention.md, "Layers of paint")
+case("svg_stroke_width_zero", "the only paint a stroke of width 0 (SVG draws nothing)",
+     [step("PutDrawing", put_svg(svg('<path id="line" d="M0 0 L100 100" fill="none" stroke="#000" stroke-width="0"/>')), message="drawing.svg: SVG has no filled shape and no stroke: nothing is painted")])
+case("svg_gradient_no_stops", "the only paint a gradient without stops (painted as none)",
+     [step("PutDrawing", put_svg(svg('<defs><linearGradient id="g"/></defs><rect width="50" height="50" fill="url(#g)"/>')), message="nothing is painted")])
+case("svg_paint_outside_view_box", "every shape lies outside the root's viewBox",
+     [step("PutDrawing", put_svg('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100"><rect x="500" y="500" width="50" height="50" fill="#f00"/><circle cx="-300" cy="40" r="20"/></svg>'), message="drawing.svg: SVG paint lies entirely outside the viewBox")])
+case("svg_hairlines_only", "a drawing of hairline strokes only (nowhere wider than the gap tolerance)",
+     [step("PutDrawing", put_svg(svg('<path d="M0 0 L400 400 M0 400 L400 0" fill="none" stroke="#000" stroke-width="0.3"/><path d="M0 200 H400" fill="none" stroke="#f00" stroke-width="0.3"/>')), message="nowhere wider than the gap tolerance")])
+case("svg_many_layers", "a drawing of 1,000,000 painted layers (40 MB of SVG)",
+     [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "layers.svg"}}, code="RESOURCE_EXHAUSTED", message="drawing.svg: SVG has more than 100000 painted layers",
+           generate={"name": "svg_many_layers", "layers": 1000000})])
 case("outline_comb", "a simple comb outline of 64,002 points whose 32,000 teeth overlap in x: crossing checks bounded, refused in about a second",
      [step("PutDrawing", {"session_id": S, "expected_version": V, "drawing": {"name": "comb"}}, code="RESOURCE_EXHAUSTED", message="too many long segments side by side",
            generate={"name": "polyline_comb", "teeth": 16000})])
