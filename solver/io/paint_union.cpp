@@ -271,8 +271,8 @@ absl::StatusOr<PaintRegion> UnionOfPaint(const std::vector<const ArtLayer*>& lay
   for (const cl::Path& p : united) united_area += cl::Area(p);
   if (!(std::abs(united_area) > 0)) {
     return absl::InvalidArgumentError(
-        "the paint covers no area (only zero-width strokes or "
-        "subpaths without area)");
+        "no filled shape or stroke covers any area (subpaths without area, or strokes too thin "
+        "to resolve)");
   }
 
   PaintRegion region;

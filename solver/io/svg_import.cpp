@@ -1196,15 +1196,25 @@ std::optional<Eigen::AlignedBox2d> ViewBox(xmlNode* root) {
 
 // The one-colour convention: filled elements only, all of one colour and opacity, none
 // overlapping another (each layer's own area adds up to the union's). Its outlines are the
-// elements' own, as written; touching elements and specks stay as they always were.
-bool IsOneColour(const std::vector<ArtLayer>& art, const PaintRegion& region) {
+// elements' own, as written; touching elements and specks stay as they always were. Elements
+// that share a curved edge overlap by slivers of the flattening's width (each flattens the curve
+// its own way): overlaps up to half the flatten tolerance along the outlines are not overlaps.
+bool IsOneColour(const std::vector<ArtLayer>& art, const std::vector<Outline>& outlines,
+                 const PaintRegion& region, double flatten_tolerance) {
   for (const ArtLayer& layer : art) {
     if (layer.stroke || !layer.fill || layer.fill->rgb != art[0].fill->rgb ||
         layer.fill->opacity != art[0].fill->opacity || layer.opacity != art[0].opacity) {
       return false;
     }
   }
-  return std::abs(region.layers_area - region.raw_area) <= 1e-6 * region.raw_area;
+  double perimeter = 0;
+  for (const Outline& o : outlines) {
+    for (size_t i = 0; i < o.points.size(); ++i) {
+      perimeter += (o.points[(i + 1) % o.points.size()] - o.points[i]).norm();
+    }
+  }
+  const double slivers = 0.5 * flatten_tolerance * perimeter;
+  return std::abs(region.layers_area - region.raw_area) <= 1e-6 * region.raw_area + slivers;
 }
 
 }  // namespace
@@ -1304,6 +1314,23 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
       for (const Point& p : path.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     }
   }
+  // Coordinates beyond what the service accepts (|x| <= 1e9) are refused downstream, naming the
+  // point; the union (quantized over the paint's extent) is not attempted for them.
+  if (!(lo.cwiseAbs().maxCoeff() <= 1e9 && hi.cwiseAbs().maxCoeff() <= 1e9)) {
+    if (info != nullptr) {
+      *info = SvgImportInfo{};
+      info->fill_rgb = collector.largest_fill;
+      info->warnings = std::move(collector.warnings);
+    }
+    OrientByNesting(&collector.outlines);
+    Drawing drawing;
+    drawing.outlines = std::move(collector.outlines);
+    drawing.cuts = std::move(collector.cuts);
+    drawing.openings = std::move(collector.openings);
+    drawing.marks = std::move(collector.marks);
+    drawing.art = std::move(collector.art);
+    return drawing;
+  }
   PaintUnionOptions union_options;
   union_options.arc_tolerance = options.tolerance;
   if (lo.x() <= hi.x()) {
@@ -1317,15 +1344,19 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
         absl::StrCat("SVG ", by_class ? "class=\"outline\" elements" : "paint", ": ",
                      region.status().message()));
   }
+  // Paint that lies entirely outside the viewBox is imported all the same (coordinates are the
+  // user units as written, and the animation is framed by the drawings' boxes), with a warning:
+  // a browser would show nothing.
   if (std::optional<Eigen::AlignedBox2d> view = ViewBox(root)) {
-    Eigen::AlignedBox2d paint;
+    bool seen = false;
     for (const Outline& o : region->outlines) {
-      for (const Point& p : o.points) paint.extend(p);
+      Eigen::AlignedBox2d box;
+      for (const Point& p : o.points) box.extend(p);
+      seen = seen || view->intersects(box);
     }
-    if (!view->intersects(paint)) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "SVG paint lies entirely outside the viewBox (paint spans (", paint.min().x(), ", ",
-          paint.min().y(), ") to (", paint.max().x(), ", ", paint.max().y(), "))"));
+    if (!seen) {
+      collector.warnings.push_back(
+          "<svg>: all paint lies outside the viewBox (a browser would show nothing)");
     }
   }
 
@@ -1333,7 +1364,7 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   report.fill_rgb = collector.largest_fill;
   report.warnings = std::move(collector.warnings);
   Drawing drawing;
-  if (!by_class && IsOneColour(collector.art, *region)) {
+  if (!by_class && IsOneColour(collector.art, collector.outlines, *region, options.tolerance)) {
     OrientByNesting(&collector.outlines);
     // The one-colour convention: the elements' own outlines, exactly as written.
     report.source = SilhouetteSource::kElements;

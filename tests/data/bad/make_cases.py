@@ -168,8 +168,6 @@ case("svg_stroke_width_zero", "the only paint a stroke of width 0 (SVG draws not
      [step("PutDrawing", put_svg(svg('<path id="line" d="M0 0 L100 100" fill="none" stroke="#000" stroke-width="0"/>')), message="drawing.svg: SVG has no filled shape and no stroke: nothing is painted")])
 case("svg_gradient_no_stops", "the only paint a gradient without stops (painted as none)",
      [step("PutDrawing", put_svg(svg('<defs><linearGradient id="g"/></defs><rect width="50" height="50" fill="url(#g)"/>')), message="nothing is painted")])
-case("svg_paint_outside_view_box", "every shape lies outside the root's viewBox",
-     [step("PutDrawing", put_svg('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100"><rect x="500" y="500" width="50" height="50" fill="#f00"/><circle cx="-300" cy="40" r="20"/></svg>'), message="drawing.svg: SVG paint lies entirely outside the viewBox")])
 case("svg_hairlines_only", "a drawing of hairline strokes only (nowhere wider than the gap tolerance)",
      [step("PutDrawing", put_svg(svg('<path d="M0 0 L400 400 M0 400 L400 0" fill="none" stroke="#000" stroke-width="0.3"/><path d="M0 200 H400" fill="none" stroke="#f00" stroke-width="0.3"/>')), message="nowhere wider than the gap tolerance")])
 case("svg_many_layers", "a drawing of 1,000,000 painted layers (40 MB of SVG)",

@@ -268,11 +268,23 @@ TEST(SvgImportPaintTest, HairlinesOnlyIsAnError) {
   EXPECT_THAT(d.status().message(), HasSubstr("nowhere wider than the gap tolerance"));
 }
 
-TEST(SvgImportPaintTest, PaintOutsideTheViewBoxIsAnError) {
-  absl::StatusOr<Drawing> d =
-      ImportSvg(Svg(R"svg(<rect x="500" y="500" width="50" height="50"/>)svg"));
-  ASSERT_FALSE(d.ok());
-  EXPECT_THAT(d.status().message(), HasSubstr("outside the viewBox"));
+// Paint entirely outside the viewBox imports (coordinates are user units as written), with a
+// warning: a browser would show nothing. Paint partly inside gets none.
+TEST(SvgImportPaintTest, PaintOutsideTheViewBoxIsWarnedAbout) {
+  Imported outside = ImportOk(Svg(R"svg(<rect x="500" y="500" width="50" height="50" fill="#f00"/>
+      <circle cx="-300" cy="40" r="20"/>)svg"));
+  EXPECT_EQ(outside.drawing.outlines.size(), 2u);
+  ASSERT_EQ(outside.info.warnings.size(), 1u);
+  EXPECT_THAT(outside.info.warnings[0], HasSubstr("outside the viewBox"));
+  Imported partly = ImportOk(Svg(R"svg(<rect x="150" y="150" width="100" height="100"/>)svg"));
+  EXPECT_TRUE(partly.info.warnings.empty());
+}
+
+// Coordinates beyond |x| <= 1e9 are left to the service's coordinate check (no union).
+TEST(SvgImportPaintTest, HugeCoordinatesSkipTheUnion) {
+  Imported im = ImportOk(Svg(R"svg(<path d="M 0 0 L 1e308 0 L 0 1e308 Z"/>)svg"));
+  ASSERT_EQ(im.drawing.outlines.size(), 1u);
+  EXPECT_EQ(im.drawing.outlines[0].points[1].x(), 1e308);
 }
 
 TEST(SvgImportPaintTest, ZeroWidthStrokeIsNotPaint) {
