@@ -1,0 +1,263 @@
+// A frame's art: morph corresponding layers, cross-fade the rest (see frame_art.h).
+#include "solver/art/frame_art.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_format.h"
+#include "solver/art/blend_paths.h"
+
+namespace inbetween::solver {
+namespace {
+
+// One layer of one key, with that key's weight normalized over the active keys.
+struct Member {
+  int key = 0;
+  int layer = 0;
+  double weight = 0.0;
+};
+using Group = std::vector<Member>;  // one member per active key, in key order
+
+bool SameKind(const ArtLayer& a, const ArtLayer& b) {
+  return a.fill.has_value() == b.fill.has_value() && a.stroke.has_value() == b.stroke.has_value();
+}
+
+// Same path count, and each path closed (and empty) in all members or in none.
+bool SameGeometry(const std::vector<EmbeddedArt>& keys, const Group& group) {
+  const EmbeddedLayer& first = keys[group[0].key].layers[group[0].layer];
+  for (const Member& m : group) {
+    const EmbeddedLayer& layer = keys[m.key].layers[m.layer];
+    if (layer.paths.size() != first.paths.size()) return false;
+    for (size_t j = 0; j < layer.paths.size(); ++j) {
+      if (layer.paths[j].closed != first.paths[j].closed ||
+          layer.paths[j].points.empty() != first.paths[j].points.empty()) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// The morphing groups among `active` (key indices ascending, weights normalized), ordered by
+// their layer in the first active key (the backbone).
+std::vector<Group> MatchLayers(const std::vector<EmbeddedArt>& keys,
+                               const std::vector<Member>& active, const FrameArtOptions& options) {
+  std::vector<Group> groups;
+  auto named = [&](const EmbeddedLayer& l) {
+    return options.match_by_name && !l.paint.name.empty();
+  };
+  if (options.match_by_name) {
+    std::map<std::pair<std::string, int>, Group> by_name;  // (name, occurrence) -> members
+    for (const Member& a : active) {
+      std::map<std::string, int> seen;
+      const std::vector<EmbeddedLayer>& layers = keys[a.key].layers;
+      for (size_t l = 0; l < layers.size(); ++l) {
+        if (!named(layers[l])) continue;
+        const std::string& name = layers[l].paint.name;
+        by_name[{name, seen[name]++}].push_back({a.key, static_cast<int>(l), a.weight});
+      }
+    }
+    for (auto& [name, group] : by_name) {
+      if (group.size() == active.size()) groups.push_back(std::move(group));
+    }
+  }
+  const size_t count = keys[active[0].key].layers.size();
+  const bool same_count = std::all_of(active.begin(), active.end(), [&](const Member& a) {
+    return keys[a.key].layers.size() == count;
+  });
+  if (options.match_by_order && same_count) {
+    for (size_t l = 0; l < count; ++l) {
+      const EmbeddedLayer& first = keys[active[0].key].layers[l];
+      Group group;
+      for (const Member& a : active) {
+        const EmbeddedLayer& layer = keys[a.key].layers[l];
+        if (named(layer) || !SameKind(layer.paint, first.paint)) break;
+        group.push_back({a.key, static_cast<int>(l), a.weight});
+      }
+      if (group.size() == active.size()) groups.push_back(std::move(group));
+    }
+  }
+  std::erase_if(groups, [&](const Group& g) { return !SameGeometry(keys, g); });
+  std::sort(groups.begin(), groups.end(),
+            [](const Group& a, const Group& b) { return a[0].layer < b[0].layer; });
+  return groups;
+}
+
+// Per 8-bit channel, weighted mean over (rgb, weight) pairs, rounded.
+uint32_t BlendRgb(const std::vector<std::pair<uint32_t, double>>& colours) {
+  double total = 0.0;
+  for (const auto& [rgb, w] : colours) total += w;
+  uint32_t out = 0;
+  for (int shift : {16, 8, 0}) {
+    double v = 0.0;
+    for (const auto& [rgb, w] : colours) v += w * ((rgb >> shift) & 0xFF);
+    out |= static_cast<uint32_t>(std::clamp(std::lround(v / total), 0L, 255L)) << shift;
+  }
+  return out;
+}
+
+// The heaviest member for which `has` holds (ties: the lower key); members are in key order.
+template <typename Has>
+const Member* Heaviest(const Group& group, Has has) {
+  const Member* best = nullptr;
+  for (const Member& m : group) {
+    if (has(m) && (best == nullptr || m.weight > best->weight)) best = &m;
+  }
+  return best;
+}
+
+class Morph {
+ public:
+  Morph(const std::vector<EmbeddedArt>& keys, const Points& frame, const FrameArtOptions& options)
+      : keys_(keys), frame_(frame), options_(options) {}
+
+  ArtLayer Layer(const Group& group) const {
+    const Member& top = *Heaviest(group, [](const Member&) { return true; });
+    ArtLayer out = Paint(top).paint;
+    out.opacity = 0.0;
+    for (const Member& m : group) out.opacity += m.weight * Paint(m).paint.opacity;
+    out.fill = Fill(group);
+    out.stroke = Stroke(group);
+    std::vector<double> weights;
+    for (const Member& m : group) weights.push_back(m.weight);
+    for (size_t j = 0; j < Paint(top).paths.size(); ++j) {
+      std::vector<Points> placed;
+      for (const Member& m : group) placed.push_back(PlacePath(Paint(m).paths[j], frame_));
+      const bool closed = Paint(top).paths[j].closed;
+      out.paths.push_back({placed[0].empty()
+                               ? Points{}
+                               : BlendPaths(placed, closed, weights, options_.merge_fraction),
+                           closed});
+    }
+    return out;
+  }
+
+ private:
+  const EmbeddedLayer& Paint(const Member& m) const { return keys_[m.key].layers[m.layer]; }
+
+  // Present in some member: colour blended among those that have it, opacity among all (a
+  // member without it counts as opacity 0, so it fades in).
+  std::optional<FillPaint> Fill(const Group& group) const {
+    const Member* top =
+        Heaviest(group, [&](const Member& m) { return Paint(m).paint.fill.has_value(); });
+    if (top == nullptr) return std::nullopt;
+    FillPaint fill = *Paint(*top).paint.fill;
+    std::vector<std::pair<uint32_t, double>> colours;
+    fill.opacity = 0.0;
+    for (const Member& m : group) {
+      const std::optional<FillPaint>& f = Paint(m).paint.fill;
+      if (!f) continue;
+      colours.emplace_back(f->rgb, m.weight);
+      fill.opacity += m.weight * f->opacity;
+    }
+    fill.rgb = BlendRgb(colours);
+    return fill;
+  }
+
+  std::optional<StrokePaint> Stroke(const Group& group) const {
+    auto has = [&](const Member& m) { return Paint(m).paint.stroke.has_value(); };
+    const Member* top = Heaviest(group, has);
+    if (top == nullptr) return std::nullopt;
+    StrokePaint stroke = *Paint(*top).paint.stroke;
+    const size_t dashes = stroke.dashes.size();
+    bool same_dashes = true;
+    double present = 0.0;
+    for (const Member& m : group) {
+      if (!has(m)) continue;
+      present += m.weight;
+      same_dashes = same_dashes && Paint(m).paint.stroke->dashes.size() == dashes;
+    }
+    std::vector<std::pair<uint32_t, double>> colours;
+    stroke.opacity = stroke.width = stroke.miter_limit = 0.0;
+    if (same_dashes) {
+      std::fill(stroke.dashes.begin(), stroke.dashes.end(), 0.0);
+      stroke.dash_offset = 0.0;
+    }
+    for (const Member& m : group) {
+      if (!has(m)) continue;
+      const StrokePaint& s = *Paint(m).paint.stroke;
+      const double w = m.weight / present;  // among the members that stroke
+      colours.emplace_back(s.rgb, m.weight);
+      stroke.opacity += m.weight * s.opacity;
+      stroke.width += w * s.width;
+      stroke.miter_limit += w * s.miter_limit;
+      if (!same_dashes) continue;
+      for (size_t d = 0; d < dashes; ++d) stroke.dashes[d] += w * s.dashes[d];
+      stroke.dash_offset += w * s.dash_offset;
+    }
+    stroke.rgb = BlendRgb(colours);
+    return stroke;
+  }
+
+  const std::vector<EmbeddedArt>& keys_;
+  const Points& frame_;
+  const FrameArtOptions& options_;
+};
+
+}  // namespace
+
+absl::StatusOr<std::vector<ArtLayer>> ArtForFrame(const std::vector<EmbeddedArt>& keys,
+                                                  const Points& frame_vertices,
+                                                  const std::vector<double>& weights,
+                                                  const FrameArtOptions& options) {
+  if (weights.size() != keys.size()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "frame art: %d weights for the art of %d keys", weights.size(), keys.size()));
+  }
+  double total = 0.0;
+  for (size_t k = 0; k < keys.size(); ++k) {
+    if (!std::isfinite(weights[k])) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("frame art: weight %d is not finite", k + 1));
+    }
+    if (keys[k].num_vertices != static_cast<int>(frame_vertices.size())) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "frame art: key %d's art is embedded in a mesh of %d vertices, the frame has %d", k + 1,
+          keys[k].num_vertices, frame_vertices.size()));
+    }
+    if (weights[k] > 0.0) total += weights[k];
+  }
+  if (!(total > 0.0)) return absl::InvalidArgumentError("frame art: no key has a weight > 0");
+  std::vector<Member> active;
+  std::vector<std::vector<int>> group_of(keys.size());  // [key][layer] -> group, or -1
+  for (size_t k = 0; k < keys.size(); ++k) {
+    group_of[k].assign(keys[k].layers.size(), -1);
+    // w / total is exactly 1 for a key frame's only active key: its art comes out unchanged.
+    if (weights[k] > 0.0) active.push_back({static_cast<int>(k), -1, weights[k] / total});
+  }
+  const std::vector<Group> groups = MatchLayers(keys, active, options);
+  for (size_t g = 0; g < groups.size(); ++g) {
+    for (const Member& m : groups[g]) group_of[m.key][m.layer] = static_cast<int>(g);
+  }
+  // slots[g + 1]: cross-faded layers drawn right after group g (slots[0]: before every group).
+  std::vector<std::vector<ArtLayer>> slots(groups.size() + 1);
+  for (const Member& a : active) {
+    int last = -1;
+    const std::vector<EmbeddedLayer>& layers = keys[a.key].layers;
+    for (size_t l = 0; l < layers.size(); ++l) {
+      if (group_of[a.key][l] >= 0) {
+        last = group_of[a.key][l];
+        continue;
+      }
+      ArtLayer& faded = slots[last + 1].emplace_back(layers[l].paint);
+      faded.opacity *= a.weight;
+      for (const EmbeddedPath& path : layers[l].paths) {
+        faded.paths.push_back({PlacePath(path, frame_vertices), path.closed});
+      }
+    }
+  }
+  const Morph morph(keys, frame_vertices, options);
+  std::vector<ArtLayer> out = std::move(slots[0]);
+  for (size_t g = 0; g < groups.size(); ++g) {
+    out.push_back(morph.Layer(groups[g]));
+    for (ArtLayer& layer : slots[g + 1]) out.push_back(std::move(layer));
+  }
+  return out;
+}
+
+}  // namespace inbetween::solver

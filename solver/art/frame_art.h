@@ -1,0 +1,62 @@
+// The art to draw in one frame, from every key's embedded art (art_embedding.h), the frame's
+// vertex positions and its example weights (interp/timing.h: one per key, sum 1, >= 0).
+//
+// Which keys count: the active ones, weight > 0. With piecewise-linear or Catmull-Rom timing the
+// active set changes only at a key's frame, where one key has weight 1 and every rule below gives
+// that key's art, so the choice of morph or cross-fade never pops between frames.
+//
+// Correspondence (among the active keys; FrameArtOptions):
+//  - by name: layers with the same non-empty name (data-layer) correspond, the m-th layer with
+//    that name in one key to the m-th in every other. Their paint may differ in kind: a fill or
+//    stroke one key lacks fades in with the others' weights (as if there at opacity 0).
+//  - by order: when every active key has the same number of layers, unnamed layers at the same
+//    index correspond if all of them have the same kind of paint (fill present, stroke present).
+//  A group of corresponding layers morphs only if its members have the same number of paths and
+//  each path is closed in all or none of them; otherwise its layers cross-fade.
+//
+// Morph: each path is placed in the frame from every member's own embedding, the placements are
+// resampled to one point count by arc length (at the union of every placement's own vertex
+// parameters, so that each placement is kept exactly, corners included, and the morph tends to a
+// key's drawn path as its weight tends to 1), then positions are blended by the weights. Closed
+// paths start at their drawn first point and keep their drawn direction (no cyclic alignment).
+// Colours (per 8-bit channel), opacities, stroke widths, miter limits and dashes (when every
+// member has as many) blend by the weights; discrete properties (cap, join, fill rule, id) are
+// the heaviest member's (ties: the lower key).
+//
+// Cross-fade: a layer without a morphing group is drawn with its opacity times its key's weight.
+//
+// Draw order: the lowest active key is the backbone. Morphed groups appear in its paint order;
+// every cross-faded layer is drawn right after the morphed group that precedes it in its own
+// key's paint order (first, before every group, when none does), and among layers sharing that
+// place the lower key's are drawn first. Keys are ordered by index rather than by weight so the
+// order never flips mid-way between two keys; in playback order the outgoing key (lower index)
+// is under the incoming one.
+#pragma once
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "solver/art/art_embedding.h"
+#include "solver/core/art.h"
+#include "solver/core/types.h"
+
+namespace inbetween::solver {
+
+struct FrameArtOptions {
+  bool match_by_name = true;   // layers with equal non-empty names correspond
+  bool match_by_order = true;  // unnamed layers at equal indices correspond (see above)
+  // Arc-length parameters (fractions of a path's length) closer than this are one sample of the
+  // morph's resampling: closer samples add points no renderer can tell apart.
+  double merge_fraction = 1e-9;
+};
+
+// The frame's layers in paint order. `keys[k]` is key k's embedded art (any order of
+// EmbeddedArt::key; weights[k] goes with keys[k]). Errors (INVALID_ARGUMENT): weights and keys
+// of different sizes, a non-finite weight, no weight > 0, art embedded in a mesh whose vertex
+// count is not frame_vertices.size().
+absl::StatusOr<std::vector<ArtLayer>> ArtForFrame(const std::vector<EmbeddedArt>& keys,
+                                                  const Points& frame_vertices,
+                                                  const std::vector<double>& weights,
+                                                  const FrameArtOptions& options = {});
+
+}  // namespace inbetween::solver

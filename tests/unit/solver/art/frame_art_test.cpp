@@ -1,0 +1,205 @@
+// ArtForFrame: key frames give the key's art, corresponding layers morph (midway paint at 0.5),
+// the others cross-fade in key order, named layers keep each key's paint order.
+#include "solver/art/frame_art.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/unit/solver/art/art_test_helpers.h"
+
+namespace inbetween::solver {
+namespace {
+
+using art_test::DistanceToPolyline;
+using art_test::ExpectSameLayers;
+using art_test::FillLayer;
+using art_test::JitteredGrid;
+using art_test::StrokeLayer;
+
+// Two keys on an 8 x 6 grid: shape 1 is shape 0 rotated and stretched.
+Multimesh TwoShapes() {
+  Multimesh mesh = JitteredGrid(8, 6, 0.25);
+  Points second;
+  for (const Point& p : interp_test::Rotated(mesh.shapes[0], 0.4, Point(4, 3))) {
+    second.emplace_back(1.5 * p.x(), p.y());
+  }
+  mesh.shapes.push_back(second);
+  return mesh;
+}
+
+Points Mix(const Points& a, const Points& b, double s) {
+  Points out;
+  for (size_t i = 0; i < a.size(); ++i) out.push_back((1 - s) * a[i] + s * b[i]);
+  return out;
+}
+
+std::vector<EmbeddedArt> Embed(const Multimesh& mesh, const std::vector<ArtLayer>& art0,
+                               const std::vector<ArtLayer>& art1) {
+  return {*EmbedArt(mesh, 0, art0), *EmbedArt(mesh, 1, art1)};
+}
+
+std::vector<ArtLayer> Frame(const std::vector<EmbeddedArt>& keys, const Points& x,
+                            std::vector<double> weights, const FrameArtOptions& options = {}) {
+  absl::StatusOr<std::vector<ArtLayer>> art = ArtForFrame(keys, x, weights, options);
+  EXPECT_TRUE(art.ok()) << art.status();
+  return art.ok() ? *art : std::vector<ArtLayer>{};
+}
+
+// Same structure in both keys (morphs by order): a head and a stroke across it.
+std::vector<ArtLayer> Head(const Point& shift, uint32_t fill, double width) {
+  std::vector<ArtLayer> art;
+  art.push_back(FillLayer({{1, 1}, {6, 1.2}, {6.5, 4.5}, {1.2, 4.8}}, fill, 0.9));
+  art.push_back(StrokeLayer({{0.5, 0.5}, {7.5, 5.5}, {3, 5.5}}, 0x000000, width));
+  for (ArtLayer& layer : art) {
+    for (Point& p : layer.paths[0].points) p += shift;
+  }
+  return art;
+}
+
+TEST(FrameArtTest, KeyFramesGiveEachKeysArt) {
+  const Multimesh mesh = TwoShapes();
+  const std::vector<ArtLayer> morphing0 = Head({0, 0}, 0x204060, 1.0);
+  const std::vector<ArtLayer> morphing1 = Head({0.3, 0.2}, 0x60a020, 3.0);
+  std::vector<ArtLayer> fading1 = morphing1;
+  fading1.push_back(FillLayer({{2, 2}, {3, 2}, {3, 3}}, 0xff0000));
+  for (const auto& art1 : {morphing1, fading1}) {
+    const std::vector<EmbeddedArt> keys = Embed(mesh, morphing0, art1);
+    ExpectSameLayers(Frame(keys, mesh.shapes[0], {1, 0}), *PlaceArt(keys[0], mesh.shapes[0]));
+    ExpectSameLayers(Frame(keys, mesh.shapes[1], {0, 1}), *PlaceArt(keys[1], mesh.shapes[1]));
+  }
+}
+
+TEST(FrameArtTest, CorrespondingLayersBlendMidway) {
+  Multimesh mesh = JitteredGrid(8, 6, 0.25);
+  mesh.shapes.push_back(mesh.shapes[0]);  // one geometry: the art's own motion is all there is
+  std::vector<ArtLayer> a = Head({0, 0}, 0x204060, 1.0);
+  std::vector<ArtLayer> b = Head({0.5, 0.25}, 0x60a020, 3.0);
+  a[0].fill->opacity = 0.2;
+  b[0].fill->opacity = 0.6;
+  b[0].opacity = 0.5;
+  a[1].stroke->dashes = {2, 2};
+  b[1].stroke->dashes = {4, 6};
+  a[1].stroke->cap = LineCap::kRound;
+  b[1].stroke->rgb = 0x0000ff;
+  const std::vector<ArtLayer> out = Frame(Embed(mesh, a, b), mesh.shapes[0], {0.5, 0.5});
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].fill->rgb, 0x407040u);
+  EXPECT_DOUBLE_EQ(out[0].fill->opacity, 0.4);
+  EXPECT_DOUBLE_EQ(out[0].opacity, 0.75);
+  EXPECT_EQ(out[1].stroke->rgb, 0x000080u);  // 127.5 rounds up
+  EXPECT_DOUBLE_EQ(out[1].stroke->width, 2.0);
+  EXPECT_EQ(out[1].stroke->dashes, (std::vector<double>{3, 4}));
+  EXPECT_EQ(out[1].stroke->cap, LineCap::kRound);  // equal weights: the lower key's
+  // Positions: on the drawn paths shifted half-way, every corner of it present.
+  const std::vector<ArtLayer> middle = Head({0.25, 0.125}, 0, 1.0);
+  for (size_t l = 0; l < 2; ++l) {
+    const ArtPath& expected = middle[l].paths[0];
+    const Points& got = out[l].paths[0].points;
+    for (const Point& p : got)
+      EXPECT_LT(DistanceToPolyline(expected.points, expected.closed, p), 1e-9);
+    for (const Point& corner : expected.points) {
+      double nearest = 1e9;
+      for (const Point& p : got) nearest = std::min(nearest, (p - corner).norm());
+      EXPECT_LT(nearest, 1e-9);
+    }
+  }
+}
+
+TEST(FrameArtTest, NonCorrespondingLayersCrossFadeInKeyOrder) {
+  const Multimesh mesh = TwoShapes();
+  const std::vector<ArtLayer> a = {FillLayer({{1, 1}, {5, 1}, {5, 4}}, 0x111111, 0.8)};
+  std::vector<ArtLayer> b = Head({0, 0}, 0x222222, 2.0);
+  const Points x = Mix(mesh.shapes[0], mesh.shapes[1], 0.75);
+  const std::vector<EmbeddedArt> keys = Embed(mesh, a, b);
+  const std::vector<ArtLayer> out = Frame(keys, x, {0.25, 0.75});
+  ASSERT_EQ(out.size(), 3u);  // layer counts differ: nothing corresponds
+  EXPECT_EQ(out[0].fill->rgb, 0x111111u);
+  EXPECT_DOUBLE_EQ(out[0].opacity, 0.25);
+  EXPECT_EQ(out[0].fill->opacity, 0.8);  // the paint is kept, the layer fades
+  EXPECT_EQ(out[1].fill->rgb, 0x222222u);
+  EXPECT_DOUBLE_EQ(out[1].opacity, 0.75);
+  EXPECT_DOUBLE_EQ(out[2].opacity, 0.75);
+  // Placed from each key's own embedding.
+  EXPECT_EQ(out[0].paths[0].points, PlacePath(keys[0].layers[0].paths[0], x));
+  EXPECT_EQ(out[2].paths[0].points, PlacePath(keys[1].layers[1].paths[0], x));
+
+  // Equal counts but different kinds of paint at an index: that index cross-fades.
+  std::vector<ArtLayer> c = Head({0, 0}, 0x333333, 2.0);
+  std::swap(c[0], c[1]);  // stroke first, fill second
+  const std::vector<ArtLayer> faded = Frame(Embed(mesh, b, c), x, {0.5, 0.5});
+  ASSERT_EQ(faded.size(), 4u);
+  for (const ArtLayer& layer : faded) EXPECT_DOUBLE_EQ(layer.opacity, 0.5);
+  EXPECT_TRUE(faded[0].fill && faded[1].stroke && faded[2].stroke && faded[3].fill);
+}
+
+TEST(FrameArtTest, NamedLayersMorphAndKeepPaintOrder) {
+  const Multimesh mesh = TwoShapes();
+  ArtLayer body = FillLayer({{1, 1}, {7, 1}, {7, 5}, {1, 5}}, 0xf0c080);
+  body.name = "body";
+  ArtLayer eye = FillLayer({{2, 2}, {3, 2}, {3, 3}}, 0x000000);
+  eye.name = "eye";
+  const ArtLayer mouth = StrokeLayer({{2, 4}, {5, 4}}, 0x800000, 0.3);
+  ArtLayer eye_outlined = eye;
+  eye_outlined.stroke = StrokePaint{};
+  eye_outlined.stroke->opacity = 0.5;
+  const std::vector<EmbeddedArt> keys = Embed(mesh, {body, eye}, {body, mouth, eye_outlined});
+  const Points x = Mix(mesh.shapes[0], mesh.shapes[1], 0.5);
+  const std::vector<ArtLayer> out = Frame(keys, x, {0.6, 0.4});
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_EQ(out[0].name, "body");
+  EXPECT_DOUBLE_EQ(out[0].opacity, 1.0);
+  EXPECT_FALSE(out[1].fill.has_value());  // the mouth, under the eye as in key 2
+  EXPECT_DOUBLE_EQ(out[1].opacity, 0.4);
+  EXPECT_EQ(out[2].name, "eye");
+  ASSERT_TRUE(out[2].stroke.has_value());  // the outline key 1 lacks fades in
+  EXPECT_DOUBLE_EQ(out[2].stroke->opacity, 0.4 * 0.5);
+  EXPECT_DOUBLE_EQ(out[2].fill->opacity, 1.0);
+
+  // Names off: the counts differ, so every layer cross-fades.
+  FrameArtOptions by_order_only;
+  by_order_only.match_by_name = false;
+  EXPECT_EQ(Frame(keys, x, {0.6, 0.4}, by_order_only).size(), 5u);
+}
+
+TEST(FrameArtTest, MorphTendsToEachKeyAsItsWeightTendsToOne) {
+  const Multimesh mesh = TwoShapes();
+  const std::vector<EmbeddedArt> keys =
+      Embed(mesh, Head({0, 0}, 0, 1.0), Head({0.4, -0.3}, 0, 1.0));
+  const double eps = 1e-7;
+  const Points x = Mix(mesh.shapes[0], mesh.shapes[1], eps);
+  const std::vector<ArtLayer> out = Frame(keys, x, {1 - eps, eps});
+  const std::vector<ArtLayer> key = *PlaceArt(keys[0], mesh.shapes[0]);
+  for (size_t l = 0; l < key.size(); ++l) {
+    const ArtPath& k = key[l].paths[0];
+    for (const Point& p : out[l].paths[0].points) {
+      EXPECT_LT(DistanceToPolyline(k.points, k.closed, p), 1e-5);
+    }
+    for (const Point& corner : k.points) {
+      EXPECT_LT(DistanceToPolyline(out[l].paths[0].points, k.closed, corner), 1e-5);
+    }
+  }
+}
+
+TEST(FrameArtTest, Deterministic) {
+  const Multimesh mesh = TwoShapes();
+  std::vector<ArtLayer> b = Head({0.2, 0.1}, 0x00ff00, 2.0);
+  b.push_back(FillLayer({{2, 2}, {3, 2}, {3, 3}}, 0xff0000));
+  const std::vector<EmbeddedArt> keys = Embed(mesh, Head({0, 0}, 0xff00ff, 1.0), b);
+  const Points x = Mix(mesh.shapes[0], mesh.shapes[1], 0.3);
+  ExpectSameLayers(Frame(keys, x, {0.7, 0.3}), Frame(keys, x, {0.7, 0.3}));
+}
+
+TEST(FrameArtTest, RejectsBadInput) {
+  const Multimesh mesh = TwoShapes();
+  const std::vector<EmbeddedArt> keys = Embed(mesh, Head({0, 0}, 0, 1), Head({0, 0}, 0, 1));
+  const Points& x = mesh.shapes[0];
+  EXPECT_EQ(ArtForFrame(keys, x, {1.0}).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(ArtForFrame(keys, x, {0.0, 0.0}).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(ArtForFrame(keys, x, {NAN, 1.0}).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(ArtForFrame(keys, Points(4), {0.5, 0.5}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace inbetween::solver
