@@ -11,6 +11,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "client/auto_topology.h"
+#include "client/drawing_art.h"
 #include "client/drawing_fills.h"
 #include "client/frames_output.h"
 #include "client/render/color.h"
@@ -397,6 +398,43 @@ absl::StatusOr<Project> ResolveProject(const Inputs& inputs) {
   return project;
 }
 
+namespace {
+
+// Whether frames are drawn from the drawings' art: --render art|silhouette, else art unless a
+// fill colour was asked for (one colour is what --fill means).
+absl::StatusOr<bool> DrawArt(const std::optional<std::string>& render, bool fill_given) {
+  if (!render) return !fill_given;
+  if (*render == "art") return true;
+  if (*render == "silhouette") return false;
+  return FlagError("--render", absl::StrCat("unknown mode '", *render, "' (art or silhouette)"));
+}
+
+// Imports each drawing's art and embeds it in the multimesh (FrameSet::art). When that fails,
+// the frames are drawn as silhouettes and one warning line says why (not an error: the
+// animation itself is fine).
+void AddDrawingArt(const std::vector<std::string>& svgs, const v1::Multimesh& mesh,
+                   const ImportSettings& import_settings, render::FrameSet* frame_set) {
+  // The service's import of each drawing (PutDrawingRequest with flatten_tolerance unset: the
+  // default tolerance), so the art's points are the ones the outlines were taken from; the gap
+  // and area settings are passed on so a drawing imports here exactly when it did there.
+  solver::SvgImportOptions import;
+  if (import_settings.gap_tolerance) import.gap_tolerance = *import_settings.gap_tolerance;
+  if (import_settings.min_area_fraction) {
+    import.min_area_fraction = *import_settings.min_area_fraction;
+  }
+  absl::StatusOr<std::vector<solver::EmbeddedArt>> art = EmbedDrawingArt(svgs, mesh, import);
+  if (art.ok()) {
+    frame_set->art = *std::move(art);
+    if (render::CheckFrameSet(*frame_set).ok()) return;
+    frame_set->art.clear();
+    art = absl::InvalidArgumentError("the frames' example weights do not fit the drawings");
+  }
+  std::fprintf(stderr, "warning: drawing art: %s; frames are drawn as one-colour silhouettes\n",
+               std::string(art.status().message()).c_str());
+}
+
+}  // namespace
+
 absl::Status RunAnimate(const AnimateOptions& options, const RunContext& ctx) {
   auto project = ResolveProject(options.inputs);
   if (!project.ok()) return project.status();
@@ -424,14 +462,20 @@ absl::Status RunAnimate(const AnimateOptions& options, const RunContext& ctx) {
   out.drawing_fills = !fill.has_value();
   out.mesh_overlay = options.mesh_overlay.value_or(project->output.mesh_overlay);
   out.transparent = options.transparent;
+  absl::StatusOr<bool> art = DrawArt(options.render, fill.has_value());
+  if (!art.ok()) return art.status();
+  out.art = *art;
 
   auto session = UploadProject(*project, "inbetween animate", ctx);
   if (!session.ok()) return session.status();
   auto built = Build(*session, ctx);
   if (!built.ok()) return built.status();
+  // The mesh the frames are computed on: the optimized one when optimizing.
+  v1::Multimesh mesh = built->multimesh();
   if (options.optimize) {
     auto optimized = Optimize(built->session(), ctx);
     if (!optimized.ok()) return optimized.status();
+    mesh = optimized->multimesh();
   }
   auto frames = ctx.client->Inbetween(
       session->id(), *params, [&](const v1::InbetweenFrame& f, uint32_t total) {
@@ -453,7 +497,11 @@ absl::Status RunAnimate(const AnimateOptions& options, const RunContext& ctx) {
       auto svg = ReadFile(d.file);
       if (svg.ok()) svgs.push_back(*std::move(svg));
     }
-    if (svgs.size() == project->drawings.size()) frame_set.fills = DrawingFills(svgs);
+    if (svgs.size() == project->drawings.size()) {
+      frame_set.fills = DrawingFills(svgs);
+      // The art goes into frames.json whatever --render says, so `render` can draw either.
+      AddDrawingArt(svgs, mesh, project->import_settings, &frame_set);
+    }
   }
   absl::Status written = render::ExportFrames(frame_set, out);
   FinishProgress(ctx);
@@ -560,6 +608,9 @@ absl::Status RunRender(const RenderOptions& options, ProgressBar& progress) {
   out.fps = options.fps;
   if (options.fill) out.fill = *options.fill;
   out.drawing_fills = !options.fill.has_value();
+  absl::StatusOr<bool> art = DrawArt(options.render, options.fill.has_value());
+  if (!art.ok()) return art.status();
+  out.art = *art;
   out.mesh_overlay = options.mesh_overlay;
   out.transparent = options.transparent;
   out.progress = [&](std::string_view stage, int done, int total) {

@@ -61,6 +61,9 @@ struct AnimateOptions {
   std::optional<double> fps;
   std::optional<bool> mesh_overlay;
   std::optional<std::string> fill;  // unset = output.fill, else the drawings' own fills
+  // "art" (the drawings' art) or "silhouette" (one colour); unset = art, unless a fill colour
+  // is given (--fill or output.fill), which asks for the one-colour silhouette.
+  std::optional<std::string> render;
   bool transparent = false;
   bool optimize = false;  // run comesh optimization before inbetweening
   // Propose cuts when the drawings' topology differs; written to --project, else OUT/project.json.
@@ -83,7 +86,8 @@ struct RenderOptions {
   std::string formats = "svg,json,gif";
   int width = 512;
   double fps = 24;
-  std::optional<std::string> fill;  // unset = frames.json's "fills", else the default colour
+  std::optional<std::string> fill;    // unset = frames.json's "fills", else the default colour
+  std::optional<std::string> render;  // as AnimateOptions::render (art: frames.json's "art")
   bool mesh_overlay = false;
   bool transparent = false;
 };

@@ -167,6 +167,12 @@ int main(int argc, char** argv) {
   AddInbetweenFlags(animate_cmd, &animate_flags);
   animate_cmd->add_option("--fill", fill,
                           "Fill colour (#rrggbb) instead of the drawings' own fill colours");
+  std::string animate_render;
+  animate_cmd
+      ->add_option("--render", animate_render,
+                   "art (default): the drawings' art; silhouette: the shape in one colour "
+                   "(the default with --fill)")
+      ->check(CLI::IsMember({"art", "silhouette"}));
   animate_cmd->add_flag("--mesh", overlay, "Draw the triangle mesh over every frame");
   std::string animate_overlay;
   animate_cmd->add_option("--overlay", animate_overlay, "mesh: same as --mesh; none: no overlay")
@@ -228,6 +234,11 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--fill", render_fill,
                          "Fill colour (#rrggbb); default: the drawings' fills in frames.json, else "
                          "#3b7dd8");
+  std::string render_render;
+  render_cmd
+      ->add_option("--render", render_render,
+                   "art (default, when frames.json has art) | silhouette (see animate)")
+      ->check(CLI::IsMember({"art", "silhouette"}));
   render_cmd->add_flag("--mesh", render.mesh_overlay, "Draw the triangle mesh");
   std::string render_overlay;
   render_cmd->add_option("--overlay", render_overlay, "mesh: same as --mesh; none: no overlay")
@@ -305,6 +316,7 @@ int main(int argc, char** argv) {
   };
   if (*render_cmd) {
     if (render_cmd->count("--fill")) render.fill = render_fill;
+    if (render_cmd->count("--render")) render.render = render_render;
     if (render_overlay == "mesh") render.mesh_overlay = true;
     return report(inbetween::client::RunRender(render, bar));
   }
@@ -351,6 +363,7 @@ int main(int argc, char** argv) {
       ApplyInbetweenFlags(*animate_cmd, animate_flags, &overrides);
       animate.overrides = overrides;
       if (animate_cmd->count("--fill")) animate.fill = fill;
+      if (animate_cmd->count("--render")) animate.render = animate_render;
       if (!formats.empty()) animate.formats = formats;
       if (width != 0) animate.width = width;
       if (fps != 0) animate.fps = fps;

@@ -40,7 +40,8 @@ absl::StatusOr<RgbaImage> RenderContactSheet(const FrameSet& frames,
                                        .fill = options.fill,
                                        .drawing_fills = options.drawing_fills,
                                        .mesh_overlay = options.mesh_overlay,
-                                       .transparent = false});
+                                       .transparent = false,
+                                       .art = options.art});
   if (!raster.ok()) return raster.status();
   const std::vector<size_t> shown = ContactSheetFrames(frames, options.inbetweens);
   const int count = static_cast<int>(shown.size());

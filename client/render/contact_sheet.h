@@ -19,6 +19,7 @@ struct ContactSheetOptions {
   std::string fill = "#3b7dd8";
   bool drawing_fills = true;  // FrameSet::fills (blended per frame) win over `fill` when present
   bool mesh_overlay = false;
+  bool art = true;  // FrameSet::art when present, else the silhouette (RasterOptions::art)
 };
 
 // Height of the label strip under each cell image, in pixels.

@@ -63,7 +63,30 @@ ContactSheetOptions SheetOptions(const ExportOptions& options) {
           .inbetweens = 6,
           .fill = options.fill,
           .drawing_fills = options.drawing_fills,
-          .mesh_overlay = options.mesh_overlay};
+          .mesh_overlay = options.mesh_overlay,
+          .art = options.art};
+}
+
+// The GIF palette's anchor colours for frames drawn from art: every key layer's fill and stroke
+// colour. Morphed colours blend corresponding layers' colours and cross-fades blend a layer into
+// what lies under it, both on the palette's ramps between anchors. More than GifPalette's 16
+// anchors: none (GifPalette's generic colour cube), which serves many colours evenly rather than
+// the first 16 well and the rest badly.
+std::vector<Rgba8> ArtPaletteColors(const FrameSet& frames, std::vector<Rgba8> colors) {
+  constexpr size_t kMaxAnchors = 16;
+  const auto add = [&](uint32_t rgb) {
+    const Rgba8 c = {static_cast<uint8_t>(rgb >> 16), static_cast<uint8_t>(rgb >> 8),
+                     static_cast<uint8_t>(rgb), 255};
+    if (std::find(colors.begin(), colors.end(), c) == colors.end()) colors.push_back(c);
+  };
+  for (const solver::EmbeddedArt& key : frames.art) {
+    for (const solver::EmbeddedLayer& layer : key.layers) {
+      if (layer.paint.fill) add(layer.paint.fill->rgb);
+      if (layer.paint.stroke) add(layer.paint.stroke->rgb);
+    }
+  }
+  if (colors.size() > kMaxAnchors) colors.clear();
+  return colors;
 }
 
 // A hidden folder inside DIR that is removed again unless released.
@@ -178,7 +201,8 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
                                          .fill = options.fill,
                                          .drawing_fills = options.drawing_fills,
                                          .mesh_overlay = options.mesh_overlay,
-                                         .transparent = options.transparent});
+                                         .transparent = options.transparent,
+                                         .art = options.art});
     if (!r.ok()) return r.status();
     raster.emplace(*std::move(r));
   }
@@ -200,6 +224,12 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
       gif_options.palette_colors.push_back(*fill);
     }
     if (options.mesh_overlay) gif_options.palette_colors.push_back(kMeshOverlayColor);
+    if (raster->draws_art()) {
+      std::vector<Rgba8> base;
+      if (!options.transparent) base.push_back(raster->background());
+      if (options.mesh_overlay) base.push_back(kMeshOverlayColor);
+      gif_options.palette_colors = ArtPaletteColors(frames, std::move(base));
+    }
     absl::StatusOr<GifEncoder> e =
         GifEncoder::Create(raster->width(), raster->height(), std::move(gif_options));
     if (!e.ok()) return e.status();
@@ -248,7 +278,8 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
     if (absl::Status s = WriteSvgFrames(out, frames,
                                         {.fill = options.fill,
                                          .drawing_fills = options.drawing_fills,
-                                         .mesh_overlay = options.mesh_overlay});
+                                         .mesh_overlay = options.mesh_overlay,
+                                         .art = options.art});
         !s.ok()) {
       return s;
     }

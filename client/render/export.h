@@ -30,6 +30,10 @@ struct ExportOptions {
   std::string fill = "#3b7dd8";  // shape colour, #rgb / #rrggbb (see ParseColor)
   // The drawings' own fills (FrameSet::fills, blended per frame) instead of `fill` when present.
   bool drawing_fills = true;
+  // The drawings' art (FrameSet::art) on SVG, PNG, GIF, WebP and the contact sheet when the set
+  // has art; false (or no art): the one-colour silhouette (`fill` / the drawings' fills). Lottie
+  // is always the silhouette.
+  bool art = true;
   bool mesh_overlay = false;  // triangle edges on SVG, PNG, GIF, WebP and contact sheet
   bool transparent = false;   // PNG, GIF (1-bit) and WebP background; else white
   bool webp_lossless = true;  // else lossy at webp_quality

@@ -5,6 +5,8 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "client/render/art_json.h"
+#include "solver/art/frame_art.h"
 
 namespace inbetween::render {
 namespace {
@@ -14,6 +16,50 @@ absl::Status PathError(const std::string& path, const std::string& what) {
 }
 
 absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc);
+
+// The art rules of CheckFrameSet (frames and triangles already checked): what ArtForFrame needs
+// to succeed on every frame, so that renderers can rely on FrameArt.
+absl::Status CheckArt(const FrameSet& frames) {
+  if (frames.art.empty() || frames.frames.empty()) return absl::OkStatus();
+  const size_t num_vertices = frames.frames[0].vertices.size();
+  for (size_t k = 0; k < frames.art.size(); ++k) {
+    const solver::EmbeddedArt& art = frames.art[k];
+    if (static_cast<size_t>(art.num_vertices) != num_vertices) {
+      return PathError(absl::StrCat("art[", k, "]"),
+                       absl::StrCat("embedded in a mesh of ", art.num_vertices,
+                                    " vertices, the frames have ", num_vertices));
+    }
+    for (size_t l = 0; l < art.layers.size(); ++l) {
+      for (size_t p = 0; p < art.layers[l].paths.size(); ++p) {
+        for (const solver::EmbeddedPoint& e : art.layers[l].paths[p].points) {
+          for (int c : e.corners) {
+            if (c < 0 || static_cast<size_t>(c) >= num_vertices) {
+              return PathError(absl::StrCat("art[", k, "].layers[", l, "].paths[", p, "]"),
+                               absl::StrCat("vertex index ", c, " out of range"));
+            }
+          }
+        }
+      }
+    }
+  }
+  for (size_t f = 0; f < frames.frames.size(); ++f) {
+    const std::vector<double>& w = frames.frames[f].weights;
+    if (w.size() != frames.art.size()) {
+      return PathError(
+          absl::StrCat("frames[", f, "].weights"),
+          absl::StrCat("has ", w.size(), " weights, art has ", frames.art.size(), " key drawings"));
+    }
+    bool positive = false;
+    for (double x : w) {
+      if (!std::isfinite(x)) {
+        return PathError(absl::StrCat("frames[", f, "].weights"), "expected finite numbers");
+      }
+      positive = positive || x > 0;
+    }
+    if (!positive) return PathError(absl::StrCat("frames[", f, "].weights"), "none is > 0");
+  }
+  return absl::OkStatus();
+}
 
 }  // namespace
 
@@ -52,7 +98,7 @@ absl::Status CheckFrameSet(const FrameSet& frames) {
       }
     }
   }
-  return absl::OkStatus();
+  return CheckArt(frames);
 }
 
 namespace {
@@ -171,6 +217,13 @@ absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc) {
       out.fills.push_back(*c);
     }
   }
+  if (doc.contains("art")) {  // optional (added field): the key drawings' art in the mesh
+    absl::StatusOr<std::vector<solver::EmbeddedArt>> art =
+        ArtFromJson(doc["art"], out.triangles, static_cast<int>(num_vertices));
+    if (!art.ok()) return art.status();
+    out.art = *std::move(art);
+    if (absl::Status s = CheckArt(out); !s.ok()) return s;
+  }
   return out;
 }
 
@@ -197,7 +250,19 @@ nlohmann::json FrameSetToJson(const FrameSet& frames) {
     for (const Rgba8& c : frames.fills) fills.push_back(HexColor(c));
     doc["fills"] = fills;
   }
+  if (!frames.art.empty()) doc["art"] = ArtToJson(frames.art);
   return doc;
+}
+
+absl::StatusOr<std::vector<solver::ArtLayer>> FrameArt(const FrameSet& frames, size_t f) {
+  if (f >= frames.frames.size()) {
+    return absl::OutOfRangeError(absl::StrCat("frame ", f, " of ", frames.frames.size()));
+  }
+  const FrameData& frame = frames.frames[f];
+  solver::Points vertices;
+  vertices.reserve(frame.vertices.size());
+  for (const Vertex& v : frame.vertices) vertices.emplace_back(v[0], v[1]);
+  return solver::ArtForFrame(frames.art, vertices, frame.weights);
 }
 
 std::optional<Rgba8> FrameFill(const FrameSet& frames, size_t f) {

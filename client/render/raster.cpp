@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <set>
 
+#include "client/render/art_painter.h"
 #include "client/render/cairo_image.h"
 
 namespace inbetween::render {
@@ -30,6 +31,7 @@ absl::StatusOr<FrameRasterizer> FrameRasterizer::Create(const FrameSet& frames,
     for (size_t f = 0; f < frames.frames.size(); ++f)
       r.frame_fills_.push_back(*FrameFill(frames, f));
   }
+  r.draw_art_ = options.art && !frames.art.empty();
   r.background_ = options.transparent ? Rgba8{255, 255, 255, 0} : Rgba8{255, 255, 255, 255};
   absl::StatusOr<std::vector<Loop>> loops = BoundaryLoops(frames.triangles);
   if (!loops.ok()) return loops.status();
@@ -60,21 +62,29 @@ RgbaImage FrameRasterizer::Render(size_t f) const {
     SetSource(cr.get(), background_);
     cairo_paint(cr.get());
   }
-  // One path of every loop, filled once: no seams between triangles, holes by winding.
-  cairo_set_fill_rule(cr.get(), CAIRO_FILL_RULE_WINDING);
-  for (const Loop& loop : loops_) {
-    for (size_t i = 0; i < loop.size(); ++i) {
-      const auto [x, y] = viewport_.ToPixels(v[loop[i]]);
-      if (i == 0) {
-        cairo_move_to(cr.get(), x, y);
-      } else {
-        cairo_line_to(cr.get(), x, y);
+  // CheckFrameSet (in Create) guarantees the art fits every frame; the silhouette stays as a
+  // fallback so that a frame is never left blank.
+  absl::StatusOr<std::vector<solver::ArtLayer>> art =
+      draw_art_ ? FrameArt(*frames_, f) : absl::FailedPreconditionError("no art");
+  if (art.ok()) {
+    PaintArt(cr.get(), *art, viewport_);
+  } else {
+    // One path of every loop, filled once: no seams between triangles, holes by winding.
+    cairo_set_fill_rule(cr.get(), CAIRO_FILL_RULE_WINDING);
+    for (const Loop& loop : loops_) {
+      for (size_t i = 0; i < loop.size(); ++i) {
+        const auto [x, y] = viewport_.ToPixels(v[loop[i]]);
+        if (i == 0) {
+          cairo_move_to(cr.get(), x, y);
+        } else {
+          cairo_line_to(cr.get(), x, y);
+        }
       }
+      cairo_close_path(cr.get());
     }
-    cairo_close_path(cr.get());
+    SetSource(cr.get(), FillOf(f));
+    cairo_fill(cr.get());
   }
-  SetSource(cr.get(), FillOf(f));
-  cairo_fill(cr.get());
   if (!edges_.empty()) {
     for (const auto& [a, b] : edges_) {
       const auto [xa, ya] = viewport_.ToPixels(v[a]);

@@ -1,6 +1,7 @@
-// Raster rendering of frames with cairo: the boundary loops filled anti-aliased with the nonzero
-// rule (holes stay holes, overlapping parts stay filled), optionally the triangle edges on top,
-// on a white or transparent background. Every frame of a set uses the same Viewport.
+// Raster rendering of frames with cairo: the drawings' art placed in the frame (FrameSet::art,
+// art_painter.h), or without art the silhouette: the boundary loops filled anti-aliased with the
+// nonzero rule (holes stay holes, overlapping parts stay filled); optionally the triangle edges
+// on top, on a white or transparent background. Every frame of a set uses the same Viewport.
 #pragma once
 
 #include <array>
@@ -23,6 +24,8 @@ struct RasterOptions {
   bool drawing_fills = true;     // FrameSet::fills (blended per frame) win over `fill` when present
   bool mesh_overlay = false;     // draw the triangle edges on top
   bool transparent = false;      // transparent instead of white background
+  // Draw FrameSet::art when the set has art; false (or no art): the one-colour silhouette.
+  bool art = true;
 };
 
 // Colour of the mesh overlay lines.
@@ -45,6 +48,8 @@ class FrameRasterizer {
   // The colour frame `f` is filled with (`fill`, or the drawings' fills blended).
   Rgba8 FillOf(size_t f) const;
   Rgba8 background() const { return background_; }
+  // Whether frames are drawn from the art (else as the silhouette).
+  bool draws_art() const { return draw_art_; }
   const RasterOptions& options() const { return options_; }
 
  private:
@@ -56,6 +61,7 @@ class FrameRasterizer {
   Rgba8 fill_;
   std::vector<Rgba8> frame_fills_;  // per frame when the drawings' fills are used, else empty
   Rgba8 background_;
+  bool draw_art_ = false;
   std::vector<Loop> loops_;
   std::vector<std::pair<int, int>> edges_;  // unique triangle edges, for the overlay
 };

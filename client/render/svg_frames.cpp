@@ -1,4 +1,5 @@
-// SVG frame export (see svg_frames.h): the shape as its boundary outline, the mesh optional.
+// SVG frame export (see svg_frames.h): the frame's art, or the shape as its boundary outline; the
+// mesh optional.
 #include "client/render/svg_frames.h"
 
 #include <optional>
@@ -9,6 +10,7 @@
 #include "client/render/atomic_write.h"
 #include "client/render/boundary_loops.h"
 #include "client/render/bounds.h"
+#include "solver/art/art_svg.h"
 
 namespace inbetween::render {
 
@@ -33,8 +35,13 @@ std::string FrameSvg(const FrameSet& frames, size_t f, const SvgFrameOptions& op
   // The outline: one subpath per boundary loop, holes winding the other way (nonzero fill), so
   // there are no seams between triangles. A mesh BoundaryLoops rejects (inconsistent orientation)
   // still draws as its triangles, stroked in the fill colour to hide their hairline seams.
+  absl::StatusOr<std::vector<solver::ArtLayer>> art = options.art && !frames.art.empty()
+                                                          ? FrameArt(frames, f)
+                                                          : absl::FailedPreconditionError("no art");
   absl::StatusOr<std::vector<Loop>> loops = BoundaryLoops(frames.triangles);
-  if (loops.ok()) {
+  if (art.ok()) {
+    absl::StrAppend(&svg, solver::ArtToSvgPaths(*art));
+  } else if (loops.ok()) {
     std::ostringstream outline;
     for (const Loop& loop : *loops) {
       for (size_t i = 0; i < loop.size(); ++i) {

@@ -14,6 +14,9 @@ struct SvgFrameOptions {
   std::string fill = "#3b7dd8";
   bool drawing_fills = true;  // FrameSet::fills (blended per frame) win over `fill` when present
   bool mesh_overlay = false;  // draw triangle edges on top
+  // Draw FrameSet::art when the set has art (its layers as <path>s with their paint, in paint
+  // order); false (or no art): the one-colour silhouette.
+  bool art = true;
 };
 
 // The SVG text of frame `f` of `frames`.
