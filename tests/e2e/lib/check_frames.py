@@ -13,16 +13,17 @@ import math
 import sys
 
 
+class FramesError(Exception):
+    pass
+
+
 def fail(msg):
-    print(f"check_frames: FAIL: {msg}", file=sys.stderr)
-    sys.exit(1)
+    raise FramesError(msg)
 
 
-def main():
-    path, n_frames, keys = sys.argv[1], int(sys.argv[2]), [int(k) for k in sys.argv[3].split(",")]
-    max_overlaps = int(sys.argv[4]) if len(sys.argv) > 4 else 0
-    with open(path) as f:
-        doc = json.load(f)
+def check_frames(doc, n_frames, keys, max_overlaps=0):
+    """Checks a parsed frames.json (the assertions above); returns a one-line summary, raises
+    FramesError naming the first problem. Also imported by tests/e2e/cli_openmoji_check.py."""
     tris, frames = doc["triangles"], doc["frames"]
     if len(frames) != n_frames:
         fail(f"{len(frames)} frames, expected {n_frames}")
@@ -53,7 +54,20 @@ def main():
             fail(f"frame {i}: area ratios {valid['min_area_ratio']} .. {valid['max_area_ratio']}")
     if not 0.0 <= frames[0]["time"] < frames[-1]["time"] <= 1.0:
         fail("frame times are not increasing within [0, 1]")
-    print(f"check_frames: ok: {len(frames)} frames, {len(tris)} triangles, {n_vertices} vertices")
+    return f"{len(frames)} frames, {len(tris)} triangles, {n_vertices} vertices"
+
+
+def main():
+    path, n_frames, keys = sys.argv[1], int(sys.argv[2]), [int(k) for k in sys.argv[3].split(",")]
+    max_overlaps = int(sys.argv[4]) if len(sys.argv) > 4 else 0
+    with open(path) as f:
+        doc = json.load(f)
+    try:
+        summary = check_frames(doc, n_frames, keys, max_overlaps)
+    except FramesError as e:
+        print(f"check_frames: FAIL: {e}", file=sys.stderr)
+        sys.exit(1)
+    print(f"check_frames: ok: {summary}")
 
 
 if __name__ == "__main__":
