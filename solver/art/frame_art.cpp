@@ -43,6 +43,62 @@ bool SameGeometry(const std::vector<EmbeddedArt>& keys, const Group& group) {
   return true;
 }
 
+// Two layers that may morph into each other: the same kind of paint and the same path structure
+// (path count, each closed in both or neither).
+bool Compatible(const EmbeddedLayer& a, const EmbeddedLayer& b) {
+  if (!SameKind(a.paint, b.paint) || a.paths.size() != b.paths.size()) return false;
+  for (size_t j = 0; j < a.paths.size(); ++j) {
+    if (a.paths[j].closed != b.paths[j].closed) return false;
+  }
+  return true;
+}
+
+// The paint order alignment of `b`'s unnamed layers to `a`'s (an index into b per layer of a, or
+// -1): the order-preserving matching of compatible layers with the largest score, a pair scoring
+// 2 when its colours agree and 1 otherwise (dynamic programming over both paint orders, as for a
+// longest common subsequence). Equal structures align index to index; a key that adds or drops
+// layers (other eyes, an extra highlight) keeps the rest of its layers morphing. Above
+// `max_cells` pairs, layers align index to index when the counts are equal and not at all
+// otherwise.
+template <typename Named>
+std::vector<int> AlignLayers(const std::vector<EmbeddedLayer>& a,
+                             const std::vector<EmbeddedLayer>& b, Named named, double max_cells) {
+  const size_t n = a.size(), m = b.size();
+  std::vector<int> match(n, -1);
+  auto score = [&](size_t i, size_t j) {
+    if (named(a[i]) || named(b[j]) || !Compatible(a[i], b[j])) return 0;
+    const ArtLayer &p = a[i].paint, &q = b[j].paint;
+    const bool same =
+        (!p.fill || p.fill->rgb == q.fill->rgb) && (!p.stroke || p.stroke->rgb == q.stroke->rgb);
+    return same ? 2 : 1;
+  };
+  if (static_cast<double>(n) * static_cast<double>(m) > max_cells) {
+    if (n == m) {
+      for (size_t i = 0; i < n; ++i) match[i] = score(i, i) > 0 ? static_cast<int>(i) : -1;
+    }
+    return match;
+  }
+  // best[i][j]: the best score aligning a[i..] with b[j..].
+  std::vector<std::vector<int>> best(n + 1, std::vector<int>(m + 1, 0));
+  for (size_t i = n; i-- > 0;) {
+    for (size_t j = m; j-- > 0;) {
+      const int s = score(i, j);
+      best[i][j] = std::max({best[i + 1][j], best[i][j + 1], s > 0 ? s + best[i + 1][j + 1] : 0});
+    }
+  }
+  for (size_t i = 0, j = 0; i < n && j < m;) {  // the first best path, ties to matching
+    const int s = score(i, j);
+    if (s > 0 && best[i][j] == s + best[i + 1][j + 1]) {
+      match[i++] = static_cast<int>(j++);
+    } else if (best[i][j] == best[i + 1][j]) {
+      ++i;
+    } else {
+      ++j;
+    }
+  }
+  return match;
+}
+
 // The morphing groups among `active` (key indices ascending, weights normalized), ordered by
 // their layer in the first active key (the backbone).
 std::vector<Group> MatchLayers(const std::vector<EmbeddedArt>& keys,
@@ -66,19 +122,23 @@ std::vector<Group> MatchLayers(const std::vector<EmbeddedArt>& keys,
       if (group.size() == active.size()) groups.push_back(std::move(group));
     }
   }
-  const size_t count = keys[active[0].key].layers.size();
-  const bool same_count = std::all_of(active.begin(), active.end(), [&](const Member& a) {
-    return keys[a.key].layers.size() == count;
-  });
-  if (options.match_by_order && same_count) {
-    for (size_t l = 0; l < count; ++l) {
-      const EmbeddedLayer& first = keys[active[0].key].layers[l];
-      Group group;
-      for (const Member& a : active) {
-        const EmbeddedLayer& layer = keys[a.key].layers[l];
-        if (named(layer) || !SameKind(layer.paint, first.paint)) break;
-        group.push_back({a.key, static_cast<int>(l), a.weight});
+  if (options.match_by_order) {
+    // Each other active key's unnamed layers aligned to the backbone's in paint order; a
+    // backbone layer aligned in every key is a group.
+    const std::vector<EmbeddedLayer>& backbone = keys[active[0].key].layers;
+    std::vector<Group> by_layer(backbone.size());
+    for (size_t l = 0; l < backbone.size(); ++l) {
+      if (!named(backbone[l]))
+        by_layer[l].push_back({active[0].key, static_cast<int>(l), active[0].weight});
+    }
+    for (size_t k = 1; k < active.size(); ++k) {
+      const std::vector<int> match =
+          AlignLayers(backbone, keys[active[k].key].layers, named, options.max_alignment_cells);
+      for (size_t l = 0; l < backbone.size(); ++l) {
+        if (match[l] >= 0) by_layer[l].push_back({active[k].key, match[l], active[k].weight});
       }
+    }
+    for (Group& group : by_layer) {
       if (group.size() == active.size()) groups.push_back(std::move(group));
     }
   }

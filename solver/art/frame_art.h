@@ -9,8 +9,11 @@
 //  - by name: layers with the same non-empty name (data-layer) correspond, the m-th layer with
 //    that name in one key to the m-th in every other. Their paint may differ in kind: a fill or
 //    stroke one key lacks fades in with the others' weights (as if there at opacity 0).
-//  - by order: when every active key has the same number of layers, unnamed layers at the same
-//    index correspond if all of them have the same kind of paint (fill present, stroke present).
+//  - by order: unnamed layers are aligned in paint order, each key to the lowest active key:
+//    the order-preserving matching of layers with the same kind of paint (fill present, stroke
+//    present) and path structure that pairs the most (pairs of equal colour count double). Keys
+//    drawn with the same layers align index to index; a key that adds or drops layers (other
+//    eyes) keeps its other layers (the face, its outline) morphing instead of fading.
 //  A group of corresponding layers morphs only if its members have the same number of paths and
 //  each path is closed in all or none of them; otherwise its layers cross-fade.
 //
@@ -44,7 +47,10 @@ namespace inbetween::solver {
 
 struct FrameArtOptions {
   bool match_by_name = true;   // layers with equal non-empty names correspond
-  bool match_by_order = true;  // unnamed layers at equal indices correspond (see above)
+  bool match_by_order = true;  // unnamed layers aligned in paint order correspond (see above)
+  // Largest alignment table (layers of one key times layers of another); above it, layers
+  // correspond index to index when the counts are equal.
+  double max_alignment_cells = 4e6;
   // Arc-length parameters (fractions of a path's length) closer than this are one sample of the
   // morph's resampling: closer samples add points no renderer can tell apart.
   double merge_fraction = 1e-9;
