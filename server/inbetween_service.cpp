@@ -3,6 +3,8 @@
 // were read at, so a concurrent mutation makes the later writer fail with ABORTED.
 #include "server/inbetween_service.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -29,6 +31,7 @@
 #include "server/session_snapshot.h"
 #include "server/status_mapping.h"
 #include "server/stiffness_field.h"
+#include "solver/art/art_embedding.h"
 #include "solver/comesh/comesh_objective.h"
 #include "solver/comesh/comesh_optimizer.h"
 #include "solver/geometry/graph_flow.h"
@@ -167,6 +170,37 @@ v1::Session Compact(const v1::Session& session) {
     drawing.clear_art();
   }
   return out;
+}
+
+// InbetweenHeader.art: every drawing's art embedded in its shape of the multimesh the frames are
+// solved on. Computed per request rather than stored with the multimesh: it takes a fraction of
+// a second and would otherwise have to follow the multimesh through every store and archive.
+// Nothing when no drawing has art. It never fails the stream: on an error the header goes
+// without art and a warning is logged.
+void AddKeyArt(const SessionState& state, v1::InbetweenHeader* header) {
+  if (std::none_of(state.parsed.begin(), state.parsed.end(),
+                   [](const solver::Drawing& d) { return !d.art.empty(); })) {
+    return;
+  }
+  const solver::Multimesh& mesh = *state.multimesh;
+  if (state.parsed.size() != mesh.shapes.size()) {
+    spdlog::warn("session={} rpc=Inbetween: {} drawings but {} shapes in the multimesh; no art",
+                 state.session.id(), state.parsed.size(), mesh.shapes.size());
+    return;
+  }
+  std::vector<solver::EmbeddedArt> embedded;
+  embedded.reserve(state.parsed.size());
+  for (size_t k = 0; k < state.parsed.size(); ++k) {
+    absl::StatusOr<solver::EmbeddedArt> art =
+        solver::EmbedArt(mesh, static_cast<int>(k), state.parsed[k].art);
+    if (!art.ok()) {
+      spdlog::warn("session={} rpc=Inbetween: drawing {} art not embedded ({}); no art",
+                   state.session.id(), k, std::string(art.status().message()));
+      return;
+    }
+    embedded.push_back(*std::move(art));
+  }
+  for (const solver::EmbeddedArt& art : embedded) ToProto(art, header->add_art());
 }
 
 // Any change to drawings or correspondences drops the multimesh built from them.
@@ -1131,6 +1165,7 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
         for (int key : schedule->keys) header->add_keys(key);
         header->set_frames(plan->frames);
         header->set_session_version(session.version());
+        AddKeyArt(*state, header);
         if (!writer->Write(message)) return StoppedStatus(*context, "Inbetween");
 
         // Frames before start_frame are solved but not sent: each frame warm-starts from the

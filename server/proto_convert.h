@@ -4,6 +4,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "inbetween/v1/inbetween.pb.h"
+#include "solver/art/art_embedding.h"
 #include "solver/core/types.h"
 #include "solver/io/svg_import.h"
 #include "solver/mesh/multimesh.h"
@@ -36,6 +37,10 @@ void ToProto(const std::vector<solver::ArtLayer>& art,
 solver::ArtLayer FromProto(const inbetween::v1::ArtLayer& layer);
 std::vector<solver::ArtLayer> FromProto(
     const google::protobuf::RepeatedPtrField<inbetween::v1::ArtLayer>& art);
+
+// A key's art embedded in the multimesh (InbetweenHeader.art): paint as in ToProto(ArtLayer)
+// without paths, each path's points packed as triangle indices and barycentric triples.
+void ToProto(const solver::EmbeddedArt& art, inbetween::v1::KeyArt* out);
 
 // What ImportSvg saw, as the API reports it; `art_layers` is the size of the drawing's art.
 inbetween::v1::ImportReport ToProto(const solver::SvgImportInfo& info, int art_layers);

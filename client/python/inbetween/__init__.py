@@ -17,6 +17,6 @@ import pkgutil
 
 __path__ = pkgutil.extend_path(__path__, __name__)
 
-from inbetween.client import Client, InbetweenError  # noqa: E402
+from inbetween.client import Client, InbetweenError, place_art  # noqa: E402
 
-__all__ = ["Client", "InbetweenError"]
+__all__ = ["Client", "InbetweenError", "place_art"]

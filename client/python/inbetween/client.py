@@ -230,6 +230,37 @@ class Client:
         return paths
 
 
+def place_art(header, frame):
+    """The drawings' art placed in ``frame`` (an InbetweenFrame), from ``header.art`` (the
+    stream's InbetweenHeader): one ``(key, weight, layers)`` per key active in the frame (weight
+    > 0), each layer a ``(paint, paths)`` pair with ``paint`` the key's ArtLayer (no paths) and
+    each path ``(closed, [(x, y), ...])``. Point i of a path is b0*v[a] + b1*v[b] + b2*v[c] for
+    its triangle (a, b, c) and the frame's vertices v. At a key frame this is that drawing's art
+    as drawn; in between, morph corresponding layers and cross-fade the others by weight
+    (docs/api.md, "Drawing a frame's art"). Empty when the header has no art."""
+    triangles = [(t.a, t.b, t.c) for t in header.triangles]
+    vertices = [(p.x, p.y) for p in frame.vertices]
+    placed = []
+    for key_art in header.art:
+        weight = frame.weights[key_art.key]
+        if weight <= 0:
+            continue
+        layers = []
+        for layer in key_art.layers:
+            paths = []
+            for path in layer.paths:
+                b = path.barycentric
+                points = []
+                for i, t in enumerate(path.triangles):
+                    (ax, ay), (bx, by), (cx, cy) = (vertices[c] for c in triangles[t])
+                    b0, b1, b2 = b[3 * i], b[3 * i + 1], b[3 * i + 2]
+                    points.append((b0 * ax + b1 * bx + b2 * cx, b0 * ay + b1 * by + b2 * cy))
+                paths.append((path.closed, points))
+            layers.append((layer.paint, paths))
+        placed.append((key_art.key, weight, layers))
+    return placed
+
+
 def _frame_svg(vertices, triangles):
     if not vertices:
         return '<svg xmlns="http://www.w3.org/2000/svg"/>\n'

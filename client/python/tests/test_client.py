@@ -93,6 +93,30 @@ class ClientTest(unittest.TestCase):
         self.assertEqual([f["index"] for f in frames], list(range(5)))
         self.assertAlmostEqual(frames[2]["time"], 0.5)
 
+    def test_header_art_places_each_key_as_drawn(self):
+        session = self.built_session("py-art")
+        drawings = self.client.get_session(session.id, full=True)[0].drawings
+        events = list(self.client.frames(session.id, 3, method="linear"))
+        header, frames = events[0][1], [message for _, message in events[1:]]
+        self.assertEqual([k.key for k in header.art], [0, 1])
+        for key, frame in ((0, frames[0]), (1, frames[-1])):
+            placed = inbetween.place_art(header, frame)
+            self.assertEqual([(k, w) for k, w, _ in placed], [(key, 1.0)])
+            layers = placed[0][2]
+            self.assertEqual(len(layers), len(drawings[key].art))
+            for (paint, paths), drawn in zip(layers, drawings[key].art):
+                self.assertEqual(paint.fill, drawn.fill)
+                self.assertEqual(len(paths), len(drawn.paths))
+                for (closed, points), drawn_path in zip(paths, drawn.paths):
+                    self.assertEqual(closed, drawn_path.closed)
+                    # The drawn points, in order, with edge crossings inserted between them.
+                    rest = iter(points)
+                    for p in drawn_path.points:
+                        self.assertTrue(any(abs(x - p.x) < 1e-6 and abs(y - p.y) < 1e-6
+                                            for x, y in rest), (key, p))
+        middle = inbetween.place_art(header, frames[1])
+        self.assertEqual([k for k, _, _ in middle], [0, 1])
+
     def test_stale_version_and_unknown_session_raise_with_their_codes(self):
         session = self.client.create_session("py-errors")
         newer = self.client.put_svg(session, SQUARE)

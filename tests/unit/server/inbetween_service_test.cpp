@@ -6,12 +6,14 @@
 #include <grpcpp/client_context.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <string>
 #include <thread>
 #include <tuple>
 #include <vector>
 
+#include "absl/strings/str_format.h"
 #include "server/parameters.h"
 #include "server/proto_convert.h"
 #include "solver/comesh/comesh_topology.h"
@@ -726,6 +728,140 @@ TEST_F(InbetweenServiceTest, ImportSessionRefusesBadArt) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// The Inbetween header's art: each key's art embedded in the multimesh (InbetweenHeader.art)
+
+// A yellow face with two black eyes and a black stroked mouth, moved by (dx, dy) and scaled by s
+// about the origin.
+std::string LayeredFaceSvg(double dx, double dy, double s) {
+  return absl::StrFormat(
+      R"svg(<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 120 120">
+  <g transform="translate(%g %g) scale(%g)">
+    <circle id="face" cx="50" cy="50" r="40" fill="#ffd020"/>
+    <circle id="left-eye" cx="35" cy="40" r="5" fill="#000000"/>
+    <circle id="right-eye" cx="65" cy="40" r="5" fill="#000000"/>
+    <path id="mouth" d="M 30 62 Q 50 80 70 62" fill="none" stroke="#000000" stroke-width="3"/>
+  </g>
+</svg>)svg",
+      dx, dy, s);
+}
+
+// Point i of a packed path in geometry `vertices`: sum_j b_j v[corner_j].
+solver::Point PlaceArtPoint(const v1::EmbeddedArtPath& path, int i,
+                            const std::vector<solver::Triangle>& triangles,
+                            const solver::Points& vertices) {
+  const solver::Triangle& t = triangles[path.triangles(i)];
+  solver::Point p(0, 0);
+  for (int c = 0; c < 3; ++c) p += path.barycentric(3 * i + c) * vertices[t[c]];
+  return p;
+}
+
+// `placed` is `drawn` with points inserted on its segments: the drawn points in order (within
+// `tol`), every other point on the drawn segment it sits between.
+void ExpectDrawnWithInsertions(const solver::Points& placed, const solver::Points& drawn,
+                               bool closed, double tol) {
+  const auto on_segment = [tol](const solver::Point& p, const solver::Point& a,
+                                const solver::Point& b) {
+    const solver::Point d = b - a;
+    const double t =
+        d.squaredNorm() > 0 ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+    return (a + t * d - p).norm() <= tol;
+  };
+  const int n = static_cast<int>(drawn.size());
+  int next = 0;  // the next drawn point to meet
+  for (size_t i = 0; i < placed.size(); ++i) {
+    if (next < n && (placed[i] - drawn[next]).norm() <= tol) {
+      ++next;
+      continue;
+    }
+    ASSERT_GT(next, 0) << "point " << i << " before the first drawn point";
+    ASSERT_TRUE(next < n || closed) << "point " << i << " after the last drawn point";
+    EXPECT_TRUE(on_segment(placed[i], drawn[next - 1], drawn[next % n]))
+        << "point " << i << " (" << placed[i].transpose() << ") off the drawn segment";
+  }
+  EXPECT_EQ(next, n) << "drawn points met";
+}
+
+TEST_F(InbetweenServiceTest, InbetweenHeaderCarriesEachKeysArtInMeshCoordinates) {
+  v1::Session session = CreateSession("faces");
+  for (const std::string& svg : {LayeredFaceSvg(0, 0, 1), LayeredFaceSvg(12, 6, 0.85)}) {
+    v1::PutDrawingResponse put;
+    grpc::Status status = PutSvg(session, "face", svg, &put);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    ASSERT_EQ(put.drawing().art_size(), 4);
+    session = put.session();
+  }
+  BuildRun build = RunBuild(*stub_, session);
+  ASSERT_TRUE(build.status.ok()) << build.status.error_message();
+  const v1::Multimesh& mesh = build.result.multimesh();
+  const v1::Session full = GetFull(*stub_, session.id()).session();
+
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(3);
+  InbetweenRun run = RunInbetween(*stub_, request);
+  ASSERT_TRUE(run.status.ok()) << run.status.error_message();
+  ASSERT_FALSE(run.messages.empty());
+  ASSERT_TRUE(run.messages[0].has_header());
+  const v1::InbetweenHeader& header = run.messages[0].header();
+  const std::vector<solver::Triangle> triangles = ToTriangles(header.triangles());
+  ASSERT_EQ(header.art_size(), 2);
+  for (int k = 0; k < 2; ++k) {
+    SCOPED_TRACE(::testing::Message() << "key " << k);
+    const v1::KeyArt& art = header.art(k);
+    EXPECT_EQ(art.key(), static_cast<uint32_t>(k));
+    const v1::Drawing& drawing = full.drawings(k);
+    ASSERT_EQ(art.layers_size(), drawing.art_size());
+    const solver::Points vertices = ToPoints(mesh.shapes(k).vertices());
+    for (int l = 0; l < art.layers_size(); ++l) {
+      SCOPED_TRACE(::testing::Message() << "layer " << l);
+      const v1::EmbeddedArtLayer& layer = art.layers(l);
+      // Paint as drawn, without the drawn paths.
+      v1::ArtLayer paint = drawing.art(l);
+      paint.clear_paths();
+      EXPECT_EQ(layer.paint().SerializeAsString(), paint.SerializeAsString());
+      ASSERT_EQ(layer.paths_size(), drawing.art(l).paths_size());
+      for (int p = 0; p < layer.paths_size(); ++p) {
+        const v1::EmbeddedArtPath& path = layer.paths(p);
+        ASSERT_EQ(path.barycentric_size(), 3 * path.triangles_size());
+        EXPECT_EQ(path.closed(), drawing.art(l).paths(p).closed());
+        solver::Points placed;
+        for (int i = 0; i < path.triangles_size(); ++i) {
+          ASSERT_LT(path.triangles(i), triangles.size());
+          placed.push_back(PlaceArtPoint(path, i, triangles, vertices));
+        }
+        ExpectDrawnWithInsertions(placed, ToPoints(drawing.art(l).paths(p).points()), path.closed(),
+                                  1e-6);
+      }
+    }
+  }
+  // The layers' paint: yellow face, black eyes, a black stroke without fill.
+  const v1::KeyArt& first = header.art(0);
+  EXPECT_EQ(first.layers(0).paint().fill().rgb(), 0xffd020u);
+  EXPECT_EQ(first.layers(1).paint().fill().rgb(), 0x000000u);
+  EXPECT_EQ(first.layers(2).paint().id(), "right-eye");
+  EXPECT_FALSE(first.layers(3).paint().has_fill());
+  EXPECT_EQ(first.layers(3).paint().stroke().width(), 3.0);
+  EXPECT_FALSE(first.layers(3).paths(0).closed());
+}
+
+TEST_F(InbetweenServiceTest, InbetweenHeaderHasNoArtForPolylineDrawings) {
+  v1::Session session = CreateSession();
+  v1::PutDrawingResponse put;
+  ASSERT_TRUE(PutPolylines(session, SquareOutline(0, 0, 1), &put).ok());
+  ASSERT_TRUE(PutPolylines(put.session(), SquareOutline(0, 0, 2), &put).ok());
+  BuildRun build = RunBuild(*stub_, put.session());
+  ASSERT_TRUE(build.status.ok()) << build.status.error_message();
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(3);
+  InbetweenRun run = RunInbetween(*stub_, request);
+  ASSERT_TRUE(run.status.ok()) << run.status.error_message();
+  ASSERT_FALSE(run.messages.empty());
+  ASSERT_TRUE(run.messages[0].has_header());
+  EXPECT_EQ(run.messages[0].header().art_size(), 0);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Heavy stages
 
 TEST_F(InbetweenServiceTest, BuildMultimeshNeedsTwoDrawings) {
@@ -822,7 +958,9 @@ TEST_F(InbetweenServiceTest, InbetweenTimingCurvesAndKeyTimes) {
   ASSERT_EQ(eased.messages.size(), linear.messages.size());
   // messages[0] is the header; frame f is messages[f + 1]. Keys stay exact, the ease-in-out
   // frames start slower and end faster than linear ones and meet them in the middle.
-  auto weight2 = [](const InbetweenRun& run, int f) { return run.messages[f + 1].frame().weights(1); };
+  auto weight2 = [](const InbetweenRun& run, int f) {
+    return run.messages[f + 1].frame().weights(1);
+  };
   EXPECT_EQ(weight2(eased, 0), 0.0);
   EXPECT_EQ(weight2(eased, 8), 1.0);
   EXPECT_DOUBLE_EQ(weight2(linear, 1), 1.0 / 8);
