@@ -1,6 +1,7 @@
 // A frame's art: morph corresponding layers, cross-fade the rest (see frame_art.h).
 #include "solver/art/frame_art.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -53,44 +54,70 @@ bool Compatible(const EmbeddedLayer& a, const EmbeddedLayer& b) {
   return true;
 }
 
+// Where a layer lies in the frame: the mean of its points placed there.
+Point Centroid(const EmbeddedLayer& layer, const Points& frame) {
+  Point sum = Point::Zero();
+  int count = 0;
+  for (const EmbeddedPath& path : layer.paths) {
+    for (const Point& p : PlacePath(path, frame)) sum += p, ++count;
+  }
+  return count > 0 ? Point(sum / count) : sum;
+}
+
 // The paint order alignment of `b`'s unnamed layers to `a`'s (an index into b per layer of a, or
-// -1): the order-preserving matching of compatible layers with the largest score, a pair scoring
-// 2 when its colours agree and 1 otherwise (dynamic programming over both paint orders, as for a
-// longest common subsequence). Equal structures align index to index; a key that adds or drops
-// layers (other eyes, an extra highlight) keeps the rest of its layers morphing. Above
-// `max_cells` pairs, layers align index to index when the counts are equal and not at all
-// otherwise.
+// -1): the order-preserving matching of compatible layers with the largest score (dynamic
+// programming over both paint orders, as for a longest common subsequence). A pair scores 2 when
+// its colours agree and 1 otherwise, plus up to 1 for lying close together in the frame
+// (1 / (1 + d / size), d between the layers' centroids placed in the frame, size the frame's
+// diagonal), so that of two open strokes of one colour the mouth pairs with the mouth, not with
+// an eye. Equal structures align index to index; a key that adds or drops layers (other eyes, an
+// extra highlight) keeps the rest of its layers morphing. Above `max_cells` pairs, layers align
+// index to index when the counts are equal and not at all otherwise.
 template <typename Named>
 std::vector<int> AlignLayers(const std::vector<EmbeddedLayer>& a,
-                             const std::vector<EmbeddedLayer>& b, Named named, double max_cells) {
+                             const std::vector<EmbeddedLayer>& b, const Points& frame, Named named,
+                             double max_cells) {
   const size_t n = a.size(), m = b.size();
   std::vector<int> match(n, -1);
-  auto score = [&](size_t i, size_t j) {
-    if (named(a[i]) || named(b[j]) || !Compatible(a[i], b[j])) return 0;
-    const ArtLayer &p = a[i].paint, &q = b[j].paint;
-    const bool same =
-        (!p.fill || p.fill->rgb == q.fill->rgb) && (!p.stroke || p.stroke->rgb == q.stroke->rgb);
-    return same ? 2 : 1;
+  auto compatible = [&](size_t i, size_t j) {
+    return !named(a[i]) && !named(b[j]) && Compatible(a[i], b[j]);
   };
   if (static_cast<double>(n) * static_cast<double>(m) > max_cells) {
     if (n == m) {
-      for (size_t i = 0; i < n; ++i) match[i] = score(i, i) > 0 ? static_cast<int>(i) : -1;
+      for (size_t i = 0; i < n; ++i) match[i] = compatible(i, i) ? static_cast<int>(i) : -1;
     }
     return match;
   }
-  // best[i][j]: the best score aligning a[i..] with b[j..].
-  std::vector<std::vector<int>> best(n + 1, std::vector<int>(m + 1, 0));
+  Eigen::AlignedBox2d box;
+  for (const Point& p : frame) box.extend(p);
+  const double size = std::max(box.isEmpty() ? 0.0 : box.diagonal().norm(), 1e-300);
+  std::vector<Point> ca(n), cb(m);
+  for (size_t i = 0; i < n; ++i) ca[i] = Centroid(a[i], frame);
+  for (size_t j = 0; j < m; ++j) cb[j] = Centroid(b[j], frame);
+  auto score = [&](size_t i, size_t j) {
+    if (!compatible(i, j)) return 0.0;
+    const ArtLayer &p = a[i].paint, &q = b[j].paint;
+    const bool same =
+        (!p.fill || p.fill->rgb == q.fill->rgb) && (!p.stroke || p.stroke->rgb == q.stroke->rgb);
+    return (same ? 2.0 : 1.0) + 1.0 / (1.0 + (ca[i] - cb[j]).norm() / size);
+  };
+  // best[i][j]: the best score aligning a[i..] with b[j..]; step[i][j]: how it starts (0: a[i]
+  // and b[j] pair, 1: a[i] unpaired, 2: b[j] unpaired; the first of equals wins).
+  std::vector<std::vector<double>> best(n + 1, std::vector<double>(m + 1, 0.0));
+  std::vector<std::vector<char>> step(n + 1, std::vector<char>(m + 1, 1));
   for (size_t i = n; i-- > 0;) {
     for (size_t j = m; j-- > 0;) {
-      const int s = score(i, j);
-      best[i][j] = std::max({best[i + 1][j], best[i][j + 1], s > 0 ? s + best[i + 1][j + 1] : 0});
+      const double s = score(i, j);
+      const double pair = s > 0 ? s + best[i + 1][j + 1] : -1.0;
+      best[i][j] = pair, step[i][j] = 0;
+      if (best[i + 1][j] > best[i][j]) best[i][j] = best[i + 1][j], step[i][j] = 1;
+      if (best[i][j + 1] > best[i][j]) best[i][j] = best[i][j + 1], step[i][j] = 2;
     }
   }
-  for (size_t i = 0, j = 0; i < n && j < m;) {  // the first best path, ties to matching
-    const int s = score(i, j);
-    if (s > 0 && best[i][j] == s + best[i + 1][j + 1]) {
+  for (size_t i = 0, j = 0; i < n && j < m;) {
+    if (step[i][j] == 0) {
       match[i++] = static_cast<int>(j++);
-    } else if (best[i][j] == best[i + 1][j]) {
+    } else if (step[i][j] == 1) {
       ++i;
     } else {
       ++j;
@@ -102,7 +129,8 @@ std::vector<int> AlignLayers(const std::vector<EmbeddedLayer>& a,
 // The morphing groups among `active` (key indices ascending, weights normalized), ordered by
 // their layer in the first active key (the backbone).
 std::vector<Group> MatchLayers(const std::vector<EmbeddedArt>& keys,
-                               const std::vector<Member>& active, const FrameArtOptions& options) {
+                               const std::vector<Member>& active, const Points& frame,
+                               const FrameArtOptions& options) {
   std::vector<Group> groups;
   auto named = [&](const EmbeddedLayer& l) {
     return options.match_by_name && !l.paint.name.empty();
@@ -132,8 +160,8 @@ std::vector<Group> MatchLayers(const std::vector<EmbeddedArt>& keys,
         by_layer[l].push_back({active[0].key, static_cast<int>(l), active[0].weight});
     }
     for (size_t k = 1; k < active.size(); ++k) {
-      const std::vector<int> match =
-          AlignLayers(backbone, keys[active[k].key].layers, named, options.max_alignment_cells);
+      const std::vector<int> match = AlignLayers(backbone, keys[active[k].key].layers, frame, named,
+                                                 options.max_alignment_cells);
       for (size_t l = 0; l < backbone.size(); ++l) {
         if (match[l] >= 0) by_layer[l].push_back({active[k].key, match[l], active[k].weight});
       }
@@ -290,7 +318,7 @@ absl::StatusOr<std::vector<ArtLayer>> ArtForFrame(const std::vector<EmbeddedArt>
     // w / total is exactly 1 for a key frame's only active key: its art comes out unchanged.
     if (weights[k] > 0.0) active.push_back({static_cast<int>(k), -1, weights[k] / total});
   }
-  const std::vector<Group> groups = MatchLayers(keys, active, options);
+  const std::vector<Group> groups = MatchLayers(keys, active, frame_vertices, options);
   for (size_t g = 0; g < groups.size(); ++g) {
     for (const Member& m : groups[g]) group_of[m.key][m.layer] = static_cast<int>(g);
   }

@@ -11,9 +11,10 @@
 //    stroke one key lacks fades in with the others' weights (as if there at opacity 0).
 //  - by order: unnamed layers are aligned in paint order, each key to the lowest active key:
 //    the order-preserving matching of layers with the same kind of paint (fill present, stroke
-//    present) and path structure that pairs the most (pairs of equal colour count double). Keys
-//    drawn with the same layers align index to index; a key that adds or drops layers (other
-//    eyes) keeps its other layers (the face, its outline) morphing instead of fading.
+//    present) and path structure that scores most (a pair: 2 for equal colours, else 1, plus up
+//    to 1 for lying close together in the frame). Keys drawn with the same layers align index to
+//    index; a key that adds or drops layers (other eyes) keeps its other layers (the face, its
+//    outline, the mouth) morphing instead of fading.
 //  A group of corresponding layers morphs only if its members have the same number of paths and
 //  each path is closed in all or none of them; otherwise its layers cross-fade.
 //

@@ -195,6 +195,30 @@ TEST(FrameArtTest, AddedAndDroppedLayersLeaveTheOthersMorphing) {
   for (size_t i = 1; i + 1 < out.size(); ++i) EXPECT_DOUBLE_EQ(out[i].opacity, 0.5);
 }
 
+// Of two open strokes of one colour in the other key, a stroke pairs with the one lying where it
+// lies: the mouth morphs into the mouth while two dots turn into two strokes beside it.
+TEST(FrameArtTest, StrokesPairWithTheNearestOfTheirKind) {
+  const Multimesh mesh = TwoShapes();
+  const std::vector<ArtLayer> a = {FillLayer({{2, 2}, {2.5, 2}, {2.5, 2.5}}, 0),
+                                   StrokeLayer({{2, 4.5}, {6, 4.5}}, 0, 0.2)};
+  const std::vector<ArtLayer> b = {StrokeLayer({{2, 2}, {3, 2.3}}, 0, 0.2),
+                                   StrokeLayer({{2, 4.2}, {6, 4.6}}, 0, 0.2)};
+  const Points x = Mix(mesh.shapes[0], mesh.shapes[1], 0.5);
+  const std::vector<EmbeddedArt> keys = Embed(mesh, a, b);
+  const std::vector<ArtLayer> out = Frame(keys, x, {0.5, 0.5});
+  ASSERT_EQ(out.size(), 3u);  // the dot and the eye stroke cross-fade, the mouths morph
+  const Point mouths = 0.5 * (PlacePath(keys[0].layers[1].paths[0], x).front() +
+                              PlacePath(keys[1].layers[1].paths[0], x).front());
+  int morphed = 0;
+  for (const ArtLayer& layer : out) {
+    if (layer.opacity != 1.0) continue;
+    ++morphed;
+    ASSERT_TRUE(layer.stroke.has_value());
+    EXPECT_LT((layer.paths[0].points.front() - mouths).norm(), 1e-9);  // mouth to mouth
+  }
+  EXPECT_EQ(morphed, 1);
+}
+
 TEST(FrameArtTest, MorphTendsToEachKeyAsItsWeightTendsToOne) {
   const Multimesh mesh = TwoShapes();
   const std::vector<EmbeddedArt> keys =
