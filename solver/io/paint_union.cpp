@@ -313,7 +313,6 @@ absl::StatusOr<PaintRegion> UnionOfPaint(const std::vector<const ArtLayer*>& lay
       Outline hole;
       for (const cl::IntPoint& p : node->Contour) hole.points.push_back(q.ToPoint(p));
       if (PolygonSignedArea(hole.points) > 0) std::reverse(hole.points.begin(), hole.points.end());
-      region.area -= q.Area(area);
       region.outlines.push_back(std::move(hole));
       for (const cl::PolyNode* child : node->Childs) stack.push_back(child);
       continue;
@@ -325,7 +324,6 @@ absl::StatusOr<PaintRegion> UnionOfPaint(const std::vector<const ArtLayer*>& lay
     Outline outer;
     for (const cl::IntPoint& p : node->Contour) outer.points.push_back(q.ToPoint(p));
     if (PolygonSignedArea(outer.points) < 0) std::reverse(outer.points.begin(), outer.points.end());
-    region.area += q.Area(area);
     region.outlines.push_back(std::move(outer));
     for (const cl::PolyNode* child : node->Childs) stack.push_back(child);
   }

@@ -21,7 +21,6 @@ struct PaintUnionOptions {
 
 struct PaintRegion {
   std::vector<Outline> outlines;  // outer outlines positive, holes negative (types.h)
-  double area = 0;                // painted area after cleaning
   double raw_area = 0;            // painted area before cleaning
   double layers_area = 0;         // the sum of each layer's own painted area (overlaps counted
                                   // once per layer: equals raw_area when no two layers overlap)

@@ -126,7 +126,6 @@ struct Collector {
   std::vector<Outline> outlines;
   std::vector<ArtLayer> art;              // painted elements, in paint order
   std::vector<ArtLayer> outline_class;    // class="outline" elements, as filled shapes
-  bool stroked = false;                   // some layer has a visible stroke
   std::vector<Points> cuts, openings;     // from class="cut" / class="opening" elements
   std::vector<CorrespondenceMark> marks;  // from data-corr="N" elements
   // The explicit fill of the filled element with the largest outline (SvgImportInfo::fill_rgb).
@@ -519,7 +518,6 @@ class Context {
     layer.fill = fill;
     layer.stroke = stroke;
     layer.opacity = group_opacity_ * opacity_;
-    collector_->stroked = collector_->stroked || stroke.has_value();
     collector_->art.push_back(std::move(layer));
     if (!fill) return;
     // The element's own outlines, as the one-colour convention reads them.
@@ -1318,22 +1316,25 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
       for (const Point& p : path.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     }
   }
-  // Coordinates beyond what the service accepts (|x| <= 1e9) are refused downstream, naming the
-  // point; the union (quantized over the paint's extent) is not attempted for them.
-  if (!(lo.cwiseAbs().maxCoeff() <= 1e9 && hi.cwiseAbs().maxCoeff() <= 1e9)) {
-    if (info != nullptr) {
-      *info = SvgImportInfo{};
-      info->fill_rgb = collector.largest_fill;
-      info->warnings = std::move(collector.warnings);
-    }
-    OrientByNesting(&collector.outlines);
+  // The drawing with the outlines chosen below, and the report on them.
+  SvgImportInfo report;
+  report.fill_rgb = collector.largest_fill;
+  auto finish = [&](std::vector<Outline> outlines) {
+    report.warnings = std::move(collector.warnings);
+    if (info != nullptr) *info = std::move(report);
     Drawing drawing;
-    drawing.outlines = std::move(collector.outlines);
+    drawing.outlines = std::move(outlines);
     drawing.cuts = std::move(collector.cuts);
     drawing.openings = std::move(collector.openings);
     drawing.marks = std::move(collector.marks);
     drawing.art = std::move(collector.art);
     return drawing;
+  };
+  // Coordinates beyond what the service accepts (|x| <= 1e9) are refused downstream, naming the
+  // point; the union (quantized over the paint's extent) is not attempted for them.
+  if (!(lo.cwiseAbs().maxCoeff() <= 1e9 && hi.cwiseAbs().maxCoeff() <= 1e9)) {
+    OrientByNesting(&collector.outlines);
+    return finish(std::move(collector.outlines));
   }
   PaintUnionOptions union_options;
   union_options.arc_tolerance = options.tolerance;
@@ -1372,40 +1373,29 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
     }
   }
 
-  SvgImportInfo report;
-  report.fill_rgb = collector.largest_fill;
-  report.warnings = std::move(collector.warnings);
-  Drawing drawing;
   if (one_colour) {
     OrientByNesting(&collector.outlines);
     // The one-colour convention: the elements' own outlines, exactly as written.
     report.source = SilhouetteSource::kElements;
     report.cleaning.gap_width = union_options.gap_width;
     report.cleaning.min_area = union_options.min_area;
-    drawing.outlines = std::move(collector.outlines);
-  } else {
-    if (region->hairline) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "SVG ", by_class ? "class=\"outline\" elements are" : "paint is",
-          " nowhere wider than the gap tolerance (", region->cleaning.gap_width,
-          " user units): it is all hairlines; lower the gap tolerance or paint wider shapes"));
-    }
-    if (region->outlines.empty()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "SVG ", by_class ? "class=\"outline\" elements" : "paint",
-          ": every piece is smaller than the minimum area (", region->cleaning.min_area,
-          " square user units; SvgImportOptions::min_area_fraction)"));
-    }
-    report.source = by_class ? SilhouetteSource::kOutlineClass : SilhouetteSource::kUnion;
-    report.cleaning = region->cleaning;
-    drawing.outlines = std::move(region->outlines);
+    return finish(std::move(collector.outlines));
   }
-  if (info != nullptr) *info = std::move(report);
-  drawing.cuts = std::move(collector.cuts);
-  drawing.openings = std::move(collector.openings);
-  drawing.marks = std::move(collector.marks);
-  drawing.art = std::move(collector.art);
-  return drawing;
+  if (region->hairline) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "SVG ", by_class ? "class=\"outline\" elements are" : "paint is",
+        " nowhere wider than the gap tolerance (", region->cleaning.gap_width,
+        " user units): it is all hairlines; lower the gap tolerance or paint wider shapes"));
+  }
+  if (region->outlines.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("SVG ", by_class ? "class=\"outline\" elements" : "paint",
+                     ": every piece is smaller than the minimum area (", region->cleaning.min_area,
+                     " square user units; SvgImportOptions::min_area_fraction)"));
+  }
+  report.source = by_class ? SilhouetteSource::kOutlineClass : SilhouetteSource::kUnion;
+  report.cleaning = region->cleaning;
+  return finish(std::move(region->outlines));
 }
 
 }  // namespace inbetween::solver
