@@ -44,6 +44,21 @@ InbetweenRun RunInbetween(v1::Inbetween::Stub& stub, const v1::InbetweenRequest&
   return run;
 }
 
+// The header of a 3-frame Inbetween stream of the session (a failed test and an empty header
+// when the stream fails).
+v1::InbetweenHeader HeaderOfThreeFrames(v1::Inbetween::Stub& stub, const std::string& session_id) {
+  v1::InbetweenRequest request;
+  request.set_session_id(session_id);
+  request.mutable_parameters()->set_frames(3);
+  InbetweenRun run = RunInbetween(stub, request);
+  EXPECT_TRUE(run.status.ok()) << run.status.error_message();
+  if (run.messages.empty() || !run.messages[0].has_header()) {
+    ADD_FAILURE() << "the stream has no header";
+    return {};
+  }
+  return run.messages[0].header();
+}
+
 struct BuildRun {
   std::vector<v1::Progress> progress;
   v1::BuildMultimeshResult result;
@@ -795,14 +810,7 @@ TEST_F(InbetweenServiceTest, InbetweenHeaderCarriesEachKeysArtInMeshCoordinates)
   const v1::Multimesh& mesh = build.result.multimesh();
   const v1::Session full = GetFull(*stub_, session.id()).session();
 
-  v1::InbetweenRequest request;
-  request.set_session_id(session.id());
-  request.mutable_parameters()->set_frames(3);
-  InbetweenRun run = RunInbetween(*stub_, request);
-  ASSERT_TRUE(run.status.ok()) << run.status.error_message();
-  ASSERT_FALSE(run.messages.empty());
-  ASSERT_TRUE(run.messages[0].has_header());
-  const v1::InbetweenHeader& header = run.messages[0].header();
+  const v1::InbetweenHeader header = HeaderOfThreeFrames(*stub_, session.id());
   const std::vector<solver::Triangle> triangles = ToTriangles(header.triangles());
   ASSERT_EQ(header.art_size(), 2);
   for (int k = 0; k < 2; ++k) {
@@ -851,14 +859,7 @@ TEST_F(InbetweenServiceTest, InbetweenHeaderHasNoArtForPolylineDrawings) {
   ASSERT_TRUE(PutPolylines(put.session(), SquareOutline(0, 0, 2), &put).ok());
   BuildRun build = RunBuild(*stub_, put.session());
   ASSERT_TRUE(build.status.ok()) << build.status.error_message();
-  v1::InbetweenRequest request;
-  request.set_session_id(session.id());
-  request.mutable_parameters()->set_frames(3);
-  InbetweenRun run = RunInbetween(*stub_, request);
-  ASSERT_TRUE(run.status.ok()) << run.status.error_message();
-  ASSERT_FALSE(run.messages.empty());
-  ASSERT_TRUE(run.messages[0].has_header());
-  EXPECT_EQ(run.messages[0].header().art_size(), 0);
+  EXPECT_EQ(HeaderOfThreeFrames(*stub_, session.id()).art_size(), 0);
 }
 
 // ---------------------------------------------------------------------------------------------
