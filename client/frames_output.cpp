@@ -1,6 +1,9 @@
 // FramesResult -> render::FrameSet (see frames_output.h).
 #include "client/frames_output.h"
 
+#include "absl/strings/str_cat.h"
+#include "server/proto_convert.h"
+
 namespace inbetween::client {
 
 render::FrameSet ToFrameSet(const FramesResult& frames) {
@@ -28,6 +31,24 @@ render::FrameSet ToFrameSet(const FramesResult& frames) {
     out.frames.push_back(std::move(data));
   }
   return out;
+}
+
+absl::Status AddHeaderArt(const v1::InbetweenHeader& header, render::FrameSet* frames) {
+  frames->art.clear();
+  if (header.art_size() == 0) return absl::OkStatus();
+  const int num_vertices =
+      frames->frames.empty() ? 0 : static_cast<int>(frames->frames[0].vertices.size());
+  std::vector<solver::EmbeddedArt> art;
+  for (int k = 0; k < header.art_size(); ++k) {
+    absl::StatusOr<solver::EmbeddedArt> key = server::EmbeddedArtFromProto(
+        header.art(k), frames->triangles, num_vertices, absl::StrCat("header.art[", k, "]"));
+    if (!key.ok()) return key.status();
+    art.push_back(*std::move(key));
+  }
+  frames->art = std::move(art);
+  absl::Status fits = render::CheckFrameSet(*frames);
+  if (!fits.ok()) frames->art.clear();
+  return fits;
 }
 
 }  // namespace inbetween::client

@@ -289,6 +289,8 @@ absl::StatusOr<FramesResult> InbetweenClient::Inbetween(
   *request.mutable_parameters() = parameters;
   FramesResult result;
   bool have_header = false;
+  // InbetweenResponse.art messages appended to result.header.art (of header.art_messages).
+  uint32_t art_received = 0;
   for (int attempt = 1;; ++attempt) {
     // Resume: the next attempt starts at the first frame not received yet.
     const uint32_t next = static_cast<uint32_t>(result.frames.size());
@@ -310,7 +312,26 @@ absl::StatusOr<FramesResult> InbetweenClient::Inbetween(
               "session ", session_id, " changed from version ", result.header.session_version(),
               " to ", response.header().session_version(), " while its frames were streamed (",
               result.frames.size(), " of ", result.header.frames(), " received); start again"));
+        } else if (art_received < result.header.art_messages()) {
+          // The art was cut off with the connection: collect it again from this header.
+          *result.header.mutable_art() = response.header().art();
+          art_received = 0;
         }
+      } else if (response.has_art()) {
+        if (art_received == result.header.art_messages()) continue;  // a resumed stream's copy
+        v1::KeyArt* key = nullptr;
+        for (v1::KeyArt& k : *result.header.mutable_art()) {
+          if (k.key() == response.art().key()) key = &k;
+        }
+        if (key == nullptr) {
+          mismatch = absl::InternalError(absl::StrCat(
+              "Inbetween stream sent art for key ", response.art().key(), ", not in its header"));
+          break;
+        }
+        for (v1::EmbeddedArtLayer& layer : *response.mutable_art()->mutable_layers()) {
+          *key->add_layers() = std::move(layer);
+        }
+        ++art_received;
       } else if (response.has_frame()) {
         if (response.frame().index() != result.frames.size()) {
           mismatch = absl::InternalError(absl::StrCat("Inbetween stream sent frame ",
@@ -336,6 +357,11 @@ absl::StatusOr<FramesResult> InbetweenClient::Inbetween(
     if (!retry.ok()) return FromGrpcStatus(retry);
   }
   if (!have_header) return absl::InternalError("Inbetween stream ended without a header");
+  if (art_received != result.header.art_messages()) {
+    return absl::InternalError(absl::StrCat("Inbetween stream sent ", art_received,
+                                            " art messages, header announced ",
+                                            result.header.art_messages()));
+  }
   if (result.frames.size() != result.header.frames()) {
     return absl::InternalError(absl::StrCat("Inbetween stream sent ", result.frames.size(),
                                             " frames, header announced ", result.header.frames()));

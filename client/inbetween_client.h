@@ -44,6 +44,8 @@ std::shared_ptr<grpc::Channel> CreateChannelForServer(
 
 // The frames of one Inbetween stream, as received.
 struct FramesResult {
+  // The header, with the layers of every InbetweenResponse.art message appended to its KeyArt
+  // (art_messages says how many there were).
   v1::InbetweenHeader header;
   std::vector<v1::InbetweenFrame> frames;
 };

@@ -172,35 +172,50 @@ v1::Session Compact(const v1::Session& session) {
   return out;
 }
 
-// InbetweenHeader.art: every drawing's art embedded in its shape of the multimesh the frames are
-// solved on. Computed per request rather than stored with the multimesh: it takes a fraction of
-// a second and would otherwise have to follow the multimesh through every store and archive.
-// Nothing when no drawing has art. It never fails the stream: on an error the header goes
-// without art and a warning is logged.
-void AddKeyArt(const SessionState& state, v1::InbetweenHeader* header) {
-  if (std::none_of(state.parsed.begin(), state.parsed.end(),
-                   [](const solver::Drawing& d) { return !d.art.empty(); })) {
-    return;
-  }
-  const solver::Multimesh& mesh = *state.multimesh;
-  if (state.parsed.size() != mesh.shapes.size()) {
-    spdlog::warn("session={} rpc=Inbetween: {} drawings but {} shapes in the multimesh; no art",
-                 state.session.id(), state.parsed.size(), mesh.shapes.size());
-    return;
-  }
-  std::vector<solver::EmbeddedArt> embedded;
-  embedded.reserve(state.parsed.size());
-  for (size_t k = 0; k < state.parsed.size(); ++k) {
-    absl::StatusOr<solver::EmbeddedArt> art =
-        solver::EmbedArt(mesh, static_cast<int>(k), state.parsed[k].art);
-    if (!art.ok()) {
-      spdlog::warn("session={} rpc=Inbetween: drawing {} art not embedded ({}); no art",
-                   state.session.id(), k, std::string(art.status().message()));
-      return;
+// The header's art and the InbetweenResponse.art messages that carry what does not fit in it
+// (InbetweenHeader.art_messages): every message stays under kArtMessageBytes, so a client with
+// gRPC's default 4 MiB receive limit reads a stream whose art is far larger. The art is the
+// stored multimesh's (embedded by BuildMultimesh and again after OptimizeComesh).
+constexpr size_t kArtMessageBytes = 1 << 20;
+
+std::vector<v1::InbetweenResponse> AddKeyArt(const solver::Multimesh& mesh,
+                                             v1::InbetweenHeader* header) {
+  std::vector<v1::InbetweenResponse> more;
+  if (mesh.art.empty()) return more;
+  // A field's bytes in its message: the payload plus a tag and a length of at most 6 bytes.
+  auto field_bytes = [](const google::protobuf::Message& m) { return m.ByteSizeLong() + 6; };
+  size_t header_bytes = header->ByteSizeLong();
+  bool header_full = false;
+  v1::KeyArt* chunk = nullptr;  // the art message being filled
+  size_t chunk_bytes = 0;
+  for (const solver::EmbeddedArt& art : mesh.art) {
+    v1::KeyArt* in_header = header->add_art();
+    in_header->set_key(static_cast<uint32_t>(art.key));
+    header_bytes += 16;
+    chunk = nullptr;  // each key starts its own art message
+    for (const solver::EmbeddedLayer& layer : art.layers) {
+      solver::EmbeddedArt one{.key = art.key, .num_vertices = art.num_vertices, .layers = {layer}};
+      v1::KeyArt packed;
+      ToProto(one, &packed);
+      v1::EmbeddedArtLayer& proto_layer = *packed.mutable_layers(0);
+      const size_t bytes = field_bytes(proto_layer);
+      if (!header_full && header_bytes + bytes <= kArtMessageBytes) {
+        *in_header->add_layers() = std::move(proto_layer);
+        header_bytes += bytes;
+        continue;
+      }
+      header_full = true;  // later layers of every key follow in order, in art messages
+      if (chunk == nullptr || (chunk_bytes + bytes > kArtMessageBytes && chunk->layers_size() > 0)) {
+        chunk = more.emplace_back().mutable_art();
+        chunk->set_key(static_cast<uint32_t>(art.key));
+        chunk_bytes = 16;
+      }
+      *chunk->add_layers() = std::move(proto_layer);
+      chunk_bytes += bytes;
     }
-    embedded.push_back(*std::move(art));
   }
-  for (const solver::EmbeddedArt& art : embedded) ToProto(art, header->add_art());
+  header->set_art_messages(static_cast<uint32_t>(more.size()));
+  return more;
 }
 
 // Any change to drawings or correspondences drops the multimesh built from them.
@@ -297,6 +312,7 @@ void KeepBuildFacts(const v1::MultimeshStats& build, v1::MultimeshStats* stats) 
   stats->set_build_seconds(build.build_seconds());
   stats->set_corner_matched_loops(build.corner_matched_loops());
   stats->set_overlays(build.overlays());
+  stats->set_achieved_tolerance(build.achieved_tolerance());
 }
 
 // The status to return once the token tripped: the deadline's, or the client's cancellation.
@@ -661,6 +677,14 @@ grpc::Status InbetweenService::ImportSession(grpc::ServerContext* context,
                                                        " shapes for ", session.drawings_size(),
                                                        " drawings"));
       }
+      // The art is embedded again from the drawings, which are what it shows (an archive
+      // written before the multimesh carried art has none).
+      absl::StatusOr<std::vector<solver::EmbeddedArt>> art =
+          solver::EmbedDrawingsArt(*mesh, state.parsed);
+      if (!art.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("data: art: ", art.status().message()));
+      }
+      mesh->art = *std::move(art);
       if (auto s = solver::ValidateMultimesh(*mesh); !s.ok()) {
         return absl::InvalidArgumentError(absl::StrCat("data: multimesh: ", s.message()));
       }
@@ -916,6 +940,8 @@ grpc::Status InbetweenService::BuildMultimesh(
         stats.set_build_seconds(report.seconds > 0 ? report.seconds : seconds);
         stats.set_corner_matched_loops(static_cast<uint32_t>(report.corner_matched_loops));
         stats.set_overlays(static_cast<uint32_t>(report.overlays));
+        for (const int n : report.loop_vertices) stats.add_loop_vertices(static_cast<uint32_t>(n));
+        stats.set_achieved_tolerance(report.achieved_tolerance);
 
         v1::BuildMultimeshResponse message;
         v1::BuildMultimeshResult* result = message.mutable_result();
@@ -1037,6 +1063,11 @@ grpc::Status InbetweenService::OptimizeComesh(
           return StoppedStatus(*context, "OptimizeComesh");
         }
         if (!mesh.ok()) return mesh.status();
+        // The optimized mesh has new triangles: the drawings' art is embedded in it again.
+        absl::StatusOr<std::vector<solver::EmbeddedArt>> art =
+            solver::EmbedDrawingsArt(*mesh, state->parsed);
+        if (!art.ok()) return art.status();
+        mesh->art = *std::move(art);
         if (absl::Status s = solver::ValidateMultimesh(*mesh); !s.ok()) {
           return absl::InternalError(
               absl::StrCat("the comesh optimizer returned an invalid mesh: ", s.message()));
@@ -1165,8 +1196,11 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
         for (int key : schedule->keys) header->add_keys(key);
         header->set_frames(plan->frames);
         header->set_session_version(session.version());
-        AddKeyArt(*state, header);
+        const std::vector<v1::InbetweenResponse> art_messages = AddKeyArt(mesh, header);
         if (!writer->Write(message)) return StoppedStatus(*context, "Inbetween");
+        for (const v1::InbetweenResponse& art : art_messages) {
+          if (!writer->Write(art)) return StoppedStatus(*context, "Inbetween");
+        }
 
         // Frames before start_frame are solved but not sent: each frame warm-starts from the
         // previous one, so a resumed stream must replay them to stay identical.

@@ -39,6 +39,8 @@ inbetween::v1::Multimesh ToProto(const solver::Multimesh& mesh) {
     pair->set_d(e[3]);
   }
   for (int v : mesh.pinned) out.add_pinned(v);
+  out.mutable_art()->Reserve(static_cast<int>(mesh.art.size()));
+  for (const solver::EmbeddedArt& art : mesh.art) ToProto(art, out.add_art());
   return out;
 }
 
@@ -94,6 +96,13 @@ absl::StatusOr<solver::Multimesh> MultimeshFromProto(const inbetween::v1::Multim
                                                      ") is not above the one before it"));
     }
     out.pinned.push_back(static_cast<int>(mesh.pinned(i)));
+  }
+  out.art.reserve(mesh.art_size());
+  for (int k = 0; k < mesh.art_size(); ++k) {
+    absl::StatusOr<solver::EmbeddedArt> art = EmbeddedArtFromProto(
+        mesh.art(k), out.triangles, num_vertices, absl::StrCat(field, ".art[", k, "]"));
+    if (!art.ok()) return art.status();
+    out.art.push_back(*std::move(art));
   }
   return out;
 }
@@ -180,6 +189,47 @@ void ToProto(const solver::EmbeddedArt& art, inbetween::v1::KeyArt* out) {
       p->set_closed(path.closed);
     }
   }
+}
+
+absl::StatusOr<solver::EmbeddedArt> EmbeddedArtFromProto(
+    const inbetween::v1::KeyArt& art, const std::vector<solver::Triangle>& triangles,
+    int num_vertices, absl::string_view field) {
+  solver::EmbeddedArt out;
+  out.key = static_cast<int>(art.key());
+  out.num_vertices = num_vertices;
+  out.layers.reserve(art.layers_size());
+  for (int l = 0; l < art.layers_size(); ++l) {
+    const inbetween::v1::EmbeddedArtLayer& layer = art.layers(l);
+    solver::EmbeddedLayer& embedded = out.layers.emplace_back();
+    embedded.paint = FromProto(layer.paint());
+    embedded.paint.paths.clear();
+    embedded.paths.reserve(layer.paths_size());
+    for (int p = 0; p < layer.paths_size(); ++p) {
+      const inbetween::v1::EmbeddedArtPath& path = layer.paths(p);
+      const std::string where = absl::StrCat(field, ".layers[", l, "].paths[", p, "]");
+      if (path.barycentric_size() != 3 * path.triangles_size()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(where, " has ", path.barycentric_size(), " barycentric coordinates for ",
+                         path.triangles_size(), " points (3 per point)"));
+      }
+      solver::EmbeddedPath& e = embedded.paths.emplace_back();
+      e.closed = path.closed();
+      e.points.reserve(path.triangles_size());
+      for (int i = 0; i < path.triangles_size(); ++i) {
+        const uint32_t t = path.triangles(i);
+        if (t >= triangles.size()) {
+          return absl::InvalidArgumentError(absl::StrCat(
+              where, ".triangles[", i, "] refers to triangle ", t, " of ", triangles.size()));
+        }
+        solver::EmbeddedPoint& point = e.points.emplace_back();
+        point.triangle = static_cast<int>(t);
+        point.corners = triangles[t];
+        point.barycentric = {path.barycentric(3 * i), path.barycentric(3 * i + 1),
+                             path.barycentric(3 * i + 2)};
+      }
+    }
+  }
+  return out;
 }
 
 solver::ArtLayer FromProto(const inbetween::v1::ArtLayer& layer) {

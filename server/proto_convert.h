@@ -16,7 +16,8 @@ void ToProto(const solver::Points& points,
              google::protobuf::RepeatedPtrField<inbetween::v1::Point>* out);
 inbetween::v1::Multimesh ToProto(const solver::Multimesh& mesh);
 
-// Checks indices and sizes (the caller validates geometry with solver::ValidateMultimesh).
+// Checks indices and sizes, the art's too (the caller validates geometry with
+// solver::ValidateMultimesh).
 // Errors are INVALID_ARGUMENT naming `field`.
 absl::StatusOr<solver::Multimesh> MultimeshFromProto(const inbetween::v1::Multimesh& mesh,
                                                      absl::string_view field);
@@ -41,6 +42,12 @@ std::vector<solver::ArtLayer> FromProto(
 // A key's art embedded in the multimesh (InbetweenHeader.art): paint as in ToProto(ArtLayer)
 // without paths, each path's points packed as triangle indices and barycentric triples.
 void ToProto(const solver::EmbeddedArt& art, inbetween::v1::KeyArt* out);
+// And back, for a mesh of `triangles` and `num_vertices` vertices (the inserted-point flags are
+// not carried: every point reads as drawn). Checks indices and sizes; errors are
+// INVALID_ARGUMENT naming `field`.
+absl::StatusOr<solver::EmbeddedArt> EmbeddedArtFromProto(
+    const inbetween::v1::KeyArt& art, const std::vector<solver::Triangle>& triangles,
+    int num_vertices, absl::string_view field);
 
 // What ImportSvg saw, as the API reports it; `art_layers` is the size of the drawing's art.
 inbetween::v1::ImportReport ToProto(const solver::SvgImportInfo& info, int art_layers);

@@ -162,6 +162,32 @@ absl::StatusOr<EmbeddedArt> EmbedArt(const Multimesh& mesh, int key,
   return out;
 }
 
+absl::StatusOr<std::vector<EmbeddedArt>> EmbedDrawingsArt(const Multimesh& mesh,
+                                                          const std::vector<Drawing>& drawings,
+                                                          const ArtEmbeddingOptions& options) {
+  std::vector<EmbeddedArt> out;
+  if (std::all_of(drawings.begin(), drawings.end(),
+                  [](const Drawing& d) { return d.art.empty(); })) {
+    return out;
+  }
+  if (mesh.num_shapes() < static_cast<int>(drawings.size())) {
+    return absl::InvalidArgumentError(absl::StrCat("art of ", drawings.size(),
+                                                   " drawings for a multimesh of ",
+                                                   mesh.num_shapes(), " shapes"));
+  }
+  out.reserve(drawings.size());
+  for (size_t k = 0; k < drawings.size(); ++k) {
+    absl::StatusOr<EmbeddedArt> art =
+        EmbedArt(mesh, static_cast<int>(k), drawings[k].art, options);
+    if (!art.ok()) {
+      return absl::Status(art.status().code(),
+                          absl::StrCat("drawing ", k + 1, ": ", art.status().message()));
+    }
+    out.push_back(*std::move(art));
+  }
+  return out;
+}
+
 Points PlacePath(const EmbeddedPath& path, const Points& vertices) {
   Points out;
   out.reserve(path.points.size());

@@ -24,6 +24,7 @@
 #include "absl/status/statusor.h"
 #include "solver/core/art.h"
 #include "solver/core/types.h"
+#include "solver/core/embedded_art.h"
 #include "solver/mesh/multimesh.h"
 
 namespace inbetween::solver {
@@ -50,30 +51,6 @@ struct ArtEmbeddingReport {
   double seconds = 0.0;
 };
 
-struct EmbeddedPoint {
-  int triangle = -1;                        // index into Multimesh::triangles
-  Triangle corners = {0, 0, 0};             // that triangle's vertex indices
-  Eigen::Vector3d barycentric = {1, 0, 0};  // sums to 1; negative outside the triangle
-  bool inserted = false;                    // a crossing point inserted on a drawn segment
-};
-
-struct EmbeddedPath {
-  std::vector<EmbeddedPoint> points;  // in path order; crossings between their segment's ends
-  bool closed = false;
-};
-
-struct EmbeddedLayer {
-  // The layer's paint, id and name as drawn; its `paths` are left empty (the geometry is below).
-  ArtLayer paint;
-  std::vector<EmbeddedPath> paths;  // one per ArtLayer path, same order
-};
-
-struct EmbeddedArt {
-  int key = 0;           // the key drawing (shape index) the art was embedded in
-  int num_vertices = 0;  // the multimesh's vertex count: the frames it can be placed in
-  std::vector<EmbeddedLayer> layers;  // in paint order
-};
-
 // Embeds `art` (key `key`'s layers, in that drawing's coordinates) in shape `key` of `mesh`.
 // Errors: INVALID_ARGUMENT for a key out of range, a mesh without triangles, or a non-finite art
 // point (naming the layer and path).
@@ -81,6 +58,13 @@ absl::StatusOr<EmbeddedArt> EmbedArt(const Multimesh& mesh, int key,
                                      const std::vector<ArtLayer>& art,
                                      const ArtEmbeddingOptions& options = {},
                                      ArtEmbeddingReport* report = nullptr);
+
+// Every drawing's art embedded in its own shape: drawings[k].art in shape k, one EmbeddedArt per
+// drawing; empty when no drawing has art (Multimesh::art). Errors: INVALID_ARGUMENT when the
+// mesh has fewer shapes than drawings, or EmbedArt's, naming the drawing ("drawing 2: ...").
+absl::StatusOr<std::vector<EmbeddedArt>> EmbedDrawingsArt(const Multimesh& mesh,
+                                                          const std::vector<Drawing>& drawings,
+                                                          const ArtEmbeddingOptions& options = {});
 
 // Positions of one embedded path's points in a geometry `vertices` of the multimesh:
 // sum_i b_i vertices[corner_i]. Expects vertices.size() == the art's num_vertices.

@@ -1399,6 +1399,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   rep.mesh_energy_before = energies.mesh;
 
   Multimesh current = resume != nullptr ? resume->mesh : mesh;
+  current.art.clear();  // embedded in the input's triangles; the caller re-embeds (multimesh.h)
   InnerStats stats;
   double pass_start_objective = rep.objective_before;
   int first_outer = 0;

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "solver/art/art_embedding.h"
 #include "solver/geometry/boundary_correspondence.h"
 #include "solver/geometry/graph_flow.h"
 #include "solver/mesh/cgal_triangulate.h"
@@ -525,7 +526,11 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
     }
     triangulate_options.max_edge = options.max_edge_relative > 0
                                        ? options.max_edge_relative * (hi - lo).norm()
-                                       : 1.5 * perimeter / num_edges;  // about the spacing
+                                       // about the even sampling's spacing (the refinement
+                                       // to the outline tolerance adds vertices at tips only)
+                                       : 1.5 * perimeter / std::max(1, bc->base_vertices > 0
+                                                                           ? bc->base_vertices
+                                                                           : num_edges);
   }
   absl::StatusOr<DomainTriangulation> triangulation =
       CgalTriangulateDomain(bc->shapes[ref], triangulate_options);
@@ -728,12 +733,24 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
   if (absl::Status valid = ValidateMultimesh(mesh); !valid.ok()) {
     return absl::InternalError(absl::StrCat("built multimesh is invalid: ", valid.message()));
   }
+  // The drawings' art rides the mesh from here on (art_embedding.h).
+  const auto art_start = std::chrono::steady_clock::now();
+  absl::StatusOr<std::vector<EmbeddedArt>> art = EmbedDrawingsArt(mesh, drawings);
+  if (!art.ok()) return art.status();
+  mesh.art = *std::move(art);
   if (report != nullptr) {
+    report->art_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - art_start).count();
     report->vertices = mesh.num_vertices();
     report->triangles = static_cast<int>(mesh.triangles.size());
     report->boundary_loops = static_cast<int>(mesh.boundary_loops.size());
     report->cohesive_edges = static_cast<int>(mesh.cohesive_edges.size());
     report->corner_matched_loops = bc->corner_matched_loops;
+    report->loop_vertices.clear();
+    for (const std::vector<int>& loop : mesh.boundary_loops) {
+      report->loop_vertices.push_back(static_cast<int>(loop.size()));
+    }
+    report->achieved_tolerance = bc->achieved_tolerance;
     report->overlays = overlays;
     report->equivalence.clear();
     for (const BoundaryGraph& g : graphs) report->equivalence.push_back(g.equivalence.ToString());

@@ -73,6 +73,8 @@ struct MultimeshReport {
   // Drawings (components) reached by the overlay of MultimeshOptions::overlay; 0 when every map
   // was found directly.
   int overlays = 0;
+  // Of `seconds`: embedding the drawings' art in the mesh (Multimesh::art).
+  double art_seconds = 0.0;
 };
 
 // Builds one compatible mesh across all drawings (>= 2): S-Alg.1 boundaries of each drawing

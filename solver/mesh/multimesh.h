@@ -3,6 +3,7 @@
 
 #include <vector>
 
+#include "solver/core/embedded_art.h"
 #include "solver/core/types.h"
 
 namespace inbetween::solver {
@@ -23,6 +24,10 @@ struct Multimesh {
   // comesh optimization moves them in no shape and no topology pass removes them. Empty when
   // the drawings had no marks.
   std::vector<int> pinned;
+  // Each drawing's art embedded in its own shape (art_embedding.h), one per drawing in drawing
+  // order, or empty when no drawing has art. BuildMultimesh fills it; OptimizeComesh returns a
+  // mesh without it (its triangles are new): re-embed with EmbedDrawingsArt.
+  std::vector<EmbeddedArt> art;
 
   int num_vertices() const { return shapes.empty() ? 0 : static_cast<int>(shapes[0].size()); }
   int num_shapes() const { return static_cast<int>(shapes.size()); }

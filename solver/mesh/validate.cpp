@@ -115,6 +115,42 @@ absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles
   return BoundaryEdgesDoNotCross(edges, x);
 }
 
+namespace {
+
+// Multimesh::art: none, or one per shape, key k in shape k, every point in a triangle of the
+// mesh with its corners and finite barycentric coordinates.
+absl::Status ValidateArt(const Multimesh& mesh) {
+  if (mesh.art.empty()) return absl::OkStatus();
+  if (static_cast<int>(mesh.art.size()) != mesh.num_shapes()) {
+    return absl::InvalidArgumentError(absl::StrCat("multimesh art: ", mesh.art.size(),
+                                                   " drawings for ", mesh.num_shapes(), " shapes"));
+  }
+  for (size_t k = 0; k < mesh.art.size(); ++k) {
+    const EmbeddedArt& art = mesh.art[k];
+    if (art.key != static_cast<int>(k) || art.num_vertices != mesh.num_vertices()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "multimesh art ", k, ": key ", art.key, " for ", art.num_vertices,
+          " vertices, expected key ", k, " for ", mesh.num_vertices()));
+    }
+    for (size_t l = 0; l < art.layers.size(); ++l) {
+      for (size_t p = 0; p < art.layers[l].paths.size(); ++p) {
+        for (const EmbeddedPoint& e : art.layers[l].paths[p].points) {
+          if (e.triangle < 0 || e.triangle >= static_cast<int>(mesh.triangles.size()) ||
+              e.corners != mesh.triangles[e.triangle] || !e.barycentric.allFinite()) {
+            return absl::InvalidArgumentError(
+                absl::StrCat("multimesh art ", k, " layer ", l, " path ", p, ": a point in triangle ",
+                             e.triangle, " of ", mesh.triangles.size(),
+                             " with other corners or non-finite coordinates"));
+          }
+        }
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::Status ValidateMultimesh(const Multimesh& mesh) {
   if (mesh.shapes.empty()) return absl::InvalidArgumentError("multimesh has no shapes");
   const int n = mesh.num_vertices();
@@ -220,7 +256,7 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
           absl::StrCat("multimesh shape ", s, ": ", crossing.message()));
     }
   }
-  return absl::OkStatus();
+  return ValidateArt(mesh);
 }
 
 absl::Status ValidateBoundaryLoops(const Multimesh& mesh) {

@@ -35,7 +35,8 @@ absl::Status ValidateBoundaryDoesNotCross(const std::vector<Triangle>& triangles
 // Checks shared topology (indices in range, every shape has the same vertex count, each directed
 // edge in one triangle only: no repeated or overlapping triangle), `boundary` vertices on the
 // boundary (and `boundary` the loops' concatenation when loops are given), boundary loops and
-// cohesive edges (below, when present), no inverted or degenerate triangle and no crossing
+// cohesive edges (below, when present), the art (none or one per shape, each point in a
+// triangle with its corners), no inverted or degenerate triangle and no crossing
 // boundary (above) in any shape. Errors name the shape and the triangle.
 absl::Status ValidateMultimesh(const Multimesh& mesh);
 

@@ -49,6 +49,46 @@ TEST(FramesOutputTest, JsonHasTheDocumentedShape) {
   EXPECT_EQ(j["frames"][0]["weights"], nlohmann::json::parse("[1.0, 0.0]"));
 }
 
+// One art layer per key: a closed triangle path at the mesh's corners.
+void AddArt(FramesResult* r) {
+  for (uint32_t key : {0u, 1u}) {
+    v1::KeyArt* art = r->header.add_art();
+    art->set_key(key);
+    v1::EmbeddedArtLayer* layer = art->add_layers();
+    layer->mutable_paint()->set_id(key == 0 ? "a" : "b");
+    layer->mutable_paint()->mutable_fill()->set_rgb(0xff0000);
+    layer->mutable_paint()->mutable_fill()->set_opacity(1);
+    layer->mutable_paint()->set_opacity(1);
+    v1::EmbeddedArtPath* path = layer->add_paths();
+    path->set_closed(true);
+    for (int corner = 0; corner < 3; ++corner) {
+      path->add_triangles(0);
+      for (int c = 0; c < 3; ++c) path->add_barycentric(c == corner ? 1.0 : 0.0);
+    }
+  }
+}
+
+TEST(FramesOutputTest, HeaderArtGoesIntoTheFrameSet) {
+  FramesResult r = TwoFrames();
+  render::FrameSet frames = ToFrameSet(r);
+  ASSERT_TRUE(AddHeaderArt(r.header, &frames).ok());
+  EXPECT_TRUE(frames.art.empty());  // no art in the header: none
+
+  AddArt(&r);
+  ASSERT_TRUE(AddHeaderArt(r.header, &frames).ok());
+  ASSERT_EQ(frames.art.size(), 2u);
+  EXPECT_EQ(frames.art[1].key, 1);
+  EXPECT_EQ(frames.art[1].num_vertices, 3);
+  EXPECT_EQ(frames.art[1].layers[0].paint.id, "b");
+  EXPECT_EQ(frames.art[1].layers[0].paths[0].points[2].corners, (solver::Triangle{0, 1, 2}));
+  EXPECT_EQ(render::FrameSetToJson(frames)["art"].size(), 2u);
+
+  r.header.mutable_art(1)->mutable_layers(0)->mutable_paths(0)->set_triangles(1, 4);
+  const absl::Status bad = AddHeaderArt(r.header, &frames);
+  EXPECT_EQ(bad.message(), "header.art[1].layers[0].paths[0].triangles[1] refers to triangle 4 of 1");
+  EXPECT_TRUE(frames.art.empty());
+}
+
 TEST(FramesOutputTest, WritesOneSvgPerFrameAndTheJson) {
   const auto dir = std::filesystem::temp_directory_path() / "inbetween_frames_output_test";
   std::filesystem::remove_all(dir);

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <deque>
 #include <fstream>
 #include <memory>
@@ -20,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "server/inbetween_server.h"
 
 namespace inbetween::client {
@@ -35,6 +38,7 @@ using ::testing::HasSubstr;
 struct Fault {
   grpc::Status status;
   int after_frames = 0;
+  int after_art = -1;  // >= 0: Inbetween breaks after this many art messages instead
 };
 
 const grpc::Status kUnavailable(grpc::StatusCode::UNAVAILABLE, "Socket closed");
@@ -84,8 +88,13 @@ class FlakyFront final : public v1::Inbetween::Service {
     auto reader = backend_->Inbetween(&upstream, *request);
     v1::InbetweenResponse response;
     int frames = 0;
+    int art = 0;
     while (reader->Read(&response)) {
-      if (response.has_frame() && fault && frames++ == fault->after_frames) {
+      const bool break_here =
+          fault && (fault->after_art >= 0
+                        ? response.has_art() && art++ == fault->after_art
+                        : response.has_frame() && frames++ == fault->after_frames);
+      if (break_here) {
         upstream.TryCancel();
         reader->Finish();
         return fault->status;
@@ -288,6 +297,60 @@ TEST_F(InbetweenClientFailoverTest, BrokenBuildIsSentAgainAndBuildsTheSameMultim
   auto refused = client->BuildMultimesh(fresh("build refused"), nullptr);
   EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_TRUE(retries_.empty());
+}
+
+// A drawing of `n` small filled discs moved by `dx`, each its own layer drawn as a polygon of
+// 120 points: art far larger than one message.
+std::string ManyLayersSvg(int n, double dx) {
+  std::string body;
+  for (int i = 0; i < n; ++i) {
+    const double cx = dx + (i % 50) * 4.0 + 1.75, cy = (i / 50) * 4.0 + 1.75;
+    body += "<polygon points=\"";
+    for (int j = 0; j < 120; ++j) {
+      const double a = 2 * M_PI * j / 120;
+      body += absl::StrFormat("%.3f,%.3f ", cx + 1.7 * std::cos(a), cy + 1.7 * std::sin(a));
+    }
+    body += absl::StrFormat(R"(" fill="#%06x"/>)", (i * 40503u) & 0xffffff);
+  }
+  return absl::StrCat(R"(<svg xmlns="http://www.w3.org/2000/svg" viewBox="-10 -10 230 190">)",
+                      R"(<rect x="-2" y="-2" width="204" height="164" fill="#eeeeee"/>)", body,
+                      "</svg>");
+}
+
+// The art that follows the header in messages of its own is appended to the header's, also when
+// the connection breaks in the middle of it.
+TEST_F(InbetweenClientFailoverTest, ArtMessagesAreAppendedToTheHeaderAcrossABrokenStream) {
+  auto session = direct_->CreateSession("many layers");
+  ASSERT_TRUE(session.ok()) << session.status();
+  for (double dx : {0.0, 5.0}) {
+    v1::PutDrawingRequest request;
+    request.set_session_id(session->id());
+    request.set_expected_version(session->version());
+    request.mutable_drawing()->set_svg(ManyLayersSvg(2000, dx));
+    auto put = direct_->PutDrawing(request);
+    ASSERT_TRUE(put.ok()) << put.status();
+    *session = put->session();
+  }
+  auto built = direct_->BuildMultimesh(*session, nullptr);
+  ASSERT_TRUE(built.ok()) << built.status();
+  ASSERT_EQ(built->multimesh().art_size(), 2);
+  v1::InbetweenParameters parameters;
+  parameters.set_frames(3);
+
+  auto direct = direct_->Inbetween(session->id(), parameters, nullptr);
+  ASSERT_TRUE(direct.ok()) << direct.status();
+  ASSERT_GT(direct->header.art_messages(), 1u);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(direct->header.art(k),
+                                                                   built->multimesh().art(k)))
+        << "key " << k;
+  }
+
+  front_->faults = {{kUnavailable, 0, /*after_art=*/1}};
+  auto resumed = FrontClient()->Inbetween(session->id(), parameters, nullptr);
+  ASSERT_TRUE(resumed.ok()) << resumed.status();
+  EXPECT_EQ(front_->start_frames.size(), 2u);
+  EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(resumed->header, direct->header));
 }
 
 TEST_F(InbetweenClientFailoverTest, ResumedStreamDeliversTheFramesOfAnUninterruptedRun) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <thread>
@@ -842,6 +843,12 @@ TEST_F(InbetweenServiceTest, InbetweenHeaderCarriesEachKeysArtInMeshCoordinates)
       }
     }
   }
+  // The header's art is the stored multimesh's, embedded once by BuildMultimesh.
+  EXPECT_EQ(header.art_messages(), 0u);
+  ASSERT_EQ(mesh.art_size(), 2);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(mesh.art(k).SerializeAsString(), header.art(k).SerializeAsString()) << "key " << k;
+  }
   // The layers' paint: yellow face, black eyes, a black stroke without fill.
   const v1::KeyArt& first = header.art(0);
   EXPECT_EQ(first.layers(0).paint().fill().rgb(), 0xffd020u);
@@ -850,6 +857,143 @@ TEST_F(InbetweenServiceTest, InbetweenHeaderCarriesEachKeysArtInMeshCoordinates)
   EXPECT_FALSE(first.layers(3).paint().has_fill());
   EXPECT_EQ(first.layers(3).paint().stroke().width(), 3.0);
   EXPECT_FALSE(first.layers(3).paths(0).closed());
+}
+
+// Every art point of `mesh`'s art is in one of its triangles, and key k's art placed in shape k
+// is drawing k's art (drawn points in order, crossings on the drawn segments).
+void ExpectArtOfDrawings(const v1::Multimesh& mesh, const v1::Session& full) {
+  const std::vector<solver::Triangle> triangles = ToTriangles(mesh.triangles());
+  ASSERT_EQ(mesh.art_size(), full.drawings_size());
+  for (int k = 0; k < mesh.art_size(); ++k) {
+    const v1::KeyArt& art = mesh.art(k);
+    ASSERT_EQ(art.layers_size(), full.drawings(k).art_size());
+    const solver::Points vertices = ToPoints(mesh.shapes(k).vertices());
+    for (int l = 0; l < art.layers_size(); ++l) {
+      for (int p = 0; p < art.layers(l).paths_size(); ++p) {
+        const v1::EmbeddedArtPath& path = art.layers(l).paths(p);
+        solver::Points placed;
+        for (int i = 0; i < path.triangles_size(); ++i) {
+          ASSERT_LT(path.triangles(i), triangles.size());
+          placed.push_back(PlaceArtPoint(path, i, triangles, vertices));
+        }
+        ExpectDrawnWithInsertions(placed, ToPoints(full.drawings(k).art(l).paths(p).points()),
+                                  path.closed(), 1e-6);
+      }
+    }
+  }
+}
+
+TEST_F(InbetweenServiceTest, OptimizeEmbedsTheArtAgainAndExportsKeepIt) {
+  v1::Session session = CreateSession("faces");
+  for (const std::string& svg : {LayeredFaceSvg(0, 0, 1), LayeredFaceSvg(12, 6, 0.85)}) {
+    v1::PutDrawingResponse put;
+    ASSERT_TRUE(PutSvg(session, "face", svg, &put).ok());
+    session = put.session();
+  }
+  BuildRun build = RunBuild(*stub_, session);
+  ASSERT_TRUE(build.status.ok()) << build.status.error_message();
+  const v1::Session full = GetFull(*stub_, session.id()).session();
+
+  grpc::ClientContext context;
+  v1::OptimizeComeshRequest request;
+  request.set_session_id(session.id());
+  request.set_expected_version(build.result.session().version());
+  request.mutable_comesh()->set_max_outer_iterations(2);
+  auto reader = stub_->OptimizeComesh(&context, request);
+  v1::OptimizeComeshResponse message;
+  v1::OptimizeComeshResult optimized;
+  while (reader->Read(&message)) {
+    if (message.has_result()) optimized = message.result();
+  }
+  grpc::Status status = reader->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  // The optimizer changes the triangles; the art rides the new ones.
+  ASSERT_NE(optimized.multimesh().triangles_size(), 0);
+  ExpectArtOfDrawings(optimized.multimesh(), full);
+  const v1::InbetweenHeader header = HeaderOfThreeFrames(*stub_, session.id());
+  ASSERT_EQ(header.art_size(), 2);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(header.art(k).SerializeAsString(), optimized.multimesh().art(k).SerializeAsString());
+  }
+
+  // Exported with the multimesh; an import embeds it again from the drawings, to the same art,
+  // and an archive without it (written before the multimesh carried art) gets it back.
+  v1::SessionArchive archive = Export(*stub_, session.id());
+  ASSERT_EQ(archive.multimesh().art_size(), 2);
+  archive.mutable_multimesh()->clear_art();
+  v1::ImportSessionResponse imported;
+  ASSERT_TRUE(Import(*stub_, archive, &imported).ok());
+  const v1::GetSessionResponse copy = GetFull(*stub_, imported.session().id());
+  ASSERT_EQ(copy.multimesh().art_size(), 2);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(copy.multimesh().art(k).SerializeAsString(),
+              optimized.multimesh().art(k).SerializeAsString());
+  }
+}
+
+// A drawing of `n` small filled discs moved by `dx`, each its own layer drawn as a polygon of
+// 120 points: art of about 3 MiB per key in mesh coordinates.
+std::string ManyLayersSvg(int n, double dx) {
+  std::string body;
+  for (int i = 0; i < n; ++i) {
+    const double cx = dx + (i % 50) * 4.0 + 1.75, cy = (i / 50) * 4.0 + 1.75;
+    body += "<polygon points=\"";
+    for (int j = 0; j < 120; ++j) {
+      const double a = 2 * M_PI * j / 120;
+      absl::StrAppendFormat(&body, "%.3f,%.3f ", cx + 1.7 * std::cos(a), cy + 1.7 * std::sin(a));
+    }
+    absl::StrAppendFormat(&body, R"(" fill="#%06x"/>)", (i * 2654435761u) & 0xffffff);
+  }
+  return absl::StrCat(R"(<svg xmlns="http://www.w3.org/2000/svg" viewBox="-10 -10 230 190">)",
+                      R"(<rect x="-2" y="-2" width="204" height="164" fill="#eeeeee"/>)", body,
+                      "</svg>");
+}
+
+TEST_F(InbetweenServiceTest, LargeArtFollowsTheHeaderInMessagesUnderOneMebibyte) {
+  v1::Session session = CreateSession("many layers");
+  for (double dx : {0.0, 6.0}) {
+    v1::PutDrawingResponse put;
+    grpc::Status status = PutSvg(session, "grid", ManyLayersSvg(2000, dx), &put);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    session = put.session();
+  }
+  BuildRun build = RunBuild(*stub_, session);
+  ASSERT_TRUE(build.status.ok()) << build.status.error_message();
+  const v1::Multimesh& mesh = build.result.multimesh();
+  ASSERT_EQ(mesh.art_size(), 2);
+  ASSERT_EQ(mesh.art(0).layers_size(), 2001);
+  ASSERT_GT(mesh.art(0).ByteSizeLong() + mesh.art(1).ByteSizeLong(), size_t{4} << 20)
+      << "the art must be larger than gRPC's default receive limit for this test to mean much";
+
+  v1::InbetweenRequest request;
+  request.set_session_id(session.id());
+  request.mutable_parameters()->set_frames(3);
+  InbetweenRun run = RunInbetween(*stub_, request);
+  ASSERT_TRUE(run.status.ok()) << run.status.error_message();
+  ASSERT_FALSE(run.messages.empty());
+  ASSERT_TRUE(run.messages[0].has_header());
+  v1::InbetweenHeader header = run.messages[0].header();
+  const uint32_t chunks = header.art_messages();
+  ASSERT_GT(chunks, 0u);
+  ASSERT_GT(run.messages.size(), chunks + 3);
+  for (const v1::InbetweenResponse& m : run.messages) {
+    EXPECT_LE(m.ByteSizeLong(), size_t{1} << 20);
+  }
+  // The art messages come right after the header; appended, they give the stored art.
+  for (uint32_t i = 1; i <= chunks; ++i) {
+    ASSERT_TRUE(run.messages[i].has_art()) << "message " << i;
+    const v1::KeyArt& more = run.messages[i].art();
+    ASSERT_LT(more.key(), 2u);
+    EXPECT_GT(more.layers_size(), 0);
+    for (const v1::EmbeddedArtLayer& layer : more.layers()) {
+      *header.mutable_art(static_cast<int>(more.key()))->add_layers() = layer;
+    }
+  }
+  EXPECT_TRUE(run.messages[chunks + 1].has_frame());
+  ASSERT_EQ(header.art_size(), 2);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(header.art(k).SerializeAsString(), mesh.art(k).SerializeAsString()) << "key " << k;
+  }
 }
 
 TEST_F(InbetweenServiceTest, InbetweenHeaderHasNoArtForPolylineDrawings) {

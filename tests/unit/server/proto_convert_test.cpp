@@ -34,6 +34,50 @@ TEST(ProtoConvertTest, ArtRoundTripsFieldForField) {
   ExpectSameArt(FromProto(parsed), art);
 }
 
+TEST(ProtoConvertTest, EmbeddedArtRoundTripsAndIndicesAreChecked) {
+  const std::vector<solver::Triangle> triangles = {{0, 1, 2}, {0, 2, 3}};
+  solver::EmbeddedArt art;
+  art.key = 1;
+  art.num_vertices = 4;
+  art.layers.push_back({.paint = SampleArt()[0], .paths = {}});
+  art.layers[0].paint.paths.clear();
+  solver::EmbeddedPath& path = art.layers[0].paths.emplace_back();
+  path.closed = true;
+  for (int t : {0, 1, 1}) {
+    solver::EmbeddedPoint& e = path.points.emplace_back();
+    e.triangle = t;
+    e.corners = triangles[t];
+    e.barycentric = {0.25 + t, 0.5, 0.25 - t};
+  }
+  v1::KeyArt proto;
+  ToProto(art, &proto);
+  absl::StatusOr<solver::EmbeddedArt> back = EmbeddedArtFromProto(proto, triangles, 4, "art[1]");
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->key, 1);
+  EXPECT_EQ(back->num_vertices, 4);
+  ASSERT_EQ(back->layers.size(), 1u);
+  EXPECT_EQ(back->layers[0].paint.id, "body");
+  EXPECT_TRUE(back->layers[0].paint.paths.empty());
+  ASSERT_EQ(back->layers[0].paths.size(), 1u);
+  EXPECT_TRUE(back->layers[0].paths[0].closed);
+  ASSERT_EQ(back->layers[0].paths[0].points.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    const solver::EmbeddedPoint& got = back->layers[0].paths[0].points[i];
+    EXPECT_EQ(got.triangle, path.points[i].triangle);
+    EXPECT_EQ(got.corners, path.points[i].corners);
+    EXPECT_EQ(got.barycentric, path.points[i].barycentric);
+  }
+
+  v1::KeyArt bad = proto;
+  bad.mutable_layers(0)->mutable_paths(0)->set_triangles(2, 2);
+  EXPECT_EQ(EmbeddedArtFromProto(bad, triangles, 4, "art[1]").status().message(),
+            "art[1].layers[0].paths[0].triangles[2] refers to triangle 2 of 2");
+  bad = proto;
+  bad.mutable_layers(0)->mutable_paths(0)->add_barycentric(0.5);
+  EXPECT_EQ(EmbeddedArtFromProto(bad, triangles, 4, "art[1]").status().message(),
+            "art[1].layers[0].paths[0] has 10 barycentric coordinates for 3 points (3 per point)");
+}
+
 TEST(ProtoConvertTest, UnspecifiedCapAndJoinAreButtAndMiter) {
   v1::ArtLayer layer;
   layer.mutable_stroke()->set_width(2);

@@ -2,6 +2,7 @@
 // outside points on the nearest triangle, long segments split where they cross edges.
 #include "solver/art/art_embedding.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 
 #include "solver/art/triangle_grid.h"
 #include "solver/mesh/build_multimesh.h"
+#include "solver/mesh/validate.h"
 #include "tests/unit/solver/art/art_test_helpers.h"
 
 namespace inbetween::solver {
@@ -19,6 +21,7 @@ using art_test::DistanceToSegment;
 using art_test::FillLayer;
 using art_test::JitteredGrid;
 using art_test::StrokeLayer;
+using ::testing::HasSubstr;
 
 // A face on a 8 x 6 grid: a filled head, eyes, a long stroke across it, a dot outside.
 std::vector<ArtLayer> Face() {
@@ -250,6 +253,53 @@ TEST(ArtEmbeddingTest, BuiltMultimeshKeysReproduceTheirArt) {
       }
     }
   }
+}
+
+// BuildMultimesh embeds every drawing's art in its own shape (Multimesh::art), and
+// ValidateMultimesh refuses art that does not fit the mesh.
+TEST(ArtEmbeddingTest, BuildMultimeshEmbedsTheDrawingsArt) {
+  auto sheared = [](const Point& p) { return Point(p.x() + 0.4 * p.y(), p.y()); };
+  const Points square = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  Drawing a, b;
+  a.outlines.push_back({square});
+  a.art = {FillLayer(square, 0xff0000), StrokeLayer({{1, 1}, {9, 9}, {9, 2}}, 0, 0.5)};
+  b = a;
+  for (Point& p : b.outlines[0].points) p = sheared(p);
+  for (ArtLayer& layer : b.art) {
+    for (Point& p : layer.paths[0].points) p = sheared(p);
+  }
+  absl::StatusOr<Multimesh> mesh = BuildMultimesh({a, b}, {});
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_EQ(mesh->art.size(), 2u);
+  for (int key : {0, 1}) {
+    const Drawing& drawing = key == 0 ? a : b;
+    EXPECT_EQ(mesh->art[key].key, key);
+    EXPECT_EQ(mesh->art[key].num_vertices, mesh->num_vertices());
+    const std::vector<ArtLayer> placed = *PlaceArt(mesh->art[key], mesh->shapes[key]);
+    ASSERT_EQ(placed.size(), drawing.art.size());
+    for (size_t l = 0; l < placed.size(); ++l) {
+      const Points drawn = Drawn(mesh->art[key].layers[l].paths[0], placed[l].paths[0].points);
+      ASSERT_EQ(drawn.size(), drawing.art[l].paths[0].points.size());
+      for (size_t i = 0; i < drawn.size(); ++i) {
+        EXPECT_LT((drawn[i] - drawing.art[l].paths[0].points[i]).norm(), 1e-8);
+      }
+    }
+  }
+  EXPECT_TRUE(ValidateMultimesh(*mesh).ok());
+
+  Multimesh bad = *mesh;
+  bad.art[1].layers[0].paths[0].points[0].triangle = static_cast<int>(bad.triangles.size());
+  EXPECT_THAT(ValidateMultimesh(bad).message(), HasSubstr("multimesh art 1 layer 0 path 0"));
+  bad = *mesh;
+  bad.art.pop_back();
+  EXPECT_THAT(ValidateMultimesh(bad).message(), HasSubstr("1 drawings for 2 shapes"));
+
+  // Without art, none.
+  a.art.clear();
+  b.art.clear();
+  mesh = BuildMultimesh({a, b}, {});
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_TRUE(mesh->art.empty());
 }
 
 }  // namespace
