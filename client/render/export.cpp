@@ -248,7 +248,8 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
         LottieAnimation(frames, {.width = options.width,
                                  .fps = options.fps,
                                  .fill = options.fill,
-                                 .drawing_fills = options.drawing_fills});
+                                 .drawing_fills = options.drawing_fills,
+                                 .art = options.art});
     if (!doc.ok()) return doc.status();
     lottie = doc->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   }

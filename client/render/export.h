@@ -30,9 +30,8 @@ struct ExportOptions {
   std::string fill = "#3b7dd8";  // shape colour, #rgb / #rrggbb (see ParseColor)
   // The drawings' own fills (FrameSet::fills, blended per frame) instead of `fill` when present.
   bool drawing_fills = true;
-  // The drawings' art (FrameSet::art) on SVG, PNG, GIF, WebP and the contact sheet when the set
-  // has art; false (or no art): the one-colour silhouette (`fill` / the drawings' fills). Lottie
-  // is always the silhouette.
+  // The drawings' art (FrameSet::art) on SVG, PNG, GIF, WebP, Lottie and the contact sheet when
+  // the set has art; false (or no art): the one-colour silhouette (`fill` / the drawings' fills).
   bool art = true;
   bool mesh_overlay = false;  // triangle edges on SVG, PNG, GIF, WebP and contact sheet
   bool transparent = false;   // PNG, GIF (1-bit) and WebP background; else white

@@ -292,7 +292,8 @@ class Morph {
 absl::StatusOr<std::vector<ArtLayer>> ArtForFrame(const std::vector<EmbeddedArt>& keys,
                                                   const Points& frame_vertices,
                                                   const std::vector<double>& weights,
-                                                  const FrameArtOptions& options) {
+                                                  const FrameArtOptions& options,
+                                                  std::vector<ArtLayerSource>* sources) {
   if (weights.size() != keys.size()) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "frame art: %d weights for the art of %d keys", weights.size(), keys.size()));
@@ -322,8 +323,10 @@ absl::StatusOr<std::vector<ArtLayer>> ArtForFrame(const std::vector<EmbeddedArt>
   for (size_t g = 0; g < groups.size(); ++g) {
     for (const Member& m : groups[g]) group_of[m.key][m.layer] = static_cast<int>(g);
   }
-  // slots[g + 1]: cross-faded layers drawn right after group g (slots[0]: before every group).
+  // slots[g + 1]: cross-faded layers drawn right after group g (slots[0]: before every group);
+  // slot_sources: their (key, layer).
   std::vector<std::vector<ArtLayer>> slots(groups.size() + 1);
+  std::vector<std::vector<ArtLayerRef>> slot_sources(groups.size() + 1);
   for (const Member& a : active) {
     int last = -1;
     const std::vector<EmbeddedLayer>& layers = keys[a.key].layers;
@@ -332,6 +335,7 @@ absl::StatusOr<std::vector<ArtLayer>> ArtForFrame(const std::vector<EmbeddedArt>
         last = group_of[a.key][l];
         continue;
       }
+      slot_sources[last + 1].push_back({a.key, static_cast<int>(l)});
       ArtLayer& faded = slots[last + 1].emplace_back(layers[l].paint);
       faded.opacity *= a.weight;
       for (const EmbeddedPath& path : layers[l].paths) {
@@ -344,6 +348,18 @@ absl::StatusOr<std::vector<ArtLayer>> ArtForFrame(const std::vector<EmbeddedArt>
   for (size_t g = 0; g < groups.size(); ++g) {
     out.push_back(morph.Layer(groups[g]));
     for (ArtLayer& layer : slots[g + 1]) out.push_back(std::move(layer));
+  }
+  if (sources != nullptr) {
+    sources->clear();
+    const auto faded = [&](size_t slot) {
+      for (const ArtLayerRef& ref : slot_sources[slot]) sources->push_back({{ref}});
+    };
+    faded(0);
+    for (size_t g = 0; g < groups.size(); ++g) {
+      ArtLayerSource& morphed = sources->emplace_back();
+      for (const Member& m : groups[g]) morphed.members.push_back({m.key, m.layer});
+      faded(g + 1);
+    }
   }
   return out;
 }

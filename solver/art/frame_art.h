@@ -57,13 +57,32 @@ struct FrameArtOptions {
   double merge_fraction = 1e-9;
 };
 
+// One layer of one key drawing: keys[key].layers[layer] of ArtForFrame's `keys` (`key` indexes
+// that vector, like `weights`; it is not EmbeddedArt::key).
+struct ArtLayerRef {
+  int key = 0;
+  int layer = 0;
+  friend bool operator==(const ArtLayerRef&, const ArtLayerRef&) = default;
+};
+
+// Where one layer of a frame's art comes from: the key layers it is made of, in key order. One
+// member for a cross-faded layer, one per active key for a morphed group, so a key frame's layers
+// (one active key) each have one member. A renderer that animates layers over frames (Lottie)
+// follows a layer through the frames by its members.
+struct ArtLayerSource {
+  std::vector<ArtLayerRef> members;
+  friend bool operator==(const ArtLayerSource&, const ArtLayerSource&) = default;
+};
+
 // The frame's layers in paint order. `keys[k]` is key k's embedded art (any order of
 // EmbeddedArt::key; weights[k] goes with keys[k]). Errors (INVALID_ARGUMENT): weights and keys
 // of different sizes, a non-finite weight, no weight > 0, art embedded in a mesh whose vertex
-// count is not frame_vertices.size().
+// count is not frame_vertices.size(). `sources`, when given, receives one ArtLayerSource per
+// returned layer (same order); it does not change the layers.
 absl::StatusOr<std::vector<ArtLayer>> ArtForFrame(const std::vector<EmbeddedArt>& keys,
                                                   const Points& frame_vertices,
                                                   const std::vector<double>& weights,
-                                                  const FrameArtOptions& options = {});
+                                                  const FrameArtOptions& options = {},
+                                                  std::vector<ArtLayerSource>* sources = nullptr);
 
 }  // namespace inbetween::solver

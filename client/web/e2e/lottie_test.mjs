@@ -1,14 +1,25 @@
 // Plays the CLI's Lottie output (`inbetween animate --format lottie`) in lottie-web, in Debian's
 // headless Chromium via playwright-core (run by tests/e2e/lottie_web_test.sh):
 //   node e2e/lottie_test.mjs --frames N [--chromium /usr/bin/chromium] A.lottie.json [B ...]
+//     [--layered L.lottie.json --expect '{"K": {"paths": n, "faded": n, "fill": ["#rrggbb", ...],
+//                                                "stroke": [...]}, ...}' [--reference DIR]]
 // A tiny page on a node http server on 127.0.0.1:0 loads lottie-web (svg renderer) from
 // node_modules and each animation by URL (no CDN: every other request is aborted). Per file:
 // lottie-web loads it with no page error and no `data_failed`/`error` event, `totalFrames` is N,
-// after `goToAndStop(k, true)` for the first, middle and last frame the rendered <path> `d`
-// is non-empty, starts at the frame's first keyframe vertex, differs between those frames, and
-// the rendered shape's bounding box is inside the animation's w×h. Then the same checks run on
-// corrupted copies of the first file (path keyframes removed, `op` changed, vertices moved out
-// of the canvas, truncated JSON) and each must be caught. Prints "N passed, N failed".
+// after `goToAndStop(k, true)` for the first, middle and last frame the visible <path>s (not
+// display:none, opacity > 0) have a non-empty `d`, the first starts at the first vertex of the
+// bottom layer shown at that frame, they differ between those frames, and their bounding box is
+// inside the animation's w×h. The layered file (art: a Lottie layer per art layer) also gets
+// these checks, then per frame K of --expect: `paths` visible <path>s (lottie-web draws a layer's
+// fill and stroke as two), `faded` of them under a layer opacity strictly between 0 and 1 (a
+// cross-fade), the visible fills' and strokes' colours the given sets (±1 per channel), and each
+// stroke drawn after the fill of the same path; with --reference, the page's pixels at frame K
+// match DIR/frame_000K.png, the CLI's PNG frame of the same export (white background, same
+// width): at most 1 % of the pixels differ by more than 64 in a channel and the mean difference
+// is at most 2 (of 255). Then the same checks run on corrupted copies of
+// the first file (path keyframes removed, `op` changed, vertices moved out of the canvas,
+// truncated JSON) and of the layered one (every layer spanning every frame; with --reference,
+// the layers in reverse paint order) and each must be caught. Prints "N passed, N failed".
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import { createServer } from "node:http";
@@ -22,12 +33,17 @@ const { values: args, positionals: files } = parseArgs({
   options: {
     frames: { type: "string" },
     chromium: { type: "string", default: "/usr/bin/chromium" },
+    layered: { type: "string" },
+    expect: { type: "string" },
+    reference: { type: "string" },
   },
   allowPositionals: true,
 });
 const frames = Number(args.frames);
 if (!Number.isInteger(frames) || frames < 3) throw new Error("--frames N (N >= 3) is required");
 if (files.length === 0) throw new Error("no animation files given");
+if (!args.layered !== !args.expect) throw new Error("--layered and --expect go together");
+const expected = args.expect ? JSON.parse(args.expect) : null;
 
 const STEP_MS = 30_000; // bound on any one wait
 const watchdog = setTimeout(() => {
@@ -73,15 +89,60 @@ window.loadAnim = (name, w, h) => new Promise((resolve, reject) => {
     resolve({ totalFrames: anim.totalFrames });
   });
 });
-// Shows frame k and returns every rendered path's d and the union of their boxes, in the
-// animation's pixels (the svg's client box is mapped onto its viewBox).
+// How far two same-sized images (/img/A, /img/B) differ: the fraction of pixels with a channel
+// more than 64 apart and the mean channel difference (0..255).
+window.compareImages = async (a, b) => {
+  const pixels = async (name) => {
+    const img = new Image();
+    img.src = "/img/" + name;
+    await img.decode();
+    const c = document.createElement("canvas");
+    [c.width, c.height] = [img.naturalWidth, img.naturalHeight];
+    const ctx = c.getContext("2d");
+    ctx.drawImage(img, 0, 0);
+    return ctx.getImageData(0, 0, c.width, c.height);
+  };
+  const [p, q] = [await pixels(a), await pixels(b)];
+  if (p.width !== q.width || p.height !== q.height) return { size: [p.width, p.height, q.width, q.height] };
+  let far = 0, sum = 0;
+  for (let i = 0; i < p.data.length; i += 4) {
+    let most = 0;
+    for (let c = 0; c < 3; c++) {
+      const d = Math.abs(p.data[i + c] - q.data[i + c]);
+      sum += d;
+      most = Math.max(most, d);
+    }
+    if (most > 64) far++;
+  }
+  const n = p.width * p.height;
+  return { far: far / n, mean: sum / (3 * n) };
+};
+// Shows frame k and returns every visible path (in document order: bottom first) with its d,
+// paint (a stroke when it has a stroke colour, else a fill), colour and the opacity of the layers
+// above it, and the union of their boxes, in the animation's pixels (the svg's client box is
+// mapped onto its viewBox). Visible: no ancestor display:none, opacity and paint opacity > 0.
 window.frameInfo = (k) => {
   window.anim.goToAndStop(k, true);
   const svg = document.querySelector("#c svg");
   const vb = svg.viewBox.baseVal;
   const r = svg.getBoundingClientRect();
   const sx = vb.width / r.width, sy = vb.height / r.height;
-  const paths = [...svg.querySelectorAll("path")].filter((p) => !p.closest("defs, clipPath, mask"));
+  const shown = [];
+  for (const p of svg.querySelectorAll("path")) {
+    if (p.closest("defs, clipPath, mask")) continue;
+    let opacity = 1, hidden = false;
+    for (let e = p; e && e !== svg; e = e.parentElement) {
+      const cs = getComputedStyle(e);
+      if (cs.display === "none" || cs.visibility === "hidden") hidden = true;
+      opacity *= Number(cs.opacity);
+    }
+    const stroke = p.getAttribute("stroke");
+    const kind = stroke && stroke !== "none" ? "stroke" : "fill";
+    const paint = Number(getComputedStyle(p)[kind === "stroke" ? "strokeOpacity" : "fillOpacity"]);
+    if (hidden || !(opacity > 0) || !(paint > 0)) continue;
+    shown.push({ p, kind, color: p.getAttribute(kind), opacity });
+  }
+  const paths = shown.map((s) => s.p);
   let box = null;
   for (const p of paths) {
     const b = p.getBoundingClientRect();
@@ -92,12 +153,13 @@ window.frameInfo = (k) => {
                   x1: Math.max(box.x1, q.x1), y1: Math.max(box.y1, q.y1) } : q;
   }
   return { currentFrame: window.anim.currentFrame, d: paths.map((p) => p.getAttribute("d") || ""),
-           fill: paths.map((p) => p.getAttribute("fill")), box,
-           viewBox: [vb.x, vb.y, vb.width, vb.height] };
+           kind: shown.map((s) => s.kind), color: shown.map((s) => s.color),
+           opacity: shown.map((s) => s.opacity), box, viewBox: [vb.x, vb.y, vb.width, vb.height] };
 };
 </script></body></html>`;
 
-// Served animations by name (bytes); the page fetches /anim/NAME.
+// Served animations by name (bytes); the page fetches /anim/NAME (and images to compare as
+// /img/NAME).
 const served = new Map();
 const server = createServer((req, res) => {
   const path = new URL(req.url, "http://x").pathname;
@@ -106,6 +168,7 @@ const server = createServer((req, res) => {
   if (path === "/") [body, type] = [PAGE, "text/html; charset=utf-8"];
   else if (path === "/lottie.js") [body, type] = [lottieJs, "text/javascript"];
   else if (path.startsWith("/anim/")) body = served.get(decodeURIComponent(path.slice(6))) ?? null;
+  else if (path.startsWith("/img/")) [body, type] = [served.get(decodeURIComponent(path.slice(5))) ?? null, "image/png"];
   if (body === null) {
     res.writeHead(404).end();
     return;
@@ -118,10 +181,13 @@ const base = `http://127.0.0.1:${server.address().port}`;
 // Every step runs: one broken file does not hide the others.
 const { step, counts } = stepRunner({ stopOnFailure: false });
 
-// The first vertex of the first path at frame k as the file gives it: keyframes sit on whole
-// frames, so frame k shows the last keyframe with t <= k.
+// The first vertex of the first path of the bottom layer shown at frame k (ip <= k < op; Lottie
+// draws the last layer at the bottom) as the file gives it: keyframes sit on whole frames, so
+// frame k shows the last keyframe with t <= k.
 function firstVertex(doc, k) {
-  const group = doc.layers[0].shapes.find((s) => s.ty === "gr");
+  const layer = doc.layers.findLast((l) => l.ip <= k && k < l.op);
+  if (!layer) return null;
+  const group = layer.shapes.find((s) => s.ty === "gr");
   const sh = group.it.find((s) => s.ty === "sh");
   const key = sh.ks.a ? sh.ks.k.findLast((kf) => kf.t <= k) : { s: [sh.ks.k] };
   return key ? key.s[0].v[0] : null;
@@ -172,6 +238,69 @@ async function checkAnimation(name, bytes) {
   return infos;
 }
 
+// "#rrggbb" or lottie-web's "rgb(r,g,b)" as [r, g, b].
+function rgb(color) {
+  const hex = /^#([0-9a-f]{2})([0-9a-f]{2})([0-9a-f]{2})$/i.exec(color ?? "");
+  if (hex) return hex.slice(1).map((h) => parseInt(h, 16));
+  const css = /^rgb\((\d+),\s*(\d+),\s*(\d+)\)$/.exec(color ?? "");
+  return css ? css.slice(1).map(Number) : null;
+}
+
+// The layered checks at frame k of --expect (see the header), on frameInfo's answer.
+function checkLayers(info, k, want) {
+  assert.equal(info.d.length, want.paths, `frame ${k}: ${info.d.length} visible paths, expected ${want.paths}`);
+  const faded = info.opacity.filter((o) => o > 0.001 && o < 0.999).length;
+  assert.equal(faded, want.faded, `frame ${k}: ${faded} paths under a cross-fading layer, expected ${want.faded}`);
+  for (const kind of ["fill", "stroke"]) {
+    const got = info.color.filter((_, i) => info.kind[i] === kind).map(rgb);
+    assert.ok(got.every((c) => c), `frame ${k}: a ${kind} colour lottie-web wrote is not rgb(): ${info.color}`);
+    const same = (a, b) => a.every((x, i) => Math.abs(x - b[i]) <= 1);
+    const wanted = want[kind].map(rgb);
+    const missing = wanted.filter((w) => !got.some((c) => same(c, w)));
+    const extra = got.filter((c) => !wanted.some((w) => same(c, w)));
+    assert.ok(missing.length === 0 && extra.length === 0,
+      `frame ${k}: ${kind} colours [${got.map((c) => c.join(","))}], expected ${want[kind]}`);
+  }
+  // A layer's stroke is listed before its fill in the file, so it lies over it on the page.
+  info.d.forEach((d, i) => {
+    if (info.kind[i] !== "stroke") return;
+    const fill = info.d.findIndex((e, j) => e === d && info.kind[j] === "fill");
+    assert.ok(fill < i, `frame ${k}: a stroke is drawn under its own fill`);
+  });
+}
+
+// The page showing frame k against the CLI's PNG of that frame (see the header).
+// Every image gets a new name: a page reuses an image it loaded by URL whatever the cache headers.
+let shots = 0;
+async function checkPixels(k, w, h) {
+  const reference = `frame_${String(k).padStart(4, "0")}.png`;
+  const [ref, shot] = [`ref_${++shots}.png`, `shot_${shots}.png`];
+  served.set(ref, readFileSync(join(args.reference, reference)));
+  served.set(shot, await page.screenshot({ clip: { x: 0, y: 0, width: w, height: h } }));
+  const d = await page.evaluate(([a, b]) => window.compareImages(a, b), [shot, ref]);
+  assert.ok(!d.size, `frame ${k}: the page is ${d.size?.slice(0, 2)}, ${reference} ${d.size?.slice(2)}`);
+  assert.ok(d.far <= 0.01 && d.mean <= 2,
+    `frame ${k}: ${(100 * d.far).toFixed(2)} % of the pixels differ from ${reference} (mean ${d.mean.toFixed(2)})`);
+  return d;
+}
+
+async function checkLayered(name, bytes) {
+  await checkAnimation(name, bytes);
+  const { w, h } = JSON.parse(bytes.toString());
+  const summary = [];
+  for (const [k, want] of Object.entries(expected)) {
+    const info = await page.evaluate((kk) => window.frameInfo(kk), Number(k));
+    checkLayers(info, Number(k), want);
+    let line = `${k}: ${info.d.length} paths (${info.opacity.filter((o) => o < 0.999).length} fading)`;
+    if (args.reference) {
+      const d = await checkPixels(Number(k), w, h);
+      line += `, ${(100 * d.far).toFixed(2)} % off the PNG (mean ${d.mean.toFixed(2)})`;
+    }
+    summary.push(line);
+  }
+  return summary;
+}
+
 const browser = await launchChromium(args.chromium, STEP_MS);
 const offsite = [];
 try {
@@ -198,6 +327,12 @@ try {
       console.log(`     frame ${infos.map((f) => `${f.k}: box [${[f.box.x0, f.box.y0, f.box.x1, f.box.y1].map((x) => x.toFixed(1))}]`).join(", ")}`);
     });
   }
+  if (args.layered) {
+    await step(`${args.layered}: art layers play in lottie-web (visible paths, cross-fades, colours per frame)`, async () => {
+      const summary = await checkLayered(`layered_${basename(args.layered)}`, readFileSync(args.layered));
+      console.log(`     frame ${summary.join(", ")}`);
+    });
+  }
 
   // Corrupted copies of the first file: each must be caught by the checks above.
   const good = readFileSync(files[0]);
@@ -206,7 +341,7 @@ try {
     fn(doc);
     return Buffer.from(JSON.stringify(doc));
   };
-  const paths = (doc) => doc.layers[0].shapes.find((s) => s.ty === "gr").it.filter((s) => s.ty === "sh");
+  const paths = (doc) => doc.layers.flatMap((l) => l.shapes.find((s) => s.ty === "gr").it.filter((s) => s.ty === "sh"));
   const corrupt = [
     ["path keyframes removed (only frame 0 kept)", /render the same path/,
       mutate((doc) => { for (const sh of paths(doc)) sh.ks.k = sh.ks.k.slice(0, 1); })],
@@ -216,16 +351,28 @@ try {
     ["truncated JSON", /lottie-web uncaught error while loading/, good.subarray(0, Math.floor(good.length / 2))],
     ["file missing (HTTP 404)", /lottie-web data_failed/, null],
   ];
-  for (const [what, expected, bytes] of corrupt) {
+  if (args.layered) {
+    const layered = JSON.parse(readFileSync(args.layered).toString());
+    for (const layer of layered.layers) [layer.ip, layer.op] = [0, layered.op];
+    corrupt.push(["layered: every layer spanning every frame", /visible paths/,
+      Buffer.from(JSON.stringify(layered)), checkLayered]);
+    if (args.reference) {
+      const upsideDown = JSON.parse(readFileSync(args.layered).toString());
+      upsideDown.layers.reverse();
+      corrupt.push(["layered: paint order upside down", /pixels differ from frame_0000\.png/,
+        Buffer.from(JSON.stringify(upsideDown)), checkLayered]);
+    }
+  }
+  for (const [what, expectedError, bytes, check = checkAnimation] of corrupt) {
     await step(`corrupted (${what}) is caught`, async () => {
       let err = null;
       try {
-        await checkAnimation(`corrupt_${corrupt.findIndex((c) => c[0] === what)}.json`, bytes);
+        await check(`corrupt_${corrupt.findIndex((c) => c[0] === what)}.json`, bytes);
       } catch (e) {
         err = e;
       }
       assert.ok(err, "the corrupted animation passed every check");
-      assert.match(err.message, expected);
+      assert.match(err.message, expectedError);
       console.log(`     caught: ${err.message.split("\n")[0]}`);
     });
   }

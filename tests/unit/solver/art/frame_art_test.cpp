@@ -238,6 +238,46 @@ TEST(FrameArtTest, MorphTendsToEachKeyAsItsWeightTendsToOne) {
   }
 }
 
+// The optional sources name every output layer's key layers in key order and leave the layers
+// as they are: morphed groups list one layer per active key, cross-faded layers their own.
+TEST(FrameArtTest, SourcesNameTheKeyLayersOfEachLayer) {
+  const Multimesh mesh = TwoShapes();
+  ArtLayer body = FillLayer({{1, 1}, {7, 1}, {7, 5}, {1, 5}}, 0xf0c080);
+  body.name = "body";
+  ArtLayer eye = FillLayer({{2, 2}, {3, 2}, {3, 3}}, 0x000000);
+  eye.name = "eye";
+  const ArtLayer mouth = StrokeLayer({{2, 4}, {5, 4}}, 0x800000, 0.3);
+  const std::vector<EmbeddedArt> keys = Embed(mesh, {body, eye}, {body, mouth, eye});
+  const Points x = Mix(mesh.shapes[0], mesh.shapes[1], 0.5);
+  using Refs = std::vector<ArtLayerRef>;
+  std::vector<ArtLayerSource> sources = {{{{9, 9}}}};  // replaced, not appended to
+  absl::StatusOr<std::vector<ArtLayer>> out = ArtForFrame(keys, x, {0.6, 0.4}, {}, &sources);
+  ASSERT_TRUE(out.ok()) << out.status();
+  ExpectSameLayers(*out, Frame(keys, x, {0.6, 0.4}));
+  ASSERT_EQ(sources.size(), 3u);
+  EXPECT_EQ(sources[0].members, (Refs{{0, 0}, {1, 0}}));  // the bodies morph
+  EXPECT_EQ(sources[1].members, (Refs{{1, 1}}));          // key 2's mouth fades in
+  EXPECT_EQ(sources[2].members, (Refs{{0, 1}, {1, 2}}));  // the eyes morph
+  EXPECT_DOUBLE_EQ((*out)[1].opacity, 0.4);
+
+  // A key frame: one member per layer, its own key's, in its paint order.
+  out = ArtForFrame(keys, mesh.shapes[1], {0, 1}, {}, &sources);
+  ASSERT_TRUE(out.ok()) << out.status();
+  ASSERT_EQ(sources.size(), 3u);
+  for (int l = 0; l < 3; ++l) EXPECT_EQ(sources[l].members, (Refs{{1, l}}));
+
+  // Nothing corresponds (names off, no layer of one key fits one of the other): every layer
+  // cross-fades, the lower key's first.
+  FrameArtOptions none;
+  none.match_by_name = none.match_by_order = false;
+  out = ArtForFrame(keys, x, {0.5, 0.5}, none, &sources);
+  ASSERT_TRUE(out.ok()) << out.status();
+  ASSERT_EQ(out->size(), 5u);
+  ASSERT_EQ(sources.size(), 5u);
+  const std::vector<Refs> faded = {{{0, 0}}, {{0, 1}}, {{1, 0}}, {{1, 1}}, {{1, 2}}};
+  for (size_t l = 0; l < 5; ++l) EXPECT_EQ(sources[l].members, faded[l]);
+}
+
 TEST(FrameArtTest, Deterministic) {
   const Multimesh mesh = TwoShapes();
   std::vector<ArtLayer> b = Head({0.2, 0.1}, 0x00ff00, 2.0);
