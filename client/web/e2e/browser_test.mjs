@@ -1,15 +1,19 @@
 // Browser end-to-end test of the page (run by tests/e2e/web_test.sh against the real
 // inbetween-server behind the real gateway), in Debian's headless Chromium via playwright-core:
 //   node e2e/browser_test.mjs --url http://127.0.0.1:PORT/ --out DIR --first A.svg --second B.svg
-//        --bad BAD.svg --cut X1,Y1,X2,Y2
+//        --bad BAD.svg --cut X1,Y1,X2,Y2 --art-first FACE1.svg --art-second FACE2.svg
 // Checks: a server error shows next to its control (bad SVG -> on its card; Inbetween before a
 // multimesh -> next to the button), the drawn cut comes back with rebuilt boundaries, build
-// and optimize fill the energy chart, the player shows different non-blank frames, the mesh
-// overlay changes the picture, the GIF download decodes, the κ/τ/α/ε sliders reach the
+// and optimize fill the energy chart, the player shows different non-blank frames in the
+// drawings' colour (their art), the mesh overlay changes the picture, the GIF download decodes
+// with the art's colour, the κ/τ/α/ε sliders reach the
 // Inbetween request (decoded from what the page sends) and ε > 0 changes the frames, the
 // project file download is docs/project-file.md's format with the cut and the slider values
-// (and, for drawings made with the mouse, comes with their SVGs), and the layout fits a phone.
-// Screenshots go to --out. Prints "N passed, N failed".
+// (and, for drawings made with the mouse, comes with their SVGs), the layout fits a phone, and
+// two layered drawings (--art-first/--art-second: client/web/e2e/data/face_*.svg) play as their
+// art: each key frame in its own paint (eye colours, the nose only key 2 has), the middle frame
+// with the eyes' colours blended and the nose faded in at half opacity, the silhouette toggle
+// back to one colour. Screenshots go to --out. Prints "N passed, N failed".
 import assert from "node:assert/strict";
 import { readFileSync, writeFileSync } from "node:fs";
 import { basename, join } from "node:path";
@@ -30,10 +34,12 @@ const { values: args } = parseArgs({
     second: { type: "string" },
     bad: { type: "string" },
     cut: { type: "string" },
+    "art-first": { type: "string" },
+    "art-second": { type: "string" },
     chromium: { type: "string", default: "/usr/bin/chromium" },
   },
 });
-for (const k of ["url", "out", "first", "second", "bad", "cut"]) {
+for (const k of ["url", "out", "first", "second", "bad", "cut", "art-first", "art-second"]) {
   if (!args[k]) throw new Error(`--${k} is required`);
 }
 const cut = args.cut.split(",").map(Number);
@@ -58,6 +64,22 @@ async function canvasInfo(page) {
     }
     return { inked: inked / (d.length / 4), hash };
   });
+}
+
+// How many player pixels are each of `colours` (0xRRGGBB, each channel within `tol`).
+async function colourCounts(page, colours, tol = 2) {
+  return page.evaluate(([targets, t]) => {
+    const c = document.getElementById("player");
+    const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+    const counts = targets.map(() => 0);
+    for (let i = 0; i < d.length; i += 4) {
+      targets.forEach((rgb, k) => {
+        if (Math.abs(d[i] - ((rgb >> 16) & 255)) <= t && Math.abs(d[i + 1] - ((rgb >> 8) & 255)) <= t &&
+            Math.abs(d[i + 2] - (rgb & 255)) <= t) counts[k]++;
+      });
+    }
+    return counts;
+  }, [colours, tol]);
 }
 
 // The InbetweenRequest in the body of a Connect server-stream call made with the binary format:
@@ -229,11 +251,20 @@ try {
     await scrubTo(page, 0);
     assert.match(await text(page, "#frame-label"), /^frame 1 \/ 12 · key 1$/);
     const first = await canvasInfo(page);
+    // The drawings have art (the cell's green, #6aa84f): the key frames show it exactly, and no
+    // frame the silhouette's blue. (In between, the one cell and the two cells are layers of
+    // different path counts: they cross-fade, lighter where only one of them is.)
+    const [green1, blue1] = await colourCounts(page, [0x6aa84f, 0x3b7dd8]);
     await scrubTo(page, 11);
     assert.match(await text(page, "#frame-label"), /^frame 12 \/ 12 · key 2$/);
     const last = await canvasInfo(page);
+    const [green2, blue2] = await colourCounts(page, [0x6aa84f, 0x3b7dd8]);
     await scrubTo(page, 5);
     const middle = await canvasInfo(page);
+    const [, blueMiddle] = await colourCounts(page, [0x6aa84f, 0x3b7dd8]);
+    assert.equal(await page.locator("#player").getAttribute("data-render"), "art");
+    assert.ok(green1 > 1000 && green2 > 1000 && blue1 + blue2 + blueMiddle === 0,
+      `green px ${green1}, ${green2} in the key frames; blue px ${blue1}, ${blue2}, ${blueMiddle}`);
     for (const [name, c] of Object.entries({ first, middle, last })) {
       assert.ok(c.inked > 0.02 && c.inked < 0.95, `${name} frame: ${(100 * c.inked).toFixed(1)}% inked`);
     }
@@ -265,13 +296,14 @@ try {
       const ctx = c.getContext("2d");
       ctx.drawImage(last.image, 0, 0);
       const d = ctx.getImageData(0, 0, c.width, c.height).data;
-      let blue = 0;
-      for (let i = 0; i < d.length; i += 4) if (d[i + 2] > d[i] + 60) blue++;
-      return { frames: track.frameCount, width: c.width, blue: blue / (d.length / 4) };
+      // The art's green (#6aa84f, (102, 170, 102) in the GIF's palette), not the silhouette blue.
+      let green = 0;
+      for (let i = 0; i < d.length; i += 4) if (d[i + 1] > d[i] + 40 && d[i + 1] > d[i + 2] + 40) green++;
+      return { frames: track.frameCount, width: c.width, green: green / (d.length / 4) };
     }, bytes.toString("base64"));
     assert.equal(decoded.frames, 12);
     assert.equal(decoded.width, 320);
-    assert.ok(decoded.blue > 0.02, `last GIF frame ${(100 * decoded.blue).toFixed(1)}% fill colour`);
+    assert.ok(decoded.green > 0.02, `last GIF frame ${(100 * decoded.green).toFixed(1)}% art colour`);
   });
 
   await step("the Lottie download has one hold keyframe per frame", async () => {
@@ -539,6 +571,79 @@ try {
       assert.ok(Math.hypot(mark[i][0] - clicked[0], mark[i][1] - clicked[1]) < 3 + units, `mark ${mark[i]}`);
     });
   });
+
+  // client/web/e2e/data/face_*.svg: a yellow face (#fcea2b) with eyes, red (#c81e1e) in key 1 and
+  // green (#1e8c1e) in key 2, a pink nose (#ff66cc) only key 2 has, a mouth and an outline.
+  const FACE = { yellow: 0xfcea2b, red: 0xc81e1e, green: 0x1e8c1e, pink: 0xff66cc, silhouette: 0x3b7dd8 };
+  const blend = (a, b, w) => [16, 8, 0].reduce(
+    (rgb, s) => rgb | (Math.round(w[0] * ((a >> s) & 255) + w[1] * ((b >> s) & 255)) << s), 0);
+  let artMiddle = null;
+  await step("layered drawings play as their art: key frames as drawn, eyes morph, the nose fades in", async () => {
+    await page.evaluate(() => { document.getElementById("server-settings").open = true; });
+    await page.click("#new-session");
+    await page.waitForFunction(() => document.getElementById("session-info").dataset.version === "1");
+    await page.setInputFiles("#upload", [args["art-first"], args["art-second"]]);
+    await page.locator("#drawing-list li[data-drawing-id]").nth(1).waitFor();
+    assert.equal(await page.locator("#drawing-list li.failed").count(), 0);
+    assert.deepEqual(await page.locator("#drawing-list li[data-drawing-id] .class").allTextContents(),
+      ["1 comp. · 0 holes", "1 comp. · 0 holes"]);
+    await page.click("#build");
+    await page.waitForFunction(() => !document.getElementById("build").disabled);
+    assert.equal(await text(page, "#error-build"), "");
+    await page.fill("#frames", "3");
+    await page.selectOption("#timing", "1"); // linear: the middle frame is halfway
+    await page.locator("#epsilon").fill("0");
+    await page.uncheck("#overlay");
+    await page.click("#inbetween");
+    await page.waitForFunction(() => !document.getElementById("inbetween").disabled);
+    assert.equal(await text(page, "#error-inbetween"), "");
+    if (await page.locator("#play").textContent() === "Pause") await page.click("#play");
+    assert.equal(await page.locator("#silhouette").isDisabled(), false, "the silhouette toggle is enabled");
+    assert.equal(await page.locator("#silhouette").isChecked(), false, "art is the default");
+    const counts = async () => {
+      const c = await colourCounts(page, Object.values(FACE));
+      return Object.fromEntries(Object.keys(FACE).map((k, i) => [k, c[i]]));
+    };
+    await scrubTo(page, 0);
+    assert.equal(await page.locator("#player").getAttribute("data-render"), "art");
+    const first = await counts();
+    assert.ok(first.red > 300 && first.yellow > 5000, `key 1: ${JSON.stringify(first)}`);
+    assert.ok(first.green < 20 && first.pink < 20 && first.silhouette === 0, `key 1: ${JSON.stringify(first)}`);
+    await page.screenshot({ path: join(args.out, "art-key1.png") });
+    await scrubTo(page, 2);
+    const last = await counts();
+    assert.ok(last.green > 300 && last.pink > 100 && last.yellow > 5000, `key 2: ${JSON.stringify(last)}`);
+    assert.ok(last.red < 20 && last.silhouette === 0, `key 2: ${JSON.stringify(last)}`);
+    await scrubTo(page, 1);
+    const weights = JSON.parse(await page.locator("#player").getAttribute("data-weights"));
+    assert.equal(weights.length, 2);
+    assert.ok(weights[0] > 0.3 && weights[1] > 0.3, `middle frame weights ${weights}`);
+    // Eyes correspond (paint order): one pair of eyes in the blended colour, neither key's own.
+    // The nose has no counterpart: key 2's nose at half its opacity over the face.
+    const eyes = blend(FACE.red, FACE.green, weights);
+    const nose = blend(FACE.yellow, FACE.pink, weights); // yellow under pink at opacity weights[1]
+    const [eyePx, nosePx] = await colourCounts(page, [eyes, nose], 3);
+    const middle = await counts();
+    assert.ok(eyePx > 300, `middle frame: ${eyePx} px of the blended eye colour #${eyes.toString(16)}`);
+    assert.ok(nosePx > 50, `middle frame: ${nosePx} px of the half-faded nose #${nose.toString(16)}`);
+    assert.ok(middle.red < 20 && middle.green < 20 && middle.pink < 20 && middle.silhouette === 0,
+      `middle frame: ${JSON.stringify(middle)}`);
+    artMiddle = (await canvasInfo(page)).hash;
+    await page.screenshot({ path: join(args.out, "art-middle.png") });
+  });
+
+  await step("the silhouette toggle draws the frames in one colour, and back", async () => {
+    await page.check("#silhouette");
+    assert.equal(await page.locator("#player").getAttribute("data-render"), "silhouette");
+    const [silhouette, yellow, red, green] = await colourCounts(page, [FACE.silhouette, FACE.yellow, FACE.red, FACE.green]);
+    assert.ok(silhouette > 5000 && yellow === 0 && red === 0 && green === 0,
+      `silhouette: ${JSON.stringify({ silhouette, yellow, red, green })}`);
+    await page.screenshot({ path: join(args.out, "art-silhouette.png") });
+    await page.uncheck("#silhouette");
+    assert.equal(await page.locator("#player").getAttribute("data-render"), "art");
+    assert.equal((await canvasInfo(page)).hash, artMiddle, "back to the same art");
+  });
+
 
   await step("no uncaught errors in the page", async () => {
     assert.deepEqual(pageErrors, []);

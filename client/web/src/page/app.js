@@ -1,5 +1,6 @@
 // The Inbetween page: key drawings -> topology edits and marks -> multimesh (build, optimize,
-// energy chart) -> inbetweens (timeline, parameters) -> player (canvas, mesh overlay) ->
+// energy chart) -> inbetweens (timeline, parameters) -> player (canvas: each frame's art by
+// art.js, the same rule as the CLI's renderers, or the one-colour silhouette; mesh overlay) ->
 // downloads. Talks Connect to the gateway on the same origin (inbetween.v1.Inbetween, plus
 // inbetween.web.v1.Gateway/EditTopologyOnce for topology edits). Every server error is shown
 // in the error line of the control that caused it.
@@ -14,6 +15,7 @@ import {
   TimingCurve,
 } from "../gen/inbetween/v1/inbetween_pb.js";
 import { Gateway } from "../gen/inbetween/web/v1/gateway_pb.js";
+import { appendArtChunk, artForFrame, hasArt, keysFromProto, paintArt } from "./art.js";
 import { addPoint, emptyBounds, fitView, isEmpty, nearestOnPolylines, signedArea2 } from "./geometry.js";
 import { encodeGif } from "./gif.js";
 import { makeLottie } from "./lottie.js";
@@ -44,6 +46,14 @@ const state = {
   triangles: null,
   frames: [], // Float64Array per frame
   frameStats: [],
+  frameWeights: [], // Float64Array per frame: its example weights, one per drawing
+  drawingCount: 0, // drawings of the Inbetween run (InbetweenHeader.keys)
+  artProto: [], // InbetweenHeader.art, with the InbetweenResponse.art messages appended
+  artExpected: 0, // InbetweenHeader.art_messages
+  artReceived: 0,
+  art: null, // art.js keys once the header's art is complete, or null (no art: silhouette)
+  frameArt: [], // per frame: its art layers (computed when first drawn)
+  artError: "", // why the art cannot be drawn (the silhouette is drawn instead)
   keys: [],
   totalFrames: 0,
   frameBounds: emptyBounds(),
@@ -780,6 +790,14 @@ function resetFrames() {
   state.triangles = null;
   state.frames = [];
   state.frameStats = [];
+  state.frameWeights = [];
+  state.drawingCount = 0;
+  state.artProto = [];
+  state.artExpected = 0;
+  state.artReceived = 0;
+  state.art = null;
+  state.frameArt = [];
+  state.artError = "";
   state.keys = [];
   state.totalFrames = 0;
   state.frameBounds = emptyBounds();
@@ -800,9 +818,17 @@ async function inbetween() {
         state.triangles = Uint32Array.from(h.triangles.flatMap((t) => [t.a, t.b, t.c]));
         state.keys = h.keys;
         state.totalFrames = h.frames;
+        state.drawingCount = h.keys.length;
+        state.artProto = h.art;
+        state.artExpected = h.artMessages;
+        if (h.artMessages === 0) finishArt();
       }
+      if (ev.case === "art") receiveArt(ev.value);
       if (ev.case === "frame") {
         const f = ev.value;
+        if (state.artReceived < state.artExpected) {
+          artFailed(`Inbetween stream sent a frame after ${state.artReceived} of ${state.artExpected} art messages`);
+        }
         const xy = new Float64Array(f.vertices.length * 2);
         f.vertices.forEach((p, i) => {
           xy[2 * i] = p.x;
@@ -811,6 +837,7 @@ async function inbetween() {
         });
         state.frames[f.index] = xy;
         state.frameStats[f.index] = f.stats;
+        state.frameWeights[f.index] = Float64Array.from(f.weights);
         $("progress").value = (f.index + 1) / state.totalFrames;
         $("progress-text").textContent = `frame ${f.index + 1} of ${state.totalFrames}`;
         updatePlayerControls();
@@ -831,13 +858,66 @@ function updatePlayerControls() {
   const done = n > 0 && n === state.totalFrames;
   $("download-gif").disabled = !done;
   $("download-lottie").disabled = !done;
+  $("silhouette").disabled = !state.art;
+  $("silhouette").parentElement.title = state.art
+    ? "draw the frames in one colour instead of the drawings' art"
+    : "the drawings have no art: the frames are drawn in one colour";
 }
 
-// Paints frame i into ctx (w×h CSS px); the same routine feeds the GIF encoder.
-function paintFrame(ctx, w, h, i, overlay) {
-  const xy = state.frames[i];
-  if (!xy || !state.triangles) return;
-  const view = fitView(state.frameBounds, w, h, 12);
+// The header's art is complete (InbetweenHeader.art plus its art_messages): ready to draw.
+function finishArt() {
+  if (state.artError) return;
+  try {
+    const keys = keysFromProto(state.artProto, state.triangles, state.drawingCount);
+    state.art = hasArt(keys) ? keys : null;
+    state.artProto = []; // converted: the messages are not needed any more
+  } catch (err) {
+    artFailed(err.message);
+  }
+  updatePlayerControls();
+}
+
+// An InbetweenResponse.art message: the rest of a key's layers.
+function receiveArt(chunk) {
+  if (state.artError) return;
+  if (state.artReceived >= state.artExpected) {
+    artFailed(`Inbetween stream sent more art messages than the ${state.artExpected} its header announced`);
+    return;
+  }
+  try {
+    appendArtChunk(state.artProto, chunk);
+  } catch (err) {
+    artFailed(err.message);
+    return;
+  }
+  if (++state.artReceived === state.artExpected) finishArt();
+}
+
+// The frames are drawn as the silhouette from now on; says why under the Inbetween button.
+function artFailed(message) {
+  if (state.artError) return;
+  state.artError = message;
+  state.art = null;
+  state.frameArt = [];
+  showError("error-inbetween", `the art cannot be drawn (${message}); showing the silhouette`);
+  updatePlayerControls();
+}
+
+// Frame i's art layers (art.js artForFrame), or null when the silhouette is to be drawn.
+function frameArt(i) {
+  if (!state.art || $("silhouette").checked || !state.frames[i] || !state.frameWeights[i]) return null;
+  if (!state.frameArt[i]) {
+    try {
+      state.frameArt[i] = artForFrame(state.art, state.frames[i], state.frameWeights[i]);
+    } catch (err) {
+      artFailed(`frame ${i + 1}: ${err.message}`);
+      return null;
+    }
+  }
+  return state.frameArt[i];
+}
+
+function trianglesPath(ctx, view, xy) {
   const t = state.triangles;
   ctx.beginPath();
   for (let k = 0; k < t.length; k += 3) {
@@ -849,26 +929,45 @@ function paintFrame(ctx, w, h, i, overlay) {
     ctx.lineTo(cx, cy);
     ctx.closePath();
   }
-  ctx.fillStyle = FILL;
-  ctx.fill("nonzero");
+}
+
+// Paints frame i into ctx (w×h CSS px): its art, or the silhouette; the same routine feeds the
+// GIF encoder. Returns what it drew: "art", "silhouette" or "" (no frame).
+function paintFrame(ctx, w, h, i, overlay) {
+  const xy = state.frames[i];
+  if (!xy || !state.triangles) return "";
+  const view = fitView(state.frameBounds, w, h, 12);
+  const art = frameArt(i);
+  if (art) {
+    paintArt(ctx, art, view);
+  } else {
+    trianglesPath(ctx, view, xy);
+    ctx.fillStyle = FILL;
+    ctx.fill("nonzero");
+  }
   if (overlay) {
-    ctx.strokeStyle = "rgba(255,255,255,0.8)";
+    trianglesPath(ctx, view, xy);
+    ctx.strokeStyle = art ? "rgba(0,0,0,0.35)" : "rgba(255,255,255,0.8)";
     ctx.lineWidth = 0.75;
     ctx.stroke();
   }
+  return art ? "art" : "silhouette";
 }
 
 function drawFrame(i) {
   const [ctx, w, h] = prepareCanvas($("player"));
   const n = state.frames.length;
   if (!n) {
+    $("player").dataset.render = "";
     $("frame-label").textContent = "no frames";
     $("frame-stats").textContent = "";
     return;
   }
   i = Math.min(i, n - 1);
   state.current = i;
-  paintFrame(ctx, w, h, i, $("overlay").checked);
+  // What the canvas shows, for tests and tools: "art" or "silhouette", and the frame's weights.
+  $("player").dataset.render = paintFrame(ctx, w, h, i, $("overlay").checked);
+  $("player").dataset.weights = JSON.stringify([...(state.frameWeights[i] ?? [])]);
   const key = state.keys.indexOf(i);
   $("frame-label").textContent =
     `frame ${i + 1} / ${state.totalFrames}${key >= 0 ? ` · key ${key + 1}` : ""}`;
@@ -1063,6 +1162,7 @@ function wire() {
     drawFrame(Number($("scrub").value));
   });
   $("overlay").addEventListener("change", () => drawFrame(state.current));
+  $("silhouette").addEventListener("change", () => drawFrame(state.current));
   $("download-gif").addEventListener("click", downloadGif);
   $("download-lottie").addEventListener("click", downloadLottie);
   $("download-project").addEventListener("click", downloadProject);
