@@ -12,6 +12,7 @@ import os
 
 import grpc
 
+from inbetween.art import FrameArt
 from inbetween.v1 import inbetween_pb2 as pb
 from inbetween.v1 import inbetween_pb2_grpc as pb_grpc
 
@@ -194,30 +195,49 @@ class Client:
                                "result").session
 
     def frames(self, session_id, frames, method="zhu17"):
-        """Yields ("header", InbetweenHeader) then ("frame", InbetweenFrame) in order."""
+        """Yields ("header", InbetweenHeader) then ("frame", InbetweenFrame) in order. The header
+        comes with all its art: the layers of the art messages that follow it on the wire
+        (InbetweenHeader.art_messages) are appended to its KeyArt of the same key."""
         parameters = pb.InbetweenParameters(method=METHODS[method], frames=frames)
         request = pb.InbetweenRequest(session_id=session_id, parameters=parameters)
         call = self._stream("Inbetween", request, session_id)
         try:
+            header, pending = None, 0
             for response in call:
                 event = response.WhichOneof("event")
-                if event in ("header", "frame"):
-                    yield event, getattr(response, event)
+                if event == "header":
+                    header, pending = response.header, response.header.art_messages
+                elif event == "art" and header is not None and pending > 0:
+                    key_art = next(k for k in header.art if k.key == response.art.key)
+                    key_art.layers.extend(response.art.layers)
+                    pending -= 1
+                elif event == "frame":
+                    yield event, response.frame
+                    continue
+                else:
+                    continue
+                if pending == 0:
+                    yield "header", header
         except grpc.RpcError as error:
             raise InbetweenError.from_rpc_error(error) from None
         finally:
             call.cancel()  # a consumer that stops early ends the stream (no-op when finished)
 
-    def stream_frames(self, session, out_dir, frames, method="zhu17"):
-        """Streams the inbetween frames into out_dir as they arrive: frame_NNNN.svg (the mesh's
-        triangles) and frame_NNNN.json (index, time, weights, vertices). Returns the paths of the
-        JSON files in frame order."""
+    def stream_frames(self, session, out_dir, frames, method="zhu17", art=True):
+        """Streams the inbetween frames into out_dir as they arrive: frame_NNNN.svg and
+        frame_NNNN.json (index, time, weights, vertices). The SVG draws the frame's art
+        (frame_art_svg, viewBox from that frame's bounds) when ``art`` is true and the drawings
+        have art, else the mesh's triangles. Returns the paths of the JSON files in frame
+        order."""
         os.makedirs(out_dir, exist_ok=True)
         session_id = session if isinstance(session, str) else session.id
-        triangles, paths = [], []
+        triangles, paths, drawing = [], [], None
         for kind, message in self.frames(session_id, frames, method):
             if kind == "header":
                 triangles = [(t.a, t.b, t.c) for t in message.triangles]
+                drawing = FrameArt(message) if art and message.art else None
+                if drawing is not None and not drawing.has_art():
+                    drawing = None  # every drawing came without art: draw the triangles
                 continue
             vertices = [(p.x, p.y) for p in message.vertices]
             stem = os.path.join(out_dir, f"frame_{message.index:04d}")
@@ -225,7 +245,7 @@ class Client:
                 json.dump({"index": message.index, "time": message.time,
                            "weights": list(message.weights), "vertices": vertices}, out)
             with open(stem + ".svg", "w", encoding="utf-8") as out:
-                out.write(_frame_svg(vertices, triangles))
+                out.write(drawing.svg(message) if drawing else _frame_svg(vertices, triangles))
             paths.append(stem + ".json")
         return paths
 
@@ -237,7 +257,8 @@ def place_art(header, frame):
     each path ``(closed, [(x, y), ...])``. Point i of a path is b0*v[a] + b1*v[b] + b2*v[c] for
     its triangle (a, b, c) and the frame's vertices v. At a key frame this is that drawing's art
     as drawn; in between, morph corresponding layers and cross-fade the others by weight
-    (docs/api.md, "Drawing a frame's art"). Empty when the header has no art."""
+    (docs/api.md, "Drawing a frame's art"; frame_art does so). Empty when the header has no
+    art."""
     triangles = [(t.a, t.b, t.c) for t in header.triangles]
     vertices = [(p.x, p.y) for p in frame.vertices]
     placed = []

@@ -117,6 +117,28 @@ class ClientTest(unittest.TestCase):
         middle = inbetween.place_art(header, frames[1])
         self.assertEqual([k for k, _, _ in middle], [0, 1])
 
+    def test_stream_frames_draws_the_frames_art(self):
+        session = self.built_session("py-art-svg")
+        drawings = self.client.get_session(session.id, full=True)[0].drawings
+        events = list(self.client.frames(session.id, 3, method="linear"))
+        header, frames = events[0][1], [message for _, message in events[1:]]
+        self.client.stream_frames(session, self.out, frames=3, method="linear")
+        for frame in frames:
+            with open(os.path.join(self.out, f"frame_{frame.index:04d}.svg"),
+                      encoding="utf-8") as source:
+                self.assertEqual(source.read(), inbetween.frame_art_svg(header, frame))
+        # A key frame draws its drawing's layers; the middle one both keys' (morphed or faded).
+        for key, frame in ((0, frames[0]), (1, frames[-1])):
+            layers = inbetween.frame_art(header, frame)
+            self.assertEqual([l.fill for l in layers],
+                             [inbetween.art.Fill(a.fill.rgb, a.fill.opacity, a.fill.even_odd)
+                              if a.HasField("fill") else None for a in drawings[key].art])
+        self.assertTrue(inbetween.frame_art(header, frames[1]))
+        mesh = os.path.join(self.out, "mesh")
+        self.client.stream_frames(session, mesh, frames=3, method="linear", art=False)
+        with open(os.path.join(mesh, "frame_0001.svg"), encoding="utf-8") as source:
+            self.assertIn('fill="#8ab"', source.read())  # the triangles, as without art
+
     def test_stale_version_and_unknown_session_raise_with_their_codes(self):
         session = self.client.create_session("py-errors")
         newer = self.client.put_svg(session, SQUARE)
