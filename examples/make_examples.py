@@ -71,7 +71,9 @@ def intersect(p, d, q, e):
 #     front hip.
 ARM_W, ARM_L = 7, 34
 
-def walker(front, back, arm, passing=False):
+def walker(front, back, arm, passing=False, geo=None):
+    # geo (a dict, optional) receives the arm's frame for the layered walk below: shoulder T,
+    # direction d, inner-edge normal n, hand, corner, and 'armpit' or 'x'/'tip'.
     P = (0, -6); w = 9; L = 54
     out = []
     cuts = []
@@ -85,11 +87,15 @@ def walker(front, back, arm, passing=False):
     corner = add(add(hand, n, ARM_W), d, 2)
     marks[8] = hand
     marks[10] = (1, -66 - math.sqrt(105) - 11)  # the top of the head
+    if geo is not None:
+        geo.update(T=T, d=d, n=n, hand=hand, corner=corner)
     if corner[0] > 9:
         # arm held in front of the torso (x = 9): the armpit where its inner edge meets the front
         armpit = intersect(add(T, n, ARM_W), d, T, (0, 1))
         out_pts += [hand, corner, armpit]
         marks[2] = armpit
+        if geo is not None:
+            geo['armpit'] = armpit
         marks[13] = corner
     else:
         # arm hanging over the torso front: only the hand shows past the front; the arm's hand
@@ -100,8 +106,11 @@ def walker(front, back, arm, passing=False):
         out_pts += [hand, x]
         cuts.append([x, corner, tip])
         marks[2] = tip
+        if geo is not None:
+            geo.update(x=x, tip=tip)
         marks[13] = corner  # on the cut: the arm's side is the first on the boundary
     out_pts += [(9, -10)]
+    legs_from = len(out_pts) - 1
     marks[3] = (9, -10)  # where the torso front meets the front leg
     def leg_edges(a):
         d = unit(a); n = (math.cos(math.radians(a)), -math.sin(math.radians(a)))
@@ -127,6 +136,8 @@ def walker(front, back, arm, passing=False):
         out_pts += [ef, toe(ef, db, nb), add(eb, db, 2), eb, bb]
         marks.update({7: eb, 9: toe(ef, db, nb), 12: bb, 17: ef, 18: add(eb, db, 2)})
     out_pts += [(-9, -10), (-10, -56), (-3, -62)]
+    if geo is not None:
+        geo['legs'] = out_pts[legs_from:-2]  # the outline from the front hip round to the back one
     marks[4] = (-9, -10)  # where the back leg meets the torso
     marks[5] = (9, -60)  # the shoulder
     dpath = head + ' L ' + ' L '.join('%s %s' % (f(x), f(y)) for x, y in out_pts) + ' Z'
@@ -416,3 +427,189 @@ write('principles_appeal', [
     ('3_appealing.svg', face_svg('Appeal key 3: round head, big eyes, a wide smile and a tilt of the head',
                                  (38, 36), (8.5, 10.5), 15, 56, ((42, 77), (78, 77), 84, 100), -6)),
 ], {'meshing': {'boundary_vertices': 120, 'max_edge_relative': 0.1}})
+
+# --- Layered art: drawings as an artist paints them, fills and line work over each other
+#     (docs/svg-convention.md). The silhouette is the union of the paint (or the class="outline"
+#     element); the layers ride the mesh and morph into the layer of the same data-layer name in
+#     the next key. Paint that lies along a cut is drawn a little off it, on the side it belongs to:
+#     a point on the cut would ride whichever side the mesh finds first and could stay behind when
+#     the cut opens.
+INK = '#2b2233'
+
+def layer(tag, name, paint, **geom):
+    attrs = ' '.join('%s="%s"' % (k.replace('_', '-'), v) for k, v in geom.items())
+    return '  <%s data-layer="%s" %s %s/>\n' % (tag, name, attrs, paint)
+
+def stroke(width, color=INK):
+    return 'fill="none" stroke="%s" stroke-width="%s" stroke-linecap="round" stroke-linejoin="round"' % (
+        color, f(width))
+
+def polyline_d(ps, closed=False):
+    return 'M ' + ' L '.join('%s %s' % (f(x), f(y)) for x, y in ps) + (' Z' if closed else '')
+
+# A face changing expression: head with an outline stroke, hair, eyes (white and pupil), brows,
+# nose and mouth, each its own layer; the smile adds blushing cheeks (a layer only that key has:
+# it cross-fades in and out). The silhouette is the head: everything else is painted on it.
+def face_key(title, head, brows, eyes, pupil_r, mouth, blush=False):
+    cx, cy, rx, ry = head
+    b = layer('ellipse', 'head', 'fill="#f2c79b" stroke="%s" stroke-width="2.5"' % INK,
+              cx=f(cx), cy=f(cy), rx=f(rx), ry=f(ry))
+    # hair: the head's outline from 200 to 340 degrees, a fringe back across the forehead
+    p = lambda a: (cx + rx * math.cos(math.radians(a)), cy + ry * math.sin(math.radians(a)))
+    (x0, y0), (x1, y1) = p(200), p(340)
+    top = cy - ry
+    b += layer('path', 'hair', 'fill="#6b4226"', d='M %s %s A %s %s 0 0 1 %s %s Q %s %s %s %s Q %s %s %s %s Z' % (
+        f(x0), f(y0), f(rx), f(ry), f(x1), f(y1), f(cx + 18), f(top + 10), f(cx + 2), f(top + 16),
+        f(cx - 16), f(top + 12), f(x0), f(y0)))
+    if blush:
+        for side in (-1, 1):
+            b += layer('ellipse', 'cheek', 'fill="#e8707a" opacity="0.45"', cx=f(cx + side * 24),
+                       cy=f(cy + 12), rx='7', ry='4.5')
+    ex, ey, erx, ery = eyes
+    for side, name in ((-1, 'left'), (1, 'right')):
+        b += layer('ellipse', name + '-eye', 'fill="#ffffff" stroke="%s" stroke-width="1.2"' % INK,
+                   cx=f(cx + side * ex), cy=f(ey), rx=f(erx), ry=f(ery))
+        b += layer('circle', name + '-pupil', 'fill="%s"' % INK, cx=f(cx + side * ex + 1), cy=f(ey + 1),
+                   r=f(pupil_r))
+    for side, name in ((-1, 'left'), (1, 'right')):
+        (ax, ay), (qx, qy), (zx, zy) = brows
+        b += layer('path', name + '-brow', stroke(3), d='M %s %s Q %s %s %s %s' % (
+            f(cx + side * ax), f(ay), f(cx + side * qx), f(qy), f(cx + side * zx), f(zy)))
+    b += layer('path', 'nose', stroke(1.5), d='M %s %s Q %s %s %s %s' % (
+        f(cx), f(cy + 2), f(cx - 5), f(cy + 12), f(cx + 2), f(cy + 14)))
+    (l, my), (r, _), upper, lower = mouth
+    b += layer('path', 'mouth', 'fill="#8a2b2b" stroke="%s" stroke-width="1.5" stroke-linejoin="round"' % INK,
+               d='M %s %s Q %s %s %s %s Q %s %s %s %s Z' % (f(l), f(my), f(cx), f(upper), f(r), f(my),
+                                                          f(cx), f(lower), f(l), f(my)))
+    return svg(120, 120, title, b)
+write('layered_face', [
+    ('1_neutral.svg', face_key('Layered face key 1: neutral', (60, 62, 40, 44),
+                               ((8, 41), (16, 39), (25, 42)), (16, 55, 7, 7.5), 3.5,
+                               ((50, 86), (70, 86), 87, 90))),
+    ('2_smile.svg', face_key('Layered face key 2: a broad smile, the cheeks blush', (60, 63, 42, 42),
+                             ((8, 42), (16, 37), (25, 41)), (16, 56, 7, 5.5), 3.5,
+                             ((40, 80), (80, 80), 84, 104), blush=True)),
+    ('3_surprised.svg', face_key('Layered face key 3: surprised: brows up, eyes wide, mouth open',
+                                 (60, 60, 38, 47), ((8, 34), (16, 27), (25, 32)), (16, 53, 8, 10), 2.5,
+                                 ((52, 88), (68, 88), 72, 108))),
+])
+
+# A walk painted as a cut-out character: six of the walk's poses, each part its own layer with its
+# line work, painted back to front: neck, trousers, shirt, head (hair, eye), the arm (sleeve, hand,
+# its ink). Where the arm hangs over the torso, the shirt is painted up to the arm's inner edge
+# (under the arm there is only arm). The silhouette is the walk's own outline (examples/walk), as
+# an unpainted class="outline" path, with its cut and marks: the union of the inked parts rounds
+# the corners the marks sit on, and a mark's nearest point on that ink lands a hair (1e-6) from
+# one of its vertices, which the mesher refuses. The parts are inset a little from the outline so
+# that their edges cross the mesh's triangles: art running along the mesh boundary is not split
+# at its vertices and would cut corners as a chord in the frames.
+def inset(poly, delta):
+    """The polygon with every edge moved `delta` inwards (corners where the moved edges meet)."""
+    area = sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(poly, poly[1:] + poly[:1]))
+    side = 1 if area > 0 else -1
+    out = []
+    for i, p in enumerate(poly):
+        a, b = poly[i - 1], poly[(i + 1) % len(poly)]
+        e0 = ((p[0] - a[0]) / math.dist(a, p), (p[1] - a[1]) / math.dist(a, p))
+        e1 = ((b[0] - p[0]) / math.dist(p, b), (b[1] - p[1]) / math.dist(p, b))
+        n0, n1 = (-side * e0[1], side * e0[0]), (-side * e1[1], side * e1[0])
+        if abs(e0[0] * e1[1] - e0[1] * e1[0]) < 1e-9:  # straight on
+            out.append(add(p, n0, delta))
+        else:
+            out.append(intersect(add(p, n0, delta), e0, add(p, n1, delta), e1))
+    return out
+
+def walk_key(number, i):
+    name, fr, bk, bob = step[i % 8]
+    g = {}
+    outline, cuts, marks = walker(fr, bk, arms[i], geo=g)
+    T, d, n = g['T'], g['d'], g['n']
+    c = (1, -66 - math.sqrt(105))  # the head's centre (radius 11)
+    arm = inset([T, add(g['hand'], d, -0.15), add(add(g['corner'], d, -0.15), n, -0.15),
+                 add(T, n, ARM_W - 0.15)], 0.15)
+    wrist = [intersect(arm[0], d, add(T, d, ARM_L - 9), n), intersect(arm[3], d, add(T, d, ARM_L - 9), n)]
+    if 'armpit' in g:
+        front = [g['armpit']]
+    else:
+        front = [add(g['tip'], n, 0.15), add(add(g['corner'], n, 0.15), d, 0.15), (9, g['x'][1] + 0.2)]
+    r = 10.85
+    h0, h1 = add(c, (math.cos(math.radians(165)), math.sin(math.radians(165))), r), \
+        add(c, (math.cos(math.radians(295)), math.sin(math.radians(295))), r)
+    inked = lambda fill, w=1.2: 'fill="%s" stroke="%s" stroke-width="%s" stroke-linejoin="round"' % (fill, INK, f(w))
+    pd = lambda ps: ('M ' + ' L '.join('%.2f %.2f' % p for p in ps) + ' Z').replace('.00', '')
+    b = '  <g transform="translate(40 %s)">\n' % f(96 + bob)
+    b += '    <path class="outline" fill="none" d="%s"/>\n' % outline
+    b += '  ' + layer('rect', 'neck', inked('#e9b98f'), x='-2.85', y='-68', width='7.7', height='8')
+    b += '  ' + layer('path', 'trousers', inked('#34406b'), d=pd(inset([(9, -16)] + g['legs'] + [(-9, -16)], 0.15)))
+    b += '  ' + layer('path', 'shirt', inked('#d9503f'), d=pd(inset([(-9, -10), (-10, -56), (-3, -60), (5, -60), T] + front + [(9, -10)], 0.15)))
+    b += '  ' + layer('circle', 'head', inked('#e9b98f'), cx=f(c[0]), cy='%.2f' % c[1], r=f(r))
+    b += '  ' + layer('path', 'hair', 'fill="#3b2a1e"', d='M %.2f %.2f A %s %s 0 0 1 %.2f %.2f Q %s %s %.2f %.2f Z' % (
+        h0[0], h0[1], f(r), f(r), h1[0], h1[1], f(c[0] - 2), f(c[1] - 3), h0[0], h0[1]))
+    b += '  ' + layer('circle', 'eye', 'fill="%s"' % INK, cx=f(c[0] + 6), cy=f(c[1] - 1), r='1.3')
+    b += '  ' + layer('path', 'sleeve', 'fill="#c2402f"', d=pd([arm[0], wrist[0], wrist[1], arm[3]]))
+    b += '  ' + layer('path', 'hand', 'fill="#e9b98f"', d=pd([wrist[0], arm[1], arm[2], wrist[1]]))
+    b += '  ' + layer('path', 'arm-ink', stroke(1), d=pd(arm))
+    for cut in cuts:
+        b += '    <path class="cut" d="%s" stroke="red" fill="none"/>\n' % polyline_d(cut)
+    for k in sorted(marks):
+        b += '    <circle data-corr="%d" cx="%s" cy="%s" r="1" fill="red"/>\n' % (k, f(marks[k][0]), f(marks[k][1]))
+    b += '  </g>\n'
+    return ('%d_%s.svg' % (number, name),
+            svg(100, 160, 'Layered walk key %d: %s, arm at %d degrees (shirt, trousers, line work)' % (
+                number, name, arms[i]), b))
+write('layered_walk', [walk_key(k + 1, i) for k, i in enumerate((0, 3, 6, 8, 11, 14))],
+      {'inbetween': {'timing': 'catmull_rom', 'frames': 36},
+       'meshing': {'boundary_vertices': 560, 'max_edge_relative': 0.016}})
+
+# The bird painted part by part: the body (a lighter belly on it) and the wing, each filled and
+# inked, an eye and a beak. Folded, the wing lies on the body and the bird example's cut frees its
+# trailing edge: the body is painted up to the cut, the wing from just beyond it.
+def painted_bird(key, name, t1, t2):
+    folded = t1 is None
+    ink = 'stroke="%s" stroke-width="1.2" stroke-linejoin="round"' % INK
+    if folded:  # the body round the wing: down its root to the cut's tip, up the cut's body side
+        body = 'M 100 52 Q 96 42 86 42 L 76 44 L 61.9 50.1 L 48.9 44.1 L 12 44'
+        wing = [(76, 44.2), (49.9, 44.2), (62.6, 49.8)]
+    else:
+        body = 'M 100 52 Q 96 42 86 42 L 76 44 L 62 44 L 12 44'
+        wing = [(76, 44), t1, t2, (62, 44)]
+    body += ' L 2 36 L 6 50 Q 30 70 70 64 Q 90 60 100 52 Z'
+    b = layer('path', 'body', 'fill="#3f7fa8" ' + ink, d=body)
+    b += layer('path', 'belly', 'fill="#cfe3ee"', d='M 14 52 Q 30 66 70 62 Q 88 58 96 53 Q 70 56 40 55 Q 24 54 14 52 Z')
+    b += layer('path', 'wing', 'fill="#8fc0dc" ' + ink, d=polyline_d(wing, True))
+    b += layer('path', 'beak', 'fill="#f0a830" stroke="%s" stroke-width="0.8" stroke-linejoin="round"' % INK,
+               d='M 98 49 L 107 52.5 L 98 55 Z')
+    b += layer('circle', 'eye', 'fill="%s"' % INK, cx='90', cy='48', r='1.8')
+    if folded:
+        b += '  <path class="cut" d="M 36 38 L 62 50" stroke="red" fill="none"/>\n'
+    # 1 the wing's trailing root (the cut's tip when folded); along the outline, the upper edge of
+    # the beak, the back before the wing and the tail's edges: without them the outline's arc length,
+    # longer by the raised wing, would slide the head round towards the tail.
+    for k, (x, y) in enumerate([(62, 50 if folded else 44), (102.5, 50.75), (81, 43), (7, 40), (4, 43)]):
+        b += '  <circle data-corr="%d" cx="%s" cy="%s" r="1" fill="red"/>\n' % (k + 1, f(x), f(y))
+    return ('%d_%s.svg' % (key, name), svg(110, 80, 'Layered bird key %d: wing %s' % (key, name), b))
+write('layered_bird', [painted_bird(1, 'folded', None, None), painted_bird(2, 'raised', (30, 20), (24, 26)),
+                       painted_bird(3, 'up', (44, 2), (38, 6))])
+
+# Squash and stretch with paint: the ball (principles_squash_stretch) inked, with a stripe round
+# its middle and a highlight; both squash and stretch with it, as they ride the ball's mesh.
+def painted_ball(title, cx, cy, rx, ry):
+    b = layer('ellipse', 'ball', 'fill="#d04a4a"', cx=f(cx), cy=f(cy), rx=f(rx), ry=f(ry))
+    # the stripe: between two curves across the ball, its ends on the ball's outline
+    e = lambda a: (cx + rx * math.cos(math.radians(a)), cy + ry * math.sin(math.radians(a)))
+    (ax, ay), (bx, by), (cx2, cy2), (dx, dy) = e(190), e(350), e(15), e(165)
+    b += layer('path', 'stripe', 'fill="#f4d35e"', d='M %s %s Q %s %s %s %s A %s %s 0 0 1 %s %s Q %s %s %s %s A %s %s 0 0 1 %s %s Z' % (
+        f(ax), f(ay), f(cx), f(cy + 0.25 * ry), f(bx), f(by), f(rx), f(ry), f(cx2), f(cy2),
+        f(cx), f(cy + 0.7 * ry), f(dx), f(dy), f(rx), f(ry), f(ax), f(ay)))
+    b += layer('ellipse', 'highlight', 'fill="#ffffff" opacity="0.8"', cx=f(cx - 0.4 * rx), cy=f(cy - 0.45 * ry),
+               rx=f(0.22 * rx), ry=f(0.16 * ry), transform='rotate(-30 %s %s)' % (f(cx - 0.4 * rx), f(cy - 0.45 * ry)))
+    b += layer('ellipse', 'outline', stroke(2), cx=f(cx), cy=f(cy), rx=f(rx), ry=f(ry))
+    # marks at the ends of the axes: each end of the ball stays that end in every key
+    for k, (x, y) in enumerate([(cx + rx, cy), (cx, cy + ry), (cx - rx, cy), (cx, cy - ry)]):
+        b += '  <circle data-corr="%d" cx="%s" cy="%s" r="1" fill="red"/>\n' % (k + 1, f(x), f(y))
+    return svg(100, 120, title, b)
+write('layered_squash_stretch', [
+    ('1_round.svg', painted_ball('Layered squash and stretch key 1: ball at the top', 50, 24, 20, 20)),
+    ('2_stretch.svg', painted_ball('Layered squash and stretch key 2: stretched as it falls', 50, 66, 14, 29)),
+    ('3_squash.svg', painted_ball('Layered squash and stretch key 3: squashed on the ground', 50, 106, 30, 12)),
+])
