@@ -47,6 +47,56 @@ std::vector<double> EdgeCrossings(const Point& p, const Point& q,
   return kept;
 }
 
+// The boundary vertices of a shape, for splitting art segments that run along the boundary
+// (on it, or a little outside: a fill whose outline is the drawing's outline, a stroke on it).
+// Such a segment crosses no triangle edge there, so without a split it would ride one triangle
+// and become a chord across the boundary wherever a frame bends it. It is split at the foot of
+// every boundary vertex it passes within a quarter of that vertex's shorter boundary edge: the
+// piece between two feet then follows the boundary edge between the two vertices.
+class BoundaryFeet {
+ public:
+  BoundaryFeet(const Multimesh& mesh, const Points& x) : x_(x) {
+    for (const std::vector<int>& loop : mesh.boundary_loops) {
+      const size_t n = loop.size();
+      for (size_t i = 0; i < n && n >= 3; ++i) {
+        const Point& v = x[loop[i]];
+        const double reach = 0.25 * std::min((v - x[loop[(i + n - 1) % n]]).norm(),
+                                             (v - x[loop[(i + 1) % n]]).norm());
+        vertices_.push_back({v.x(), loop[i], reach});
+        max_reach_ = std::max(max_reach_, reach);
+      }
+    }
+    std::sort(vertices_.begin(), vertices_.end(),
+              [](const Entry& a, const Entry& b) { return a.x < b.x; });
+  }
+
+  // Parameters t in (min_gap, 1 - min_gap) on pq of the feet of boundary vertices within reach.
+  void Add(const Point& p, const Point& q, double min_gap, std::vector<double>* ts) const {
+    const Point d = q - p;
+    const double length2 = d.squaredNorm();
+    if (vertices_.empty() || !(length2 > 0.0)) return;
+    const double lo = std::min(p.x(), q.x()) - max_reach_, hi = std::max(p.x(), q.x()) + max_reach_;
+    auto it = std::lower_bound(vertices_.begin(), vertices_.end(), lo,
+                               [](const Entry& e, double x) { return e.x < x; });
+    for (; it != vertices_.end() && it->x <= hi; ++it) {
+      const Point& v = x_[it->vertex];
+      const double t = (v - p).dot(d) / length2;
+      if (t <= min_gap || t >= 1.0 - min_gap) continue;
+      if ((p + t * d - v).norm() <= it->reach) ts->push_back(t);
+    }
+  }
+
+ private:
+  struct Entry {
+    double x;
+    int vertex;
+    double reach;
+  };
+  const Points& x_;
+  std::vector<Entry> vertices_;
+  double max_reach_ = 0.0;
+};
+
 class Embedder {
  public:
   Embedder(const Multimesh& mesh, int key, const ArtEmbeddingOptions& options,
@@ -55,6 +105,7 @@ class Embedder {
         x_(mesh.shapes[key]),
         options_(options),
         grid_(mesh.triangles, x_, options.triangles_per_cell),
+        feet_(mesh, x_),
         report_(report) {}
 
   bool empty() const { return grid_.empty(); }
@@ -70,8 +121,19 @@ class Embedder {
       if (!options_.split_at_edges || !has_segment) continue;
       const Point& q = p[(i + 1) % n];
       if (p[i] == q) continue;
-      for (double t : EdgeCrossings(p[i], q, grid_.AlongSegment(p[i], q), mesh_.triangles, x_,
-                                    options_.min_split_fraction)) {
+      std::vector<double> ts = EdgeCrossings(p[i], q, grid_.AlongSegment(p[i], q),
+                                             mesh_.triangles, x_, options_.min_split_fraction);
+      const size_t crossings = ts.size();
+      feet_.Add(p[i], q, options_.min_split_fraction, &ts);
+      if (ts.size() > crossings) {  // merge the feet in, keeping splits apart
+        std::sort(ts.begin(), ts.end());
+        std::vector<double> kept;
+        for (double t : ts) {
+          if (kept.empty() || t - kept.back() > options_.min_split_fraction) kept.push_back(t);
+        }
+        ts = std::move(kept);
+      }
+      for (double t : ts) {
         path.points.push_back(Embed(p[i] + t * (q - p[i]), true));
         ++report_->inserted;
       }
@@ -100,6 +162,7 @@ class Embedder {
   const Points& x_;
   const ArtEmbeddingOptions& options_;
   TriangleGrid grid_;
+  BoundaryFeet feet_;
   ArtEmbeddingReport* report_;
 };
 

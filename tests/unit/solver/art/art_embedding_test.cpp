@@ -174,6 +174,50 @@ TEST(ArtEmbeddingTest, LongSegmentSplitWhereItCrossesEdges) {
   EXPECT_EQ(plain.points, 2);
 }
 
+// A segment along the boundary, a little outside it (a fill whose outline is the drawing's
+// outline), crosses no triangle edge; split at the feet of the boundary vertices it passes, it
+// follows the boundary when a frame bends it instead of cutting across as one chord.
+TEST(ArtEmbeddingTest, SegmentAlongTheBoundaryFollowsItWhenBent) {
+  Multimesh mesh = JitteredGrid(16, 1, 0.0);
+  mesh.boundary_loops.emplace_back();
+  for (int i = 0; i <= 16; ++i) mesh.boundary_loops[0].push_back(i);       // bottom, left to right
+  for (int i = 16; i >= 0; --i) mesh.boundary_loops[0].push_back(17 + i);  // top, right to left
+  const Points bent = interp_test::Bent(mesh.shapes[0], 16.0, 2.0);
+  const ArtLayer edge = StrokeLayer({{0.0, -0.01}, {16.0, -0.01}}, 0, 0.1);
+  // The bent bottom boundary, as a polyline.
+  Points bottom;
+  for (int i = 0; i <= 16; ++i) bottom.push_back(bent[i]);
+  auto farthest = [&](const Points& placed) {
+    double worst = 0.0;
+    for (size_t k = 0; k + 1 < placed.size(); ++k) {
+      for (double t = 0.0; t <= 1.0; t += 0.125) {
+        const Point p = placed[k] + t * (placed[k + 1] - placed[k]);
+        double d = std::numeric_limits<double>::infinity();
+        for (size_t j = 0; j + 1 < bottom.size(); ++j) {
+          d = std::min(d, DistanceToSegment(bottom[j], bottom[j + 1], p));
+        }
+        worst = std::max(worst, d);
+      }
+    }
+    return worst;
+  };
+  ArtEmbeddingReport report;
+  absl::StatusOr<EmbeddedArt> along = EmbedArt(mesh, 0, {edge}, {}, &report);
+  ASSERT_TRUE(along.ok()) << along.status();
+  EXPECT_EQ(report.inserted, 15);  // the inner bottom vertices' feet
+  EXPECT_LT(farthest(PlacePath(along->layers[0].paths[0], bent)), 0.05);
+  // The key itself is unchanged: the feet lie on the drawn segment.
+  for (const Point& p : PlacePath(along->layers[0].paths[0], mesh.shapes[0])) {
+    EXPECT_NEAR(p.y(), -0.01, 1e-12);
+  }
+
+  // Without the boundary loops nothing tells the boundary apart: one chord, far off.
+  mesh.boundary_loops.clear();
+  absl::StatusOr<EmbeddedArt> chord = EmbedArt(mesh, 0, {edge});
+  ASSERT_TRUE(chord.ok());
+  EXPECT_GT(farthest(PlacePath(chord->layers[0].paths[0], bent)), 1.0);
+}
+
 TEST(ArtEmbeddingTest, ThousandsOfPointsOnThousandsOfTriangles) {
   const Multimesh mesh = JitteredGrid(60, 40, 0.3);  // 4800 triangles
   std::mt19937 rng(2);
