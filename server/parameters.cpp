@@ -90,6 +90,18 @@ absl::Status ValidateMeshing(const inbetween::v1::MeshingParameters& meshing,
                                                    meshing.corner_matching(),
                                                    " is not a known CornerMatching"));
   }
+  if (meshing.has_boundary_tolerance() && meshing.boundary_tolerance() != 0) {
+    if (auto s =
+            CheckRange(meshing.boundary_tolerance(), 0, 0.1, true, field, "boundary_tolerance");
+        !s.ok()) {
+      return s;
+    }
+  }
+  if (!inbetween::v1::BoundaryAlignment_IsValid(meshing.boundary_alignment())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".boundary_alignment = ", meshing.boundary_alignment(),
+                     " is not a known BoundaryAlignment"));
+  }
   return absl::OkStatus();
 }
 
@@ -190,6 +202,11 @@ solver::MultimeshOptions ToMultimeshOptions(const inbetween::v1::MeshingParamete
       options.corner_matching = solver::MultimeshOptions::CornerMatching::kWhenArcLengthFails;
       break;
   }
+  if (meshing.has_boundary_tolerance()) options.boundary_tolerance = meshing.boundary_tolerance();
+  options.correspondence =
+      meshing.boundary_alignment() == inbetween::v1::BOUNDARY_ALIGNMENT_ARC_LENGTH
+          ? solver::MultimeshOptions::Correspondence::kArcLength
+          : solver::MultimeshOptions::Correspondence::kFeatures;
   return options;
 }
 

@@ -14,6 +14,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "solver/geometry/affine_fit.h"
+#include "solver/geometry/loop_alignment.h"
 #include "solver/geometry/polygon.h"
 #include "solver/geometry/resample_outline.h"
 
@@ -670,6 +671,73 @@ std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(
   return pairs;
 }
 
+// How far `c`'s outline between arc lengths a0 < a1 (unwrapped, a1 - a0 < length) strays from
+// the chord between its ends, and the arc of its farthest vertex.
+double ChordDeviation(const Curve& c, double a0, double a1, double* farthest) {
+  const double length = c.length();
+  const Point p = c.At(a0), q = c.At(a1), d = q - p;
+  const double dd = d.squaredNorm();
+  const int n = static_cast<int>(c.p.size());
+  double worst = 0.0;
+  *farthest = 0.5 * (a0 + a1);
+  // The vertices strictly inside (a0, a1), walking from the one after a0.
+  const double base = std::floor(a0 / length) * length;
+  int k = static_cast<int>(std::upper_bound(c.cum.begin(), c.cum.end(), a0 - base) - c.cum.begin());
+  for (int steps = 0; steps < n; ++steps, ++k) {
+    const int wrap = k / n, idx = k % n;
+    const double arc = base + wrap * length + c.cum[idx];
+    if (arc >= a1) break;
+    if (arc <= a0) continue;
+    const Point& x = c.p[idx];
+    const double t = dd > 0 ? std::clamp((x - p).dot(d) / dd, 0.0, 1.0) : 0.0;
+    const double dist = (p + t * d - x).norm();
+    if (dist > worst) worst = dist, *farthest = arc;
+  }
+  return worst;
+}
+
+// Common parameters `ts` (increasing, the interval's vertices, ending before `t1`) with points
+// added until, in every drawing d, the outline between consecutive vertices (and the last and
+// t1) lies within tol[d] of their chord: each chord that strays is split at its drawing's
+// farthest vertex (by that drawing's parameterization), else halved. A rounded tip drawn with
+// many small turns gets vertices along it, where the corner test (a turn above
+// corner_angle_degrees in one step) saw none.
+std::vector<double> RefineToTolerance(const std::vector<double>& ts, double t1,
+                                      const std::vector<const Curve*>& curves,
+                                      const std::vector<const Param*>& params,
+                                      const std::vector<double>& tol) {
+  std::vector<double> out;
+  // Depth-first over the pieces, in order; a piece narrower than kMinPiece in t is left as it is
+  // (coincident vertices would follow).
+  constexpr double kMinPiece = 1e-7;
+  for (size_t k = 0; k < ts.size(); ++k) {
+    const double end = k + 1 < ts.size() ? ts[k + 1] : t1;
+    std::vector<std::pair<double, double>> stack = {{ts[k], end}};
+    while (!stack.empty()) {
+      const auto [lo, hi] = stack.back();
+      stack.pop_back();
+      double split = -1.0;
+      for (size_t d = 0; d < curves.size() && split < 0.0; ++d) {
+        const double a0 = params[d]->Forward(lo), a1 = params[d]->Forward(hi);
+        double far;
+        if (ChordDeviation(*curves[d], a0, a1, &far) > tol[d]) {
+          const double t = Wrap01(params[d]->Inverse(far));
+          // Inverse wraps into [0, 1); the piece may end at 1.
+          const double tt = t < lo ? t + 1.0 : t;
+          split = tt > lo + kMinPiece && tt < hi - kMinPiece ? tt : 0.5 * (lo + hi);
+        }
+      }
+      if (split < 0.0 || hi - lo < 2 * kMinPiece) {
+        out.push_back(lo);
+        continue;
+      }
+      stack.push_back({split, hi});  // after the first half
+      stack.push_back({lo, split});
+    }
+  }
+  return out;
+}
+
 struct UnionFind {
   std::vector<int> parent;
   explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
@@ -682,8 +750,48 @@ struct UnionFind {
 // How far a correspondence mark may sit from the boundary it pins, relative to the length of
 // that boundary loop.
 constexpr double kMarkRelativeTolerance = 0.05;
+// A mark computed by a program lands a hair off the drawn corner (an SVG written with four
+// decimals puts it 5e-5 units, 1e-7 of the diagonal, from an arrow's corner); pinned there it
+// splits the boundary next to the corner's own breakpoint into a sliver interval that every
+// drawing must repeat, and the mesher then fails on the sliver in another drawing. So a mark
+// within this fraction of its drawing's bounding-box diagonal of a corner of the loop
+// (FindCorners at corner_angle_degrees) snaps onto that corner, else onto the nearest vertex of
+// the loop within it (BoundaryCorrespondenceOptions::marks).
+constexpr double kMarkSnapRelative = 1e-5;
+// A mark's interval shorter than this fraction of the drawing's diagonal in some drawing (a mark
+// beside another breakpoint that it did not snap to) is refused naming the mark: it would reach
+// the mesher as a cusp.
+constexpr double kMarkSliverRelative = 1e-6;
+// Corners of different drawings closer than this fraction of a drawing's diagonal share one
+// breakpoint (see the breakpoints below).
+constexpr double kCornerMergeRelative = 1e-4;
 
 namespace {
+
+// Arc length `at` on `c` snapped onto the nearest corner within `tolerance`, else the nearest
+// vertex within it, else unchanged (kMarkSnapRelative). Distances are along the loop: a loop
+// that passes twice through one point (the two sides of a cut) must not send the mark to the
+// other pass.
+double SnapMark(const Curve& c, double at, double tolerance, double corner_angle_degrees) {
+  const double length = c.length();
+  auto nearest = [&](const std::vector<int>& indices) {
+    int best = -1;
+    double best_dist = tolerance;
+    for (int k : indices) {
+      const double gap = std::abs(c.cum[k] - at);
+      const double dist = std::min(gap, length - gap);
+      if (dist <= best_dist) best_dist = dist, best = k;
+    }
+    return best;
+  };
+  int k = nearest(FindCorners(c.p, corner_angle_degrees));
+  if (k < 0) {
+    std::vector<int> all(c.p.size());
+    std::iota(all.begin(), all.end(), 0);
+    k = nearest(all);
+  }
+  return k < 0 ? at : c.cum[k];
+}
 
 // The loop of drawing `graph` that is component c's outline.
 int OuterLoopOf(const BoundaryGraph& graph, int c) {
@@ -909,6 +1017,9 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
   // Parameterizations: marks, else automatic alignment.
   std::vector<std::vector<Param>> param(num_shapes, std::vector<Param>(num_groups));
   std::vector<std::vector<std::pair<double, std::vector<double>>>> marks_on(num_groups);
+  std::vector<std::pair<int, double>> mark_at;  // per mark: its loop group, arc in drawing 1
+  // Per group: the common parameters that marks (or matched corners) pin, each a breakpoint.
+  std::vector<std::vector<double>> pinned_t(num_groups);
   for (size_t m = 0; m < options.marks.size(); ++m) {
     if (static_cast<int>(options.marks[m].size()) != num_shapes) {
       return absl::InvalidArgumentError(absl::StrCat("mark ", m + 1, " has ",
@@ -926,6 +1037,8 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     for (int d = 0; d < num_shapes; ++d) {
       double dist = best;
       if (d > 0) at[d] = curve(d, group).Project(options.marks[m][d], &dist);
+      at[d] = SnapMark(curve(d, group), at[d], kMarkSnapRelative * scale[d],
+                       options.corner_angle_degrees);
       // A mark must sit on (near) a boundary; one far away is a mistake, not a pin.
       if (!(dist <= kMarkRelativeTolerance * curve(d, group).length())) {
         const Point& p = options.marks[m][d];
@@ -935,7 +1048,8 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
                          kMarkRelativeTolerance * 100, "% of that boundary's length"));
       }
     }
-    marks_on[group].push_back({at0, at});
+    marks_on[group].push_back({at[0], at});
+    mark_at.push_back({group, at[0]});
   }
   for (int g = 0; g < num_groups; ++g) {
     std::sort(marks_on[g].begin(), marks_on[g].end());
@@ -960,9 +1074,32 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     }
     out.corner_matched_loops += corner_pairs.empty() ? 0 : 1;
     const auto& marks = marks_on[g].empty() ? corner_pairs : marks_on[g];
+    for (const auto& mark : marks) {
+      pinned_t[g].push_back((mark.first - marks[0].first) / curve(0, g).length());
+    }
     for (int d = 0; d < num_shapes; ++d) {
       Param& p = param[d][g];
       p.length = curve(d, g).length();
+      // A loop that its component's affine map carried (components with holes, MatchHoles)
+      // keeps arc length from the carried start: that map already pairs the loops point by
+      // point, and an affine map changes the turns the alignment weighs (a sheared flower's
+      // outline: arc length 0.5-0.7 units off the affine correspondence, the alignment
+      // 1.4-2.8).
+      if (marks.empty() && d > 0 && !hole_carry[g][d].has_value() &&
+          options.alignment == BoundaryCorrespondenceOptions::Alignment::kFeatures) {
+        // Both loops in their drawings' normalised frames, for the alignment's position term.
+        Points a = curve(0, g).p, b = curve(d, g).p;
+        for (Point& q : a) q = (q - centre[0]) / scale[0];
+        for (Point& q : b) q = (q - centre[d]) / scale[d];
+        LoopAlignmentOptions align;
+        align.corner_angle_degrees = options.corner_angle_degrees;
+        const LoopAlignment al = AlignLoops(a, b, start[d] / p.length, align);
+        for (size_t k = 0; k < al.a.size(); ++k) {
+          p.t.push_back(al.a[k]);
+          p.a.push_back(al.b[k] * p.length);
+        }
+        continue;
+      }
       if (marks.empty()) {
         p.t = {0.0};
         p.a = {start[d]};
@@ -1005,10 +1142,28 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
   for (int g = 0; g < num_groups; ++g) {
     breaks[g].push_back(0.0);
     for (int d = 0; d < num_shapes; ++d) {
-      for (double t : param[d][g].t) add_break(g, t);
+      if (d == 0) {
+        for (double t : pinned_t[g]) add_break(g, t);
+      }
       const Curve& c = curve(d, g);
       for (int k : FindCorners(c.p, options.corner_angle_degrees)) {
-        add_break(g, param[d][g].Inverse(c.cum[k]));
+        const double t = Wrap01(param[d][g].Inverse(c.cum[k]));
+        // Two drawings' corners that the correspondence puts a hair apart would make a sliver
+        // interval that every drawing repeats (the mesher refuses it as a cusp): a corner within
+        // kCornerMergeRelative of an existing breakpoint in some drawing is left to it. Its
+        // drawing's vertex then sits that close to the corner, far inside the outline tolerance.
+        bool near = false;
+        const std::vector<double>& b = breaks[g];
+        auto it = std::lower_bound(b.begin(), b.end(), t);
+        for (double other : {it != b.end() ? *it : b.front() + 1.0,
+                             it != b.begin() ? *(it - 1) : b.back() - 1.0}) {
+          for (int e = 0; e < num_shapes && !near; ++e) {
+            const Param& p = param[e][g];
+            const double gap = std::abs(p.Forward(Wrap01(t)) - p.Forward(Wrap01(other)));
+            near = std::min(gap, p.length - gap) < kCornerMergeRelative * scale[e];
+          }
+        }
+        if (!near) add_break(g, t);
       }
     }
   }
@@ -1066,6 +1221,41 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
           "correspondence marks, so their two sides cannot share one set of boundary vertices; "
           "pin both ends of every cut with a correspondence mark (data-corr) in every drawing, "
           "or mark the corners around them"));
+    }
+  }
+
+  // A mark beside another breakpoint (kMarkSliverRelative) is named here rather than left to
+  // fail in the mesher as a cusp of some drawing.
+  for (size_t m = 0; m < mark_at.size(); ++m) {
+    const auto [g, at0] = mark_at[m];
+    const std::vector<double>& b = breaks[g];
+    if (b.size() < 2) continue;
+    const double t = Wrap01((at0 - marks_on[g][0].first) / curve(0, g).length());
+    size_t i = 0;
+    double best = 2.0;
+    for (size_t j = 0; j < b.size(); ++j) {
+      const double gap = std::abs(b[j] - t);
+      if (std::min(gap, 1.0 - gap) < best) best = std::min(gap, 1.0 - gap), i = j;
+    }
+    const double t_prev = i > 0 ? b[i - 1] : b.back() - 1.0;
+    const double t_next = i + 1 < b.size() ? b[i + 1] : b[0] + 1.0;
+    for (int d = 0; d < num_shapes; ++d) {
+      const Param& p = param[d][g];
+      const double here = p.Forward(b[i]);
+      const double before =
+          here - (t_prev < 0 ? p.Forward(t_prev + 1.0) - p.length : p.Forward(t_prev));
+      const double after =
+          (t_next > 1.0 ? p.Forward(t_next - 1.0) + p.length : p.Forward(t_next)) - here;
+      const double shortest = std::min(before, after);
+      if (shortest < kMarkSliverRelative * scale[d]) {
+        const Point at = curve(d, g).At(here);
+        return absl::InvalidArgumentError(absl::StrCat(
+            "drawing ", d + 1, ": correspondence mark ", m + 1, " at (", at.x(), ", ", at.y(),
+            ") sits ", shortest,
+            " from another breakpoint of its boundary (a corner of some "
+            "drawing or another mark), too close to keep apart; move the mark onto that corner "
+            "or away from it"));
+      }
     }
   }
 
@@ -1131,6 +1321,36 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
   }
   for (int i = 0; i < num_intervals; ++i) count[i] = class_count[classes.Find(i)];
 
+  // Each interval's vertices as common parameters: `count` evenly spaced, then (with a
+  // tolerance, and no fixed vertex count) refined until every drawing's polyline lies within the
+  // tolerance of its outline (RefineToTolerance). Intervals of a cut or opening keep the even
+  // spacing, which their twins repeat.
+  std::vector<std::vector<double>> interval_t(num_intervals);
+  std::vector<bool> has_twin(num_intervals, false);
+  for (int d = 0; d < num_shapes; ++d) {
+    for (int i = 0; i < num_intervals; ++i) has_twin[i] = has_twin[i] || twin_interval[d][i] >= 0;
+  }
+  const bool refine = options.tolerance > 0.0 && options.vertices <= 0;
+  for (int i = 0; i < num_intervals; ++i) out.base_vertices += count[i];
+  for (int g = 0; g < num_groups; ++g) {
+    for (int i = 0; i < static_cast<int>(breaks[g].size()); ++i) {
+      const int gi = interval_start[g] + i;
+      const double t0 = breaks[g][i], t1 = interval_end_t(g, i);
+      std::vector<double>& ts = interval_t[gi];
+      for (int k = 0; k < count[gi]; ++k) ts.push_back(t0 + (t1 - t0) * k / count[gi]);
+      if (!refine || has_twin[gi]) continue;
+      std::vector<const Curve*> cs;
+      std::vector<const Param*> ps;
+      std::vector<double> tol;
+      for (int d = 0; d < num_shapes; ++d) {
+        cs.push_back(&curve(d, g)), ps.push_back(&param[d][g]);
+        tol.push_back(options.tolerance * scale[d]);
+      }
+      ts = RefineToTolerance(ts, t1, cs, ps, tol);
+      count[gi] = static_cast<int>(ts.size());
+    }
+  }
+
   // Vertex numbering and sampling.
   std::vector<int> first_vertex(num_intervals + 1, 0);
   for (int i = 0; i < num_intervals; ++i) first_vertex[i + 1] = first_vertex[i] + count[i];
@@ -1144,10 +1364,16 @@ absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(
     for (int g = 0; g < num_groups; ++g) {
       for (int i = 0; i < static_cast<int>(breaks[g].size()); ++i) {
         const int gi = interval_start[g] + i;
-        const double a0 = param[d][g].Forward(breaks[g][i]);
-        const double a1 = param[d][g].Forward(interval_end_t(g, i));
+        // Uniform in the common parameter, through the drawing's parameterization: arc length
+        // between breakpoints where that is linear (marks), the alignment's map otherwise.
+        const double t1 = interval_end_t(g, i);
         for (int k = 0; k < count[gi]; ++k) {
-          flat[first_vertex[gi] + k] = curve(d, g).At(a0 + (a1 - a0) * k / count[gi]);
+          const double a0 = param[d][g].Forward(interval_t[gi][k]);
+          flat[first_vertex[gi] + k] = curve(d, g).At(a0);
+          const double a1 = param[d][g].Forward(k + 1 < count[gi] ? interval_t[gi][k + 1] : t1);
+          double far;
+          out.achieved_tolerance = std::max(out.achieved_tolerance,
+                                            ChordDeviation(curve(d, g), a0, a1, &far) / scale[d]);
         }
       }
     }

@@ -37,6 +37,22 @@ struct BoundaryCorrespondenceOptions {
   // aligned start. BuildMultimesh turns it on when the arc-length correspondence cannot be built
   // or mapped (MultimeshOptions::corner_matching).
   bool match_corners = false;
+  // How a loop without marks (and without matched corners, above) is paired with drawing 1's:
+  // kArcLength: arc length from the automatic start; kFeatures: the feature alignment of
+  // loop_alignment.h (corner onto corner, turning onto turning, stretching penalized), drawing
+  // 1's loop carried into the other drawing's frame as for the start.
+  enum class Alignment { kArcLength, kFeatures };
+  Alignment alignment = Alignment::kArcLength;
+  // Outline tolerance, relative to each drawing's bounding-box diagonal: the vertices per
+  // interval between breakpoints (spread evenly in the common parameter, `vertices` or the
+  // automatic budget) are refined, every drawing at once, until in every drawing the polyline
+  // lies within the tolerance of the drawing's outline (Hausdorff, both ways: the outline between
+  // two vertices strays at most this far from their chord). A rounded tip drawn with many small
+  // turns, which no single turn marks as a corner, keeps its shape. The vertices are common
+  // parameters, so the correspondence between drawings is the one chosen above; an interval gets
+  // what the drawing that needs most needs. 0, or a fixed `vertices`: no refinement. Intervals on
+  // a cut or opening keep the even spacing.
+  double tolerance = 0.0;
 };
 
 // Loops are matched as follows (documented default; pairs set by marks are kept, and the rest
@@ -58,7 +74,8 @@ struct BoundaryCorrespondenceOptions {
 // right map. Without marks, each loop gets the cyclic shift that best matches drawing
 // 1's loop in normalised turning angle and position over arc length, its component's map (if
 // any) carrying drawing 1's loop first (orientation is fixed: the drawing is on the left of
-// every loop).
+// every loop); with Alignment::kFeatures, loops that no component's map carried are then paired
+// by the feature alignment (loop_alignment.h), that start one of the starts it tries.
 struct BoundaryCorrespondence {
   // Loop g's vertices are the global indices loop_start[g] .. loop_start[g + 1] - 1; edge e joins
   // vertex e to the next vertex of its loop.
@@ -74,6 +91,12 @@ struct BoundaryCorrespondence {
   std::vector<int> mark_vertices;
   // Loops parameterized by matched corners (BoundaryCorrespondenceOptions::match_corners).
   int corner_matched_loops = 0;
+  // The farthest any drawing's outline strays from its loops' chords, relative to the drawing's
+  // bounding-box diagonal (the tolerance achieved).
+  double achieved_tolerance = 0.0;
+  // Boundary vertices before the refinement to the tolerance (the even sampling's budget): the
+  // spacing that sizes the interior mesh, so that a few refined tips do not refine it all.
+  int base_vertices = 0;
   int num_loops() const { return static_cast<int>(loop_start.size()) - 1; }
   int num_vertices() const { return loop_start.back(); }
 };

@@ -447,6 +447,11 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
   correspondence_options.vertices = options.boundary_vertices;
   correspondence_options.corner_angle_degrees = options.corner_angle_degrees;
   correspondence_options.match_corners = match_corners;
+  correspondence_options.alignment =
+      options.correspondence == MultimeshOptions::Correspondence::kFeatures
+          ? BoundaryCorrespondenceOptions::Alignment::kFeatures
+          : BoundaryCorrespondenceOptions::Alignment::kArcLength;
+  correspondence_options.tolerance = options.boundary_tolerance;
   correspondence_options.marks = options.marks;
   if (options.marks.empty()) {
     absl::StatusOr<std::vector<std::vector<Point>>> drawn = MarksFromDrawings(drawings);
@@ -524,13 +529,12 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
         perimeter += (loop[(i + 1) % loop.size()] - loop[i]).norm();
       }
     }
-    triangulate_options.max_edge = options.max_edge_relative > 0
-                                       ? options.max_edge_relative * (hi - lo).norm()
-                                       // about the even sampling's spacing (the refinement
-                                       // to the outline tolerance adds vertices at tips only)
-                                       : 1.5 * perimeter / std::max(1, bc->base_vertices > 0
-                                                                           ? bc->base_vertices
-                                                                           : num_edges);
+    triangulate_options.max_edge =
+        options.max_edge_relative > 0
+            ? options.max_edge_relative * (hi - lo).norm()
+            // about the even sampling's spacing (the refinement
+            // to the outline tolerance adds vertices at tips only)
+            : 1.5 * perimeter / std::max(1, bc->base_vertices > 0 ? bc->base_vertices : num_edges);
   }
   absl::StatusOr<DomainTriangulation> triangulation =
       CgalTriangulateDomain(bc->shapes[ref], triangulate_options);

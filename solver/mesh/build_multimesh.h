@@ -38,6 +38,17 @@ struct MultimeshOptions {
   // the corners matched).
   enum class CornerMatching { kNever, kWhenArcLengthFails, kAlways };
   CornerMatching corner_matching = CornerMatching::kWhenArcLengthFails;
+  // How loops without marks are paired (BoundaryCorrespondenceOptions::alignment): kFeatures,
+  // the default, by the feature alignment of solver/geometry/loop_alignment.h (corner onto
+  // corner, stretching penalized: a bar bent into a half ring bends instead of sliding its
+  // material round the corners, docs/benchmarks.md "correspondence"); kArcLength by arc length
+  // from the automatic start, as before. Marks and corner matching (above) win over both.
+  enum class Correspondence { kArcLength, kFeatures };
+  Correspondence correspondence = Correspondence::kFeatures;
+  // Outline tolerance (BoundaryCorrespondenceOptions::tolerance), relative to each drawing's
+  // bounding-box diagonal: every key's boundary lies within it of its drawing's outline (0.1% by
+  // default). 0: the even sampling alone. A fixed boundary_vertices wins over it.
+  double boundary_tolerance = 1e-3;
   // Bound on the vertices of the initial mesh (TriangulateOptions::max_vertices); above it the
   // build is RESOURCE_EXHAUSTED instead of refining (practically) forever.
   int max_mesh_vertices = 2'000'000;
@@ -70,6 +81,11 @@ struct MultimeshReport {
   // Boundary loops (groups of corresponding loops) whose correspondence matched corners to
   // corners (MultimeshOptions::corner_matching); 0 when arc length (or marks) gave it.
   int corner_matched_loops = 0;
+  // Boundary vertices of each loop (Multimesh::boundary_loops), and the farthest any drawing's
+  // outline strays from its loops, relative to the drawing's bounding-box diagonal
+  // (MultimeshOptions::boundary_tolerance is the bound asked for).
+  std::vector<int> loop_vertices;
+  double achieved_tolerance = 0.0;
   // Drawings (components) reached by the overlay of MultimeshOptions::overlay; 0 when every map
   // was found directly.
   int overlays = 0;

@@ -58,6 +58,9 @@ class CornerMatchingServiceTest : public ServerTest {
     request.set_session_id(session_.id());
     request.set_expected_version(session_.version());
     request.mutable_meshing()->set_corner_matching(matching);
+    // Corner matching is the fallback of the arc-length correspondence, which this pins (the
+    // feature alignment, the default, pairs the arrowhead's corners at the first attempt).
+    request.mutable_meshing()->set_boundary_alignment(v1::BOUNDARY_ALIGNMENT_ARC_LENGTH);
     auto reader = stub_->BuildMultimesh(&context, request);
     v1::BuildMultimeshResponse message;
     while (reader->Read(&message)) {

@@ -80,6 +80,35 @@ TEST(ParametersTest, CornerMatchingIsCheckedAndReachesTheBuilder) {
   EXPECT_THAT(std::string(s.message()), HasSubstr("meshing.corner_matching = 17"));
 }
 
+TEST(ParametersTest, BoundaryToleranceAndAlignmentAreCheckedAndReachTheBuilder) {
+  using Correspondence = solver::MultimeshOptions::Correspondence;
+  v1::MeshingParameters m;
+  // Unset: the solver's defaults (0.1% of the diagonal, the feature alignment).
+  EXPECT_DOUBLE_EQ(ToMultimeshOptions(m).boundary_tolerance,
+                   solver::MultimeshOptions().boundary_tolerance);
+  EXPECT_EQ(ToMultimeshOptions(m).correspondence, Correspondence::kFeatures);
+  m.set_boundary_tolerance(0.0);  // the even sampling alone
+  ASSERT_TRUE(ValidateMeshing(m, "meshing").ok());
+  EXPECT_DOUBLE_EQ(ToMultimeshOptions(m).boundary_tolerance, 0.0);
+  m.set_boundary_tolerance(5e-4);
+  ASSERT_TRUE(ValidateMeshing(m, "meshing").ok());
+  EXPECT_DOUBLE_EQ(ToMultimeshOptions(m).boundary_tolerance, 5e-4);
+  m.set_boundary_tolerance(0.5);
+  EXPECT_THAT(std::string(ValidateMeshing(m, "meshing").message()),
+              HasSubstr("meshing.boundary_tolerance"));
+  m.set_boundary_tolerance(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(ValidateMeshing(m, "meshing").code(), absl::StatusCode::kInvalidArgument);
+  m.clear_boundary_tolerance();
+  m.set_boundary_alignment(v1::BOUNDARY_ALIGNMENT_ARC_LENGTH);
+  ASSERT_TRUE(ValidateMeshing(m, "meshing").ok());
+  EXPECT_EQ(ToMultimeshOptions(m).correspondence, Correspondence::kArcLength);
+  m.set_boundary_alignment(v1::BOUNDARY_ALIGNMENT_FEATURES);
+  EXPECT_EQ(ToMultimeshOptions(m).correspondence, Correspondence::kFeatures);
+  m.set_boundary_alignment(static_cast<v1::BoundaryAlignment>(9));
+  EXPECT_THAT(std::string(ValidateMeshing(m, "meshing").message()),
+              HasSubstr("meshing.boundary_alignment = 9"));
+}
+
 TEST(ParametersTest, OutlineCornerDegreesIsCheckedAndReachesTheOptimizer) {
   v1::ComeshParameters c;
   EXPECT_TRUE(ToComeshOptions(c).slide_outline);  // unset: the solver's default, 25 degrees

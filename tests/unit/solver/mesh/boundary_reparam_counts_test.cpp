@@ -290,6 +290,9 @@ absl::StatusOr<Stage> Correspond(const std::vector<Drawing>& drawings,
   options.vertices = vertices;
   options.marks = marks;
   options.match_corners = match_corners;
+  // As BuildMultimesh passes them by default (the multimesh's loops are checked against this).
+  options.tolerance = MultimeshOptions().boundary_tolerance;
+  options.alignment = BoundaryCorrespondenceOptions::Alignment::kFeatures;
   absl::StatusOr<BoundaryCorrespondence> bc = ComputeBoundaryCorrespondence(out.graphs, options);
   if (!bc.ok()) return bc.status();
   out.bc = *std::move(bc);

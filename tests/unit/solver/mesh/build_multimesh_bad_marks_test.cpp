@@ -43,5 +43,33 @@ TEST(BuildMultimeshBadMarksTest, MarkSlightlyOffTheBoundaryStillPins) {
   EXPECT_TRUE(m.ok()) << m.status();
 }
 
+// A mark computed by a program lands a hair off the drawn corner (an SVG written with four
+// decimals): it snaps onto the corner instead of splitting the boundary into a sliver interval
+// beside the corner's own breakpoint, which every drawing would repeat (the mesher refused the
+// sliver as a cusp of the other drawing).
+TEST(BuildMultimeshBadMarksTest, MarkAHairOffACornerSnapsOntoIt) {
+  const Points arrow = {{0, 40}, {220, 40}, {220, 0}, {320, 70}, {220, 140}, {220, 100}, {0, 100}};
+  Points longer;
+  for (const Point& p : arrow) longer.emplace_back(p.x() < 200 ? p.x() : p.x() + 60.0, p.y());
+  Drawing a, b;
+  a.outlines = {{arrow}};
+  b.outlines = {{longer}};
+  for (size_t k = 0; k < arrow.size(); ++k) {
+    const int id = static_cast<int>(k) + 1;
+    a.marks.push_back({id, arrow[k]});
+    b.marks.push_back({id, longer[k]});
+  }
+  // The tip's mark 5e-5 units off the corner, along the side into it.
+  a.marks[3].point += Point(-5e-5, -3.5e-5);
+  absl::StatusOr<Multimesh> m = BuildMultimesh({a, b}, {});
+  ASSERT_TRUE(m.ok()) << m.status();
+  bool tip = false;
+  for (int v : m->pinned) {
+    tip = tip || ((m->shapes[0][v] - arrow[3]).norm() < 1e-9 &&
+                  (m->shapes[1][v] - longer[3]).norm() < 1e-9);
+  }
+  EXPECT_TRUE(tip) << "the tip's mark is not on the corner";
+}
+
 }  // namespace
 }  // namespace inbetween::solver

@@ -61,6 +61,7 @@ TEST(BuildMultimeshCutEndsTest, SlitsEndingAtDifferentPlacesAreRefusedWithWhatTo
       SlitSquare(5.9, 0.8, 4.1, true), SlitSquare(3.8, 0.1, 7.7, true)};
   MultimeshOptions arc_length;
   arc_length.corner_matching = MultimeshOptions::CornerMatching::kNever;
+  arc_length.correspondence = MultimeshOptions::Correspondence::kArcLength;
   const absl::StatusOr<Multimesh> mesh = BuildMultimesh(drawings, arc_length);
   ASSERT_FALSE(mesh.ok()) << mesh->shapes[0].size() << " vertices";
   EXPECT_EQ(mesh.status().code(), absl::StatusCode::kInvalidArgument) << mesh.status();
@@ -70,11 +71,17 @@ TEST(BuildMultimeshCutEndsTest, SlitsEndingAtDifferentPlacesAreRefusedWithWhatTo
   // corner to corner (the slit mouth is not the loop's start, so this needs the matched corners'
   // arcs measured from the first matched corner, not from the loop's start), and builds.
   MultimeshReport report;
+  MultimeshOptions fallback;
+  fallback.correspondence = MultimeshOptions::Correspondence::kArcLength;
   const absl::StatusOr<Multimesh> matched =
-      BuildMultimesh(drawings, {}, nullptr, nullptr, &report);
+      BuildMultimesh(drawings, fallback, nullptr, nullptr, &report);
   ASSERT_TRUE(matched.ok()) << matched.status();
   EXPECT_TRUE(ValidateMultimesh(*matched).ok()) << ValidateMultimesh(*matched);
   EXPECT_EQ(report.corner_matched_loops, 1);
+  // The feature alignment (the default) pairs the mouths and tips at the first attempt.
+  const absl::StatusOr<Multimesh> aligned = BuildMultimesh(drawings, {});
+  ASSERT_TRUE(aligned.ok()) << aligned.status();
+  EXPECT_TRUE(ValidateMultimesh(*aligned).ok()) << ValidateMultimesh(*aligned);
 }
 
 // The same slits in squares: matched by arc length they are refused like the rounded ones
@@ -85,16 +92,20 @@ TEST(BuildMultimeshCutEndsTest, SlitsInSquaresBuildOnceTheCornersAreMatched) {
                                          SlitSquare(5.9, 0.8, 4.1), SlitSquare(3.8, 0.1, 7.7)};
   MultimeshOptions arc_length;
   arc_length.corner_matching = MultimeshOptions::CornerMatching::kNever;
+  arc_length.correspondence = MultimeshOptions::Correspondence::kArcLength;
   const absl::StatusOr<Multimesh> refused = BuildMultimesh(drawings, arc_length);
   ASSERT_FALSE(refused.ok());
   EXPECT_THAT(refused.status().message(), HasSubstr("pin both ends of every cut"));
   std::vector<std::string> details;
   std::vector<double> fractions;
-  const absl::StatusOr<Multimesh> mesh = BuildMultimesh(
-      drawings, {}, nullptr, [&](const std::string&, double fraction, const std::string& detail) {
-        details.push_back(detail);
-        fractions.push_back(fraction);
-      });
+  MultimeshOptions fallback;
+  fallback.correspondence = MultimeshOptions::Correspondence::kArcLength;
+  const absl::StatusOr<Multimesh> mesh =
+      BuildMultimesh(drawings, fallback, nullptr,
+                     [&](const std::string&, double fraction, const std::string& detail) {
+                       details.push_back(detail);
+                       fractions.push_back(fraction);
+                     });
   ASSERT_TRUE(mesh.ok()) << mesh.status();
   EXPECT_TRUE(ValidateMultimesh(*mesh).ok()) << ValidateMultimesh(*mesh);
   EXPECT_FALSE(mesh->cohesive_edges.empty());

@@ -211,9 +211,16 @@ TEST(ValidateRejectsTest, TriangleOverlappingItsNeighbours) {
     const int t = InteriorTriangle(m);
     if (!with_loops) m.boundary_loops.clear();
     const Triangle tri = m.triangles[t];
+    // Its other two edges must be new, so that a-b is the edge the validator names (which
+    // vertex comes first depends on the mesh).
+    std::set<std::pair<int, int>> directed;
+    for (const Triangle& u : m.triangles) {
+      for (int k = 0; k < 3; ++k) directed.insert({u[k], u[(k + 1) % 3]});
+    }
     int extra = -1;
     for (int c = 0; c < m.num_vertices() && extra < 0; ++c) {
       if (c == tri[0] || c == tri[1] || c == tri[2]) continue;
+      if (directed.count({tri[1], c}) || directed.count({c, tri[0]})) continue;
       bool positive = true;
       for (const Points& x : m.shapes)
         positive = positive && SignedArea2({tri[0], tri[1], c}, x) > 0;
