@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -55,19 +57,30 @@ std::vector<double> EdgeCrossings(const Point& p, const Point& q,
 // piece between two feet then follows the boundary edge between the two vertices.
 class BoundaryFeet {
  public:
+  // Boundary edges are the directed triangle edges whose reverse is no triangle's edge (the
+  // sides of cuts and openings included), so no boundary loops are needed.
   BoundaryFeet(const Multimesh& mesh, const Points& x) : x_(x) {
-    for (const std::vector<int>& loop : mesh.boundary_loops) {
-      const size_t n = loop.size();
-      for (size_t i = 0; i < n && n >= 3; ++i) {
-        const Point& v = x[loop[i]];
-        const double reach = 0.25 * std::min((v - x[loop[(i + n - 1) % n]]).norm(),
-                                             (v - x[loop[(i + 1) % n]]).norm());
-        vertices_.push_back({v.x(), loop[i], reach});
-        max_reach_ = std::max(max_reach_, reach);
-      }
+    std::vector<std::pair<int, int>> edges;
+    edges.reserve(3 * mesh.triangles.size());
+    for (const Triangle& t : mesh.triangles) {
+      for (int k = 0; k < 3; ++k) edges.emplace_back(t[k], t[(k + 1) % 3]);
     }
-    std::sort(vertices_.begin(), vertices_.end(),
-              [](const Entry& a, const Entry& b) { return a.x < b.x; });
+    std::sort(edges.begin(), edges.end());
+    std::vector<double> reach(x.size(), std::numeric_limits<double>::infinity());
+    for (const auto& [a, b] : edges) {
+      if (std::binary_search(edges.begin(), edges.end(), std::make_pair(b, a))) continue;
+      const double length = (x[a] - x[b]).norm();
+      reach[a] = std::min(reach[a], 0.25 * length);
+      reach[b] = std::min(reach[b], 0.25 * length);
+    }
+    for (size_t v = 0; v < x.size(); ++v) {
+      if (!std::isfinite(reach[v])) continue;
+      vertices_.push_back({x[v].x(), static_cast<int>(v), reach[v]});
+      max_reach_ = std::max(max_reach_, reach[v]);
+    }
+    std::sort(vertices_.begin(), vertices_.end(), [](const Entry& a, const Entry& b) {
+      return a.x < b.x || (a.x == b.x && a.vertex < b.vertex);
+    });
   }
 
   // Parameters t in (min_gap, 1 - min_gap) on pq of the feet of boundary vertices within reach.

@@ -9,8 +9,7 @@
 //    inside a triangle. A segment running along the boundary (on it, or a little outside, as a
 //    fill whose outline is the drawing's outline) crosses no edge there; it is also split at the
 //    foot of each boundary vertex it passes within a quarter of that vertex's shorter boundary
-//    edge, so it follows the boundary where a frame bends it (Multimesh::boundary_loops; none
-//    without them).
+//    edge, so it follows the boundary where a frame bends it.
 //  - A point inside no triangle (art a little outside the mesh: on a curved outline, outside the
 //    chords between boundary vertices, or paint within the import's gap tolerance) rides the
 //    nearest triangle, with its barycentric coordinates extrapolated (some negative).
