@@ -24,6 +24,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "server/inbetween_server.h"
+#include "tests/unit/server/many_layers_svg.h"
 
 namespace inbetween::client {
 namespace {
@@ -299,24 +300,6 @@ TEST_F(InbetweenClientFailoverTest, BrokenBuildIsSentAgainAndBuildsTheSameMultim
   EXPECT_TRUE(retries_.empty());
 }
 
-// A drawing of `n` small filled discs moved by `dx`, each its own layer drawn as a polygon of
-// 120 points: art far larger than one message.
-std::string ManyLayersSvg(int n, double dx) {
-  std::string body;
-  for (int i = 0; i < n; ++i) {
-    const double cx = dx + (i % 50) * 4.0 + 1.75, cy = (i / 50) * 4.0 + 1.75;
-    body += "<polygon points=\"";
-    for (int j = 0; j < 120; ++j) {
-      const double a = 2 * M_PI * j / 120;
-      body += absl::StrFormat("%.3f,%.3f ", cx + 1.7 * std::cos(a), cy + 1.7 * std::sin(a));
-    }
-    body += absl::StrFormat(R"(" fill="#%06x"/>)", (i * 40503u) & 0xffffff);
-  }
-  return absl::StrCat(R"(<svg xmlns="http://www.w3.org/2000/svg" viewBox="-10 -10 230 190">)",
-                      R"(<rect x="-2" y="-2" width="204" height="164" fill="#eeeeee"/>)", body,
-                      "</svg>");
-}
-
 // The art that follows the header in messages of its own is appended to the header's, also when
 // the connection breaks in the middle of it.
 TEST_F(InbetweenClientFailoverTest, ArtMessagesAreAppendedToTheHeaderAcrossABrokenStream) {
@@ -326,7 +309,7 @@ TEST_F(InbetweenClientFailoverTest, ArtMessagesAreAppendedToTheHeaderAcrossABrok
     v1::PutDrawingRequest request;
     request.set_session_id(session->id());
     request.set_expected_version(session->version());
-    request.mutable_drawing()->set_svg(ManyLayersSvg(2000, dx));
+    request.mutable_drawing()->set_svg(server::testing::ManyLayersSvg(2000, dx));
     auto put = direct_->PutDrawing(request);
     ASSERT_TRUE(put.ok()) << put.status();
     *session = put->session();

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "tests/unit/server/many_layers_svg.h"
 #include "server/parameters.h"
 #include "server/proto_convert.h"
 #include "solver/comesh/comesh_topology.h"
@@ -929,24 +930,6 @@ TEST_F(InbetweenServiceTest, OptimizeEmbedsTheArtAgainAndExportsKeepIt) {
     EXPECT_EQ(copy.multimesh().art(k).SerializeAsString(),
               optimized.multimesh().art(k).SerializeAsString());
   }
-}
-
-// A drawing of `n` small filled discs moved by `dx`, each its own layer drawn as a polygon of
-// 120 points: art of about 3 MiB per key in mesh coordinates.
-std::string ManyLayersSvg(int n, double dx) {
-  std::string body;
-  for (int i = 0; i < n; ++i) {
-    const double cx = dx + (i % 50) * 4.0 + 1.75, cy = (i / 50) * 4.0 + 1.75;
-    body += "<polygon points=\"";
-    for (int j = 0; j < 120; ++j) {
-      const double a = 2 * M_PI * j / 120;
-      absl::StrAppendFormat(&body, "%.3f,%.3f ", cx + 1.7 * std::cos(a), cy + 1.7 * std::sin(a));
-    }
-    absl::StrAppendFormat(&body, R"(" fill="#%06x"/>)", (i * 2654435761u) & 0xffffff);
-  }
-  return absl::StrCat(R"(<svg xmlns="http://www.w3.org/2000/svg" viewBox="-10 -10 230 190">)",
-                      R"(<rect x="-2" y="-2" width="204" height="164" fill="#eeeeee"/>)", body,
-                      "</svg>");
 }
 
 TEST_F(InbetweenServiceTest, LargeArtFollowsTheHeaderInMessagesUnderOneMebibyte) {
