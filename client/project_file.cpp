@@ -152,11 +152,32 @@ absl::StatusOr<v1::CornerMatching> CornerMatchingFromName(const Node& node) {
                                  "' (when_arc_length_fails, never, always)"));
 }
 
+// meshing.boundary_alignment's names, indexed by v1::BoundaryAlignment (0: unspecified).
+constexpr const char* kBoundaryAlignments[] = {"features", "features", "arc_length"};
+
+absl::StatusOr<v1::BoundaryAlignment> BoundaryAlignmentFromName(const Node& node) {
+  PROJECT_ASSIGN_OR_RETURN(name, node.String());
+  for (int k = v1::BOUNDARY_ALIGNMENT_FEATURES; k <= v1::BOUNDARY_ALIGNMENT_ARC_LENGTH; ++k) {
+    if (name == kBoundaryAlignments[k]) return static_cast<v1::BoundaryAlignment>(k);
+  }
+  return node.Error(
+      absl::StrCat("unknown boundary alignment '", name, "' (features, arc_length)"));
+}
+
 absl::Status ParseMeshing(const Node& node, v1::MeshingParameters* out) {
-  if (absl::Status s = node.CheckKeys(
-          {"boundary_vertices", "max_edge_relative", "shape_bound", "corner_matching"});
+  if (absl::Status s = node.CheckKeys({"boundary_vertices", "max_edge_relative", "shape_bound",
+                                       "corner_matching", "boundary_tolerance",
+                                       "boundary_alignment"});
       !s.ok()) {
     return s;
+  }
+  if (node.Has("boundary_tolerance")) {
+    PROJECT_ASSIGN_OR_RETURN(v, node.Child("boundary_tolerance").Number(0.0, 0.1));
+    out->set_boundary_tolerance(v);
+  }
+  if (node.Has("boundary_alignment")) {
+    PROJECT_ASSIGN_OR_RETURN(v, BoundaryAlignmentFromName(node.Child("boundary_alignment")));
+    out->set_boundary_alignment(v);
   }
   if (node.Has("boundary_vertices")) {
     PROJECT_ASSIGN_OR_RETURN(v, node.Child("boundary_vertices").Integer(8, 100000));
@@ -506,6 +527,11 @@ json ProjectToJson(const Project& project, const std::filesystem::path& base_dir
   if (m.corner_matching() != v1::CORNER_MATCHING_UNSPECIFIED &&
       v1::CornerMatching_IsValid(m.corner_matching())) {
     meshing["corner_matching"] = kCornerMatchings[m.corner_matching()];
+  }
+  if (m.has_boundary_tolerance()) meshing["boundary_tolerance"] = m.boundary_tolerance();
+  if (m.boundary_alignment() != v1::BOUNDARY_ALIGNMENT_UNSPECIFIED &&
+      v1::BoundaryAlignment_IsValid(m.boundary_alignment())) {
+    meshing["boundary_alignment"] = kBoundaryAlignments[m.boundary_alignment()];
   }
   if (!meshing.empty()) doc["meshing"] = std::move(meshing);
   const v1::ComeshParameters& c = project.parameters.comesh();

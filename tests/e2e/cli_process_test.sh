@@ -79,14 +79,20 @@ report = json.load(open(os.path.join(sys.argv[1], "report.json")))
 assert report["corner_matched_loops"] == 1, report
 PY
 
-# Two concave quadrilaterals neither of whose meshes maps onto the other: built by the overlay,
-# which stderr and report.json say, and optimized into a valid multimesh.
+# Two concave quadrilaterals neither of whose meshes maps onto the other when paired by arc
+# length with the even sampling (the project's meshing settings; the feature alignment pairs
+# them so that they map directly): built by the overlay, which stderr and report.json say, and
+# optimized into a valid multimesh.
 for q in "24.30 18.73 L28.52 28.64 L23.79 23.94 L5.13 -8.66" \
          "30.24 37.81 L20.55 29.14 L21.83 44.12 L-4.56 6.21"; do
   n=$(( ${n:-0} + 1 ))
   echo "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"-10 -10 50 60\"><path d=\"M$q Z\"/></svg>" > quad$n.svg
 done
-"$CLI_BIN" optimize quad1.svg quad2.svg --out overlay_out 2> overlay.err >/dev/null
+cat > overlay.json <<JSON
+{"version": 1, "drawings": ["quad1.svg", "quad2.svg"],
+ "meshing": {"boundary_alignment": "arc_length", "boundary_tolerance": 0}}
+JSON
+"$CLI_BIN" optimize --project overlay.json --out overlay_out 2> overlay.err >/dev/null
 grep -q "1 overlaid with a triangulation of the drawing" overlay.err || { cat overlay.err; exit 1; }
 python3 - overlay_out <<'PY'
 import json, os, sys

@@ -98,6 +98,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{R"({"version": 1, "drawings": ["a", "b"],
                     "meshing": {"corner_matching": "sometimes"}})",
                 "$.meshing.corner_matching: unknown corner matching 'sometimes'"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"],
+                    "meshing": {"boundary_alignment": "by eye"}})",
+                "$.meshing.boundary_alignment: unknown boundary alignment 'by eye'"},
+        BadCase{R"({"version": 1, "drawings": ["a", "b"],
+                    "meshing": {"boundary_tolerance": 0.5}})",
+                "$.meshing.boundary_tolerance"},
         BadCase{R"({"version": 1, "drawings": ["a", {"file": "b", "cuts": [[[0,0]]]}]})",
                 "$.drawings[1].cuts[0]: needs at least 2 points"},
         BadCase{R"({"version": 1, "drawings": ["a", "b"], "correspondences": [[[0,0]]]})",
@@ -119,6 +125,25 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{R"({"version": 1, "drawings": [{"file": "a", "key_time": 0},
                     {"file": "b", "key_time": 0.5}]})",
                 "$.drawings: key_time: the first time must be 0 and the last 1"}));
+
+TEST(ProjectFileTest, BoundaryAlignmentAndToleranceRoundTrip) {
+  for (const char* name : {"features", "arc_length"}) {
+    json doc = Minimal();
+    doc["meshing"] = {{"boundary_alignment", name}, {"boundary_tolerance", 0.002}};
+    auto p = ParseProject(doc, "/base");
+    ASSERT_TRUE(p.ok()) << p.status();
+    EXPECT_NE(p->parameters.meshing().boundary_alignment(), v1::BOUNDARY_ALIGNMENT_UNSPECIFIED);
+    EXPECT_DOUBLE_EQ(p->parameters.meshing().boundary_tolerance(), 0.002);
+    const json back = ProjectToJson(*p, "/base")["meshing"];
+    EXPECT_EQ(back["boundary_alignment"], name);
+    EXPECT_DOUBLE_EQ(back["boundary_tolerance"].get<double>(), 0.002);
+  }
+  // Unset stays unset (the server's defaults) and is not written.
+  auto p = ParseProject(Minimal(), "/base");
+  ASSERT_TRUE(p.ok()) << p.status();
+  EXPECT_FALSE(p->parameters.meshing().has_boundary_tolerance());
+  EXPECT_FALSE(ProjectToJson(*p, "/base").contains("meshing"));
+}
 
 TEST(ProjectFileTest, EveryCornerMatchingRoundTrips) {
   for (const char* name : {"when_arc_length_fails", "never", "always"}) {
