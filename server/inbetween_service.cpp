@@ -194,10 +194,8 @@ std::vector<v1::InbetweenResponse> AddKeyArt(const solver::Multimesh& mesh,
     header_bytes += 16;
     chunk = nullptr;  // each key starts its own art message
     for (const solver::EmbeddedLayer& layer : art.layers) {
-      solver::EmbeddedArt one{.key = art.key, .num_vertices = art.num_vertices, .layers = {layer}};
-      v1::KeyArt packed;
-      ToProto(one, &packed);
-      v1::EmbeddedArtLayer& proto_layer = *packed.mutable_layers(0);
+      v1::EmbeddedArtLayer proto_layer;
+      ToProto(layer, &proto_layer);
       const size_t bytes = field_bytes(proto_layer);
       if (!header_full && header_bytes + bytes <= kArtMessageBytes) {
         *in_header->add_layers() = std::move(proto_layer);

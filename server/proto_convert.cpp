@@ -173,21 +173,22 @@ void ToProto(const std::vector<solver::ArtLayer>& art,
 void ToProto(const solver::EmbeddedArt& art, inbetween::v1::KeyArt* out) {
   out->set_key(static_cast<uint32_t>(art.key));
   out->mutable_layers()->Reserve(static_cast<int>(art.layers.size()));
-  for (const solver::EmbeddedLayer& layer : art.layers) {
-    inbetween::v1::EmbeddedArtLayer* l = out->add_layers();
-    ToProto(layer.paint, l->mutable_paint());
-    l->mutable_paint()->clear_paths();
-    l->mutable_paths()->Reserve(static_cast<int>(layer.paths.size()));
-    for (const solver::EmbeddedPath& path : layer.paths) {
-      inbetween::v1::EmbeddedArtPath* p = l->add_paths();
-      p->mutable_triangles()->Reserve(static_cast<int>(path.points.size()));
-      p->mutable_barycentric()->Reserve(3 * static_cast<int>(path.points.size()));
-      for (const solver::EmbeddedPoint& point : path.points) {
-        p->add_triangles(static_cast<uint32_t>(point.triangle));
-        for (int c = 0; c < 3; ++c) p->add_barycentric(point.barycentric[c]);
-      }
-      p->set_closed(path.closed);
+  for (const solver::EmbeddedLayer& layer : art.layers) ToProto(layer, out->add_layers());
+}
+
+void ToProto(const solver::EmbeddedLayer& layer, inbetween::v1::EmbeddedArtLayer* out) {
+  ToProto(layer.paint, out->mutable_paint());
+  out->mutable_paint()->clear_paths();
+  out->mutable_paths()->Reserve(static_cast<int>(layer.paths.size()));
+  for (const solver::EmbeddedPath& path : layer.paths) {
+    inbetween::v1::EmbeddedArtPath* p = out->add_paths();
+    p->mutable_triangles()->Reserve(static_cast<int>(path.points.size()));
+    p->mutable_barycentric()->Reserve(3 * static_cast<int>(path.points.size()));
+    for (const solver::EmbeddedPoint& point : path.points) {
+      p->add_triangles(static_cast<uint32_t>(point.triangle));
+      for (int c = 0; c < 3; ++c) p->add_barycentric(point.barycentric[c]);
     }
+    p->set_closed(path.closed);
   }
 }
 

@@ -42,6 +42,7 @@ std::vector<solver::ArtLayer> FromProto(
 // A key's art embedded in the multimesh (InbetweenHeader.art): paint as in ToProto(ArtLayer)
 // without paths, each path's points packed as triangle indices and barycentric triples.
 void ToProto(const solver::EmbeddedArt& art, inbetween::v1::KeyArt* out);
+void ToProto(const solver::EmbeddedLayer& layer, inbetween::v1::EmbeddedArtLayer* out);
 // And back, for a mesh of `triangles` and `num_vertices` vertices (the inserted-point flags are
 // not carried: every point reads as drawn). Checks indices and sizes; errors are
 // INVALID_ARGUMENT naming `field`.
