@@ -10,6 +10,9 @@ deps_only=0
 web=$(cd "$(dirname "$0")/.." && pwd)
 cd "$web"
 command -v node >/dev/null || { echo "prepare: node not found (scripts/setup installs nodejs)" >&2; exit 1; }
+# package.json's engines (npm ci would only warn): Debian 12's nodejs 18 is the oldest supported.
+node -e 'process.exit(Number(process.versions.node.split(".")[0]) >= 18 ? 0 : 1)' ||
+  { echo "prepare: Node.js >= 18 needed, found $(node --version)" >&2; exit 1; }
 command -v npm >/dev/null || { echo "prepare: npm not found (scripts/setup installs npm)" >&2; exit 1; }
 ((deps_only)) || command -v protoc >/dev/null ||
   { echo "prepare: protoc not found (scripts/setup installs protobuf-compiler)" >&2; exit 1; }
