@@ -15,7 +15,13 @@ shaped like them) will do.
 
 import math
 from dataclasses import dataclass, field
-from typing import List, NamedTuple, Optional, Tuple
+from typing import Any, Callable, List, NamedTuple, Optional, Sequence, Tuple
+
+XY = Tuple[float, float]
+# An embedded art point: its triangle's vertices (a, b, c) and barycentric coordinates.
+Corner = Tuple[int, int, int, float, float, float]
+# A correspondence group's member: (key, layer index, normalized weight).
+Member = Tuple[int, int, float]
 
 # inbetween.v1 LineCap / LineJoin values (UNSPECIFIED and unknown values = butt / miter).
 _CAPS = {2: "round", 3: "square"}
@@ -79,12 +85,12 @@ class _KeyLayer:
 
     __slots__ = ("paint", "paths")
 
-    def __init__(self, paint, paths):
+    def __init__(self, paint: "Layer", paths: List[Tuple[bool, List[Corner]]]) -> None:
         self.paint = paint
         self.paths = paths
 
 
-def _paint(p):
+def _paint(p: Any) -> Layer:
     fill = stroke = None
     if p.HasField("fill"):
         fill = Fill(p.fill.rgb, p.fill.opacity, p.fill.even_odd)
@@ -95,7 +101,7 @@ def _paint(p):
     return Layer(p.id, p.name, p.opacity, fill, stroke)
 
 
-def _copy_paint(paint):
+def _copy_paint(paint: Layer) -> Layer:
     fill = Fill(**vars(paint.fill)) if paint.fill else None
     stroke = None
     if paint.stroke:
@@ -104,7 +110,7 @@ def _copy_paint(paint):
     return Layer(paint.id, paint.name, paint.opacity, fill, stroke)
 
 
-def _keys_from_header(header):
+def _keys_from_header(header: Any) -> List[List[_KeyLayer]]:
     """Per drawing (index = KeyArt.key) its layers, triangle indices resolved to vertices."""
     triangles = [(t.a, t.b, t.c) for t in header.triangles]
     count = max([k.key + 1 for k in header.art] + [len(header.keys)])
@@ -133,7 +139,7 @@ def _keys_from_header(header):
 # ------------------------------------------------------------------------------------------
 # Placement (art_embedding.h)
 
-def _place(corners, xy):
+def _place(corners: List[Corner], xy: Sequence[XY]) -> List[XY]:
     """b0 v[a] + b1 v[b] + b2 v[c] per point."""
     out = []
     for a, b, c, b0, b1, b2 in corners:
@@ -142,7 +148,7 @@ def _place(corners, xy):
     return out
 
 
-def _check_vertices(keys, xy):
+def _check_vertices(keys: List[List[_KeyLayer]], xy: Sequence[XY]) -> None:
     for k, layers in enumerate(keys):
         for layer in layers:
             for _, corners in layer.paths:
@@ -155,12 +161,12 @@ def _check_vertices(keys, xy):
 # ------------------------------------------------------------------------------------------
 # Morph of corresponding paths (blend_paths.h)
 
-def _norm(p, q):
+def _norm(p: Tuple[float, float], q: Tuple[float, float]) -> float:
     dx, dy = q[0] - p[0], q[1] - p[1]
     return math.sqrt(dx * dx + dy * dy)  # as Eigen's norm (not math.hypot)
 
 
-def _arc_length_parameters(path, closed):
+def _arc_length_parameters(path: List[XY], closed: bool) -> List[float]:
     n = len(path)
     params = [0.0] * n
     for i in range(1, n):
@@ -174,7 +180,7 @@ def _arc_length_parameters(path, closed):
     return params
 
 
-def _point_at_parameter(path, closed, params, u):
+def _point_at_parameter(path: List[XY], closed: bool, params: List[float], u: float) -> XY:
     n = len(path)
     if n == 1 or params[-1] == 0.0:
         return path[0]
@@ -198,7 +204,8 @@ def _point_at_parameter(path, closed, params, u):
     return (ax + t * (bx - ax), ay + t * (by - ay))
 
 
-def _blend_paths(paths, closed, weights, merge_fraction):
+def _blend_paths(paths: List[List[XY]], closed: bool, weights: List[float],
+                 merge_fraction: float) -> List[XY]:
     if len(paths) == 1:
         return paths[0]
     params = [_arc_length_parameters(p, closed) for p in paths]
@@ -226,12 +233,12 @@ def _blend_paths(paths, closed, weights, merge_fraction):
 # Which layers correspond (frame_art.cpp). A group member is (key, layer, weight), the weight
 # normalized over the active keys; a group has one member per active key, in key order.
 
-def _same_kind(a, b):
+def _same_kind(a: Layer, b: Layer) -> bool:
     return (a.fill is not None) == (b.fill is not None) and \
         (a.stroke is not None) == (b.stroke is not None)
 
 
-def _same_geometry(keys, group):
+def _same_geometry(keys: List[List[_KeyLayer]], group: List[Member]) -> bool:
     first = keys[group[0][0]][group[0][1]].paths
     for key, l, _ in group:
         paths = keys[key][l].paths
@@ -243,13 +250,13 @@ def _same_geometry(keys, group):
     return True
 
 
-def _compatible(a, b):
+def _compatible(a: _KeyLayer, b: _KeyLayer) -> bool:
     if not _same_kind(a.paint, b.paint) or len(a.paths) != len(b.paths):
         return False
     return all(p[0] == q[0] for p, q in zip(a.paths, b.paths))
 
 
-def _centroid(layer, xy):
+def _centroid(layer: _KeyLayer, xy: Sequence[XY]) -> XY:
     sx = sy = 0.0
     count = 0
     for _, corners in layer.paths:
@@ -260,13 +267,14 @@ def _centroid(layer, xy):
     return (sx / count, sy / count) if count else (sx, sy)
 
 
-def _align_layers(a, b, xy, named, max_cells):
+def _align_layers(a: List[_KeyLayer], b: List[_KeyLayer], xy: Sequence[XY],
+                  named: Callable[[_KeyLayer], bool], max_cells: float) -> List[int]:
     """The paint-order alignment of b's unnamed layers to a's: an index into b per layer of a,
     or -1 (frame_art.cpp AlignLayers; ties: pair, then skip a, then skip b)."""
     n, m = len(a), len(b)
     match = [-1] * n
 
-    def ok(i, j):
+    def ok(i: int, j: int) -> bool:
         return not named(a[i]) and not named(b[j]) and _compatible(a[i], b[j])
 
     if n * m > max_cells:
@@ -283,7 +291,7 @@ def _align_layers(a, b, xy, named, max_cells):
     ca = [_centroid(layer, xy) for layer in a]
     cb = [_centroid(layer, xy) for layer in b]
 
-    def score(i, j):
+    def score(i: int, j: int) -> float:
         if not ok(i, j):
             return 0.0
         p, q = a[i].paint, b[j].paint
@@ -317,12 +325,13 @@ def _align_layers(a, b, xy, named, max_cells):
     return match
 
 
-def _match_layers(keys, active, xy, options):
+def _match_layers(keys: List[List[_KeyLayer]], active: List[Tuple[int, float]],
+                  xy: Sequence[XY], options: FrameArtOptions) -> List[List[Member]]:
     """The morphing groups among ``active`` ((key, weight), keys ascending), ordered by their
     layer in the first active key (the backbone)."""
     groups = []
 
-    def named(layer):
+    def named(layer: _KeyLayer) -> bool:
         return options.match_by_name and layer.paint.name != ""
 
     if options.match_by_name:
@@ -357,12 +366,12 @@ def _match_layers(keys, active, xy, options):
 # ------------------------------------------------------------------------------------------
 # Morph of a group's paint (frame_art.cpp Morph)
 
-def _round_half_away(v):
+def _round_half_away(v: float) -> int:
     r = math.floor(v)
     return r + 1 if v - r >= 0.5 else r
 
 
-def _blend_rgb(colours):
+def _blend_rgb(colours: List[Tuple[int, float]]) -> int:
     """Per 8-bit channel, the weighted mean over (rgb, weight) pairs, rounded."""
     total = 0.0
     for _, w in colours:
@@ -376,7 +385,7 @@ def _blend_rgb(colours):
     return out
 
 
-def _heaviest(group, has):
+def _heaviest(group: List[Member], has: Callable[[Member], bool]) -> Optional[Member]:
     """The heaviest member for which ``has`` holds (ties: the lower key)."""
     best = None
     for m in group:
@@ -385,8 +394,9 @@ def _heaviest(group, has):
     return best
 
 
-def _morph_layer(keys, group, xy, options):
-    def layer_of(m):
+def _morph_layer(keys: List[List[_KeyLayer]], group: List[Member], xy: Sequence[XY],
+                 options: FrameArtOptions) -> Layer:
+    def layer_of(m: Member) -> _KeyLayer:
         return keys[m[0]][m[1]]
 
     top = _heaviest(group, lambda m: True)
@@ -404,7 +414,8 @@ def _morph_layer(keys, group, xy, options):
     return out
 
 
-def _morph_fill(group, layer_of):
+def _morph_fill(group: List[Member], layer_of: Callable[[Member], _KeyLayer]
+                ) -> Optional[Fill]:
     """Colour blended among the members that fill, opacity among all (a member without a fill
     counts as opacity 0, so it fades in)."""
     top = _heaviest(group, lambda m: layer_of(m).paint.fill is not None)
@@ -423,8 +434,9 @@ def _morph_fill(group, layer_of):
     return fill
 
 
-def _morph_stroke(group, layer_of):
-    def has(m):
+def _morph_stroke(group: List[Member], layer_of: Callable[[Member], _KeyLayer]
+                  ) -> Optional[Stroke]:
+    def has(m: Member) -> bool:
         return layer_of(m).paint.stroke is not None
 
     top = _heaviest(group, has)
@@ -468,20 +480,21 @@ def _morph_stroke(group, layer_of):
 class FrameArt:
     """The header's art prepared once (triangles resolved), for the art of many frames."""
 
-    def __init__(self, header, options=None):
+    def __init__(self, header: Any, options: Optional[FrameArtOptions] = None) -> None:
         self.options = options or FrameArtOptions()
         self._keys = _keys_from_header(header)
 
-    def has_art(self):
+    def has_art(self) -> bool:
         """True when some drawing has a layer: the frames have art to draw."""
         return any(self._keys)
 
-    def layers(self, frame):
+    def layers(self, frame: Any) -> List[Layer]:
         """The frame's layers in paint order (see frame_art)."""
         return _art_for_frame(self._keys, [(p.x, p.y) for p in frame.vertices],
                               list(frame.weights), self.options)
 
-    def svg(self, frame, bounds=None):
+    def svg(self, frame: Any,
+            bounds: Optional[Tuple[float, float, float, float]] = None) -> str:
         """The frame's art as an SVG document (see frame_art_svg)."""
         xy = [(p.x, p.y) for p in frame.vertices]
         if bounds is None:
@@ -496,7 +509,8 @@ class FrameArt:
                     _g6(max_y - min_y + 2 * margin), frame.index, frame.time, svg_paths(layers))
 
 
-def _art_for_frame(keys, xy, weights, options):
+def _art_for_frame(keys: List[List[_KeyLayer]], xy: Sequence[XY], weights: List[float],
+                   options: FrameArtOptions) -> List[Layer]:
     if len(weights) != len(keys):
         raise ValueError(f"frame art: {len(weights)} weights for the art of {len(keys)} keys")
     total = 0.0
@@ -534,7 +548,8 @@ def _art_for_frame(keys, xy, weights, options):
     return out
 
 
-def frame_art(header, frame, options=None):
+def frame_art(header: Any, frame: Any, options: Optional[FrameArtOptions] = None
+              ) -> List[Layer]:
     """The art of ``frame`` (an InbetweenFrame) from ``header.art`` (its stream's
     InbetweenHeader, every art message appended, as Client.frames yields it): a list of Layer in
     paint order, each with its paint and placed paths (solver/art/frame_art.h ArtForFrame: at a
@@ -545,7 +560,9 @@ def frame_art(header, frame, options=None):
     return art.layers(frame) if art.has_art() else []
 
 
-def frame_art_svg(header, frame, bounds=None, options=None):
+def frame_art_svg(header: Any, frame: Any,
+                  bounds: Optional[Tuple[float, float, float, float]] = None,
+                  options: Optional[FrameArtOptions] = None) -> str:
     """``frame``'s art as an SVG document, as the CLI's frame_NNNN.svg draws it
     (client/render/svg_frames.cpp): one <path> per drawn layer in paint order
     (svg_paths). The viewBox is ``bounds`` (min_x, min_y, max_x, max_y), default the frame's
@@ -557,24 +574,24 @@ def frame_art_svg(header, frame, bounds=None, options=None):
 # ------------------------------------------------------------------------------------------
 # SVG (solver/art/art_svg.cpp)
 
-def _g6(v):
+def _g6(v: float) -> str:
     return "%.6g" % v
 
 
-def _number(v):
+def _number(v: float) -> str:
     return "%.9g" % v
 
 
-def _colour(rgb):
+def _colour(rgb: int) -> str:
     return "#%06x" % (rgb & 0xFFFFFF)
 
 
-def _escaped(text):
+def _escaped(text: str) -> str:
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace(
         '"', "&quot;")
 
 
-def svg_paths(layers):
+def svg_paths(layers: Sequence[Layer]) -> str:
     """``layers`` (frame_art) as SVG <path> elements, one line each (ArtToSvgPaths): a layer
     with neither fill nor stroke, or no points, is skipped; subpaths "M x y L x y ... Z";
     data-layer = its name; fill, stroke and opacity attributes, defaults left out; numbers with 9

@@ -12,8 +12,8 @@ client/web/e2e/art_parity.mjs.
 
     python3 art_parity.py DIR
 
-Needs the stubs and the inbetween package on sys.path (tests/e2e/python_client_test.sh). Prints one
-line per frame; exits 1 on the first difference.
+Needs the inbetween package installed (tests/e2e/python_client_test.sh installs it in a venv).
+Prints one line per frame; exits 1 on the first difference.
 """
 
 import json
