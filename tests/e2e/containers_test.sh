@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
-# docker/ and deploy/k8s/ without a container engine (none runs in CI), checked by
-# containers_check.py: `kubectl kustomize deploy/k8s` renders and has the server Deployment with
-# gRPC readiness/liveness probes and limits, its Services, ConfigMaps, HPA, PDB, Redis and HAProxy
-# (`haproxy -c` on its config); compose.yaml has Redis, 3 replicas, nginx, the gateway and the
-# load generator under the `load` profile; every runtime package exists in Debian and together
-# they cover what ldd lists for inbetween-server and inbetween-loadgen; the Dockerfile's build
-# stage runs exactly scripts/setup and scripts/build. Then the commands of compose.yaml and of the
-# Deployment run for real on loopback: replicas with their flags on a real Redis, the proxy
-# image's nginx entrypoint in front, the HEALTHCHECK script, inbetween-loadgen through nginx.
+# docker/ and deploy/k8s/ without a container engine (tests/e2e/podman_test.sh runs the images
+# in containers where Podman can; this covers the rest), checked by containers_check.py:
+# `kubectl kustomize deploy/k8s` renders and has the server Deployment with gRPC readiness/liveness
+# probes and limits, its Services, ConfigMaps, HPA, PDB, Redis and HAProxy (`haproxy -c` on its
+# config); compose.yaml has Redis, 3 replicas, nginx, the gateway and the load generator under the
+# `load` profile; every runtime package exists in Debian and together they cover what ldd lists
+# for inbetween-server and inbetween-loadgen; every Dockerfile stage starts from its BASE_IMAGE
+# and the build stage runs exactly scripts/setup and scripts/build. Then the commands of
+# compose.yaml and of the Deployment run for real on loopback: replicas with their flags on a real
+# Redis, the proxy image's nginx entrypoint in front, the HEALTHCHECK script, inbetween-loadgen
+# through nginx.
 source "$(dirname "$0")/lib/common.sh"
 source "$(dirname "$0")/lib/cluster.sh"
 for tool in nginx haproxy node apt-cache dpkg ldd; do

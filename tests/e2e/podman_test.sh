@@ -1,0 +1,128 @@
+#!/usr/bin/env bash
+# The images of docker/Dockerfile and the services of docker/compose.yaml in real containers,
+# with Podman (scripts/containers): the server, proxy and redis images assembled from this build's
+# binaries (no compile inside a container) on a local Debian 12 base (debootstrap, created once
+# and cached), then Redis, three replicas and nginx started as compose describes them, on the
+# host network, loopback only. Through nginx the CLI streams a long animation; after its first
+# frame the replica container serving it gets SIGKILL: the CLI resumes on another replica and
+# its frames.json is identical to an uninterrupted run, and every session still answers (also
+# after the container is started again). Skips (exit 77) where Podman cannot run: not root, no
+# podman or runc, no base image and no way to make one.
+source "$(dirname "$0")/lib/common.sh"
+PY=/usr/bin/python3
+t0=$SECONDS
+skip() { echo "SKIP: $*"; exit 77; }
+[[ $EUID -eq 0 ]] || skip "needs root (rootful podman; debootstrap makes the base image)"
+command -v podman >/dev/null || skip "podman is not installed (scripts/setup --test installs it)"
+command -v runc >/dev/null || skip "runc is not installed (scripts/setup --test installs it)"
+"$PY" -c 'import yaml' 2>/dev/null || skip "python3-yaml is not installed (scripts/setup --test)"
+containers() { "$PY" "$INBETWEEN_SRC/scripts/containers" "$@"; }
+
+if ! containers base >"$WORK/base.log" 2>&1; then
+  cat "$WORK/base.log"
+  skip "no local base image and none could be made (debootstrap and Debian's mirror needed)"
+fi
+if ! containers podman run --rm --network host localhost/debian:bookworm-local true \
+    >"$WORK/probe.log" 2>&1; then
+  cat "$WORK/probe.log"
+  skip "podman cannot run a container here"
+fi
+
+project="ibsmoke-$$"
+state="$WORK/stack.json"
+trap 'containers down --project "$project" --volumes >/dev/null 2>&1 || true; cleanup' EXIT
+
+t=$SECONDS
+containers prebuilt --bin "$INBETWEEN_BIN" --tag smoke --log "$WORK/build.log"
+echo "images in $((SECONDS - t)) s"
+t=$SECONDS
+# The gateway is left out: its image needs the npm registry (tests/e2e/web_test.sh covers it).
+containers up --project "$project" --tag smoke --free-ports --without gateway --state "$state"
+echo "stack up (redis, 3 replicas healthy, nginx) in $((SECONDS - t)) s"
+port() { "$PY" -c 'import json,sys; print(json.load(open(sys.argv[1]))["ports"][sys.argv[2]][sys.argv[3]])' "$state" "$1" "$2"; }
+NGINX_ADDR="127.0.0.1:$(port nginx grpc)"
+declare -A REPLICA_OF
+for n in 1 2 3; do REPLICA_OF["127.0.0.1:$(port "replica$n" grpc)"]="replica$n"; done
+
+cli() { "$CLI_BIN" --server "$NGINX_ADDR" "$@"; }
+session_of() { grep -oE '^session [0-9a-f]+' "$1" | awk '{print $2}'; }
+inspect() { containers podman inspect --format "$2" "$project-$1"; }
+# nginx's access log, read as a file (`podman logs` takes too long between the pause and the kill).
+NGINX_LOG=$(inspect nginx '{{.HostConfig.LogConfig.Path}}')
+nginx_log() { cat "$NGINX_LOG"; }
+
+# The long stream of tests/e2e/scale_test.sh: more frames than the buffers between a replica and
+# a paused CLI hold, so the replica still has frames to send when it is killed.
+WALK=("$INBETWEEN_SRC"/examples/walk/0[1-8]_*.svg)
+FRAMES=6000
+LONG=(animate "${WALK[@]}" --frames "$FRAMES" --format json)
+t=$SECONDS
+cli -q "${LONG[@]}" --out "$WORK/reference" >"$WORK/reference.out"
+SESSIONS=("$(session_of "$WORK/reference.out")")
+echo "reference run through nginx in $((SECONDS - t)) s"
+
+# chaos A: the stream paused after its first frame, the replica container that built its
+# session (nginx's log: upstream of the last BuildMultimesh) killed, the CLI resumed; 2 when the
+# stream ran on another replica than the one that built it (nothing interrupted: again). The
+# kill is SIGKILL to the container's first process from here, as `podman kill` sends it, but
+# within milliseconds: a replica makes the 6000 frames in about a second, and they would all be
+# in the loopback buffers before a slower kill.
+chaos() {
+  local out="$WORK/chaos-$1" err="$WORK/chaos-$1.err" pid line sid up victim resume n
+  declare -A pids
+  for n in 1 2 3; do pids[replica$n]=$(inspect "replica$n" '{{.State.Pid}}'); done
+  cli "${LONG[@]}" --out "$out" >"$out.txt" 2>"$err" &
+  pid=$!
+  for _ in $(seq 1 1200); do
+    grep -q '^frames' "$err" && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.05
+  done
+  grep -q '^frames' "$err" || { cat "$err"; echo "no frame arrived"; return 1; }
+  kill -STOP "$pid"
+  line=$(nginx_log | grep '/inbetween.v1.Inbetween/BuildMultimesh ' | tail -1)
+  sid=$(grep -oE 'session=[0-9a-f]+' <<<"$line" | cut -d= -f2)
+  # "upstream=A, B 0.123": the last upstream nginx tried is the one that answered.
+  up=$(sed -E 's/.* upstream=(.*) [0-9.]+$/\1/' <<<"$line" | awk -F', ' '{print $NF}')
+  victim=${REPLICA_OF[$up]:-}
+  [[ -n "$victim" ]] || { echo "no replica for nginx upstream '$up': $line"; return 1; }
+  kill -9 "${pids[$victim]}"
+  echo "session $sid streams from $victim ($up): SIGKILL its container"
+  containers podman wait "$project-$victim" >/dev/null
+  kill -CONT "$pid"
+  wait "$pid" || { cat "$err"; echo "the CLI failed after the kill"; return 1; }
+  containers start --state "$state" "$victim"
+  [[ "$(session_of "$out.txt")" == "$sid" ]] || { echo "the CLI ran another session"; return 1; }
+  SESSIONS+=("$sid")
+  cmp "$WORK/reference/frames.json" "$out/frames.json" ||
+    { echo "frames differ from the uninterrupted run"; return 1; }
+  resume=$(grep -oE 'retry: Inbetween attempt 1 failed .*resuming at frame [0-9]+' "$err" |
+           grep -oE '[0-9]+$' | head -1 || true)
+  if [[ -z "$resume" ]]; then
+    if nginx_log | grep "/inbetween.v1.Inbetween/Inbetween .*session=$sid " | grep -vq "upstream=$up"; then
+      echo "the stream ran on another replica than $victim; again"
+      return 2
+    fi
+    cat "$err"; echo "no mid-stream resume reported"; return 1
+  fi
+  [[ "$resume" -gt 0 && "$resume" -lt "$FRAMES" ]] || { echo "resumed at frame $resume"; return 1; }
+  echo "resumed at frame $resume on another replica; $FRAMES frames identical"
+}
+t=$SECONDS
+rc=0
+for a in 1 2 3; do
+  rc=0
+  chaos "$a" || rc=$?
+  [[ $rc -eq 2 ]] || break
+done
+[[ $rc -eq 0 ]] || { echo "the replica kill mid-stream failed"; exit 1; }
+echo "kill mid-stream and restart in $((SECONDS - t)) s"
+
+# Nothing lost: every session answers through nginx.
+for sid in "${SESSIONS[@]}"; do
+  [[ -n "$sid" ]] || { echo "a run printed no session id"; exit 1; }
+  cli inspect "$sid" >"$WORK/inspect.out" 2>&1 || { cat "$WORK/inspect.out"; echo "session $sid lost"; exit 1; }
+  grep -q "$sid" "$WORK/inspect.out" || { cat "$WORK/inspect.out"; echo "inspect $sid: no id"; exit 1; }
+done
+echo "ok: ${#SESSIONS[@]} sessions, 1 replica container killed mid-stream, 0 lost, frames identical;" \
+     "$((SECONDS - t0)) s"
