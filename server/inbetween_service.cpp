@@ -994,6 +994,16 @@ grpc::Status InbetweenService::OptimizeComesh(
                                                                        : nullptr;
         solver::ComeshOptions options = ToComeshOptions(comesh);
         options.threads = options_.solver_threads;
+        // The outline guard holds the keys to the session's outline tolerance, measured against
+        // the drawings the multimesh was built from (without them, e.g. a session whose drawings
+        // do not match the mesh's shapes, against the mesh's own outline).
+        options.outline_tolerance = ComeshOutlineTolerance(state->session.parameters().meshing());
+        if (static_cast<int>(state->parsed.size()) == state->multimesh->num_shapes()) {
+          for (const solver::Drawing& drawing : state->parsed) {
+            std::vector<solver::Points>& loops = options.outline_reference.emplace_back();
+            for (const solver::Outline& outline : drawing.outlines) loops.push_back(outline.points);
+          }
+        }
         absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
         if (!slot.ok()) return slot.status();
 

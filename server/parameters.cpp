@@ -231,6 +231,12 @@ solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& com
   return options;
 }
 
+double ComeshOutlineTolerance(const inbetween::v1::MeshingParameters& meshing) {
+  return meshing.has_boundary_tolerance() && meshing.boundary_tolerance() > 0.0
+             ? meshing.boundary_tolerance()
+             : solver::MultimeshOptions{}.boundary_tolerance;
+}
+
 inbetween::v1::InbetweenParameters MergeInbetween(
     const inbetween::v1::InbetweenParameters& session,
     const inbetween::v1::InbetweenParameters& request) {

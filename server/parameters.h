@@ -36,6 +36,10 @@ solver::MultimeshOptions ToMultimeshOptions(const inbetween::v1::MeshingParamete
 // Validated comesh parameters -> solver options with the proto's defaults (w 0.5, 50 outer and
 // 200 inner iterations, relative decrease 1e-6); other options keep the solver's defaults.
 solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& comesh);
+// The outline guard's bound for an optimization (ComeshOptions::outline_tolerance): the
+// tolerance the session's outlines are built to (MeshingParameters.boundary_tolerance), or the
+// build's default when that is unset or 0 (even sampling, which promises none).
+double ComeshOutlineTolerance(const inbetween::v1::MeshingParameters& meshing);
 
 // Request fields that are set (non-zero, present or non-empty) override the session's.
 inbetween::v1::InbetweenParameters MergeInbetween(

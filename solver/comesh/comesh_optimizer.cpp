@@ -144,6 +144,8 @@ class Layout {
             var.slider = true;
             var.outline = at->loop;
             var.u0 = at->u;
+            var.prev = boundary_nbrs[v][0];
+            var.next = boundary_nbrs[v][1];
             std::tie(var.lo, var.hi) = outline->Stretch(at->loop, at->u);
             ++num_outline_;
           } else {
@@ -177,6 +179,7 @@ class Layout {
     // unknown is the arc length itself) and the stretch between hard points it stays in.
     int outline = -1;
     double u0 = 0.0, lo = 0.0, hi = 0.0;
+    int prev = -1, next = -1;  // outline sliders: the two boundary neighbours
   };
 
   bool cancelled() const { return cancelled_; }
@@ -233,7 +236,7 @@ class Layout {
     for (const Var& var : vars_) {
       Point& p = (*shapes)[var.shape][var.vertex];
       if (var.outline >= 0) {
-        p = (*outlines_)[var.shape].At(var.outline, std::clamp(z[var.offset], var.lo, var.hi));
+        p = OutlinePoint(var, z[var.offset]);
       } else {
         p = var.slider ? Point(var.base + z[var.offset] * var.direction)
                        : Point(z.segment<2>(var.offset));
@@ -253,6 +256,10 @@ class Layout {
   }
   // Moves the outline sliders' current tangents to the arc lengths in z (after an accepted step;
   // a straight slider's tangent is its direction throughout).
+  // Where outline slider i (var.outline >= 0) is at unknown value u.
+  Point OutlinePoint(const Var& var, double u) const {
+    return (*outlines_)[var.shape].At(var.outline, std::clamp(u, var.lo, var.hi));
+  }
   void Track(const VectorXd& z) {
     if (num_outline_ == 0) return;
     for (size_t i = 0; i < vars_.size(); ++i) {
@@ -1032,12 +1039,19 @@ struct InnerStats {
   double objective = 0.0;
 };
 
+// The outline guard's reference and bound per shape (ComeshOptions::outline_tolerance).
+struct OutlineBounds {
+  std::vector<const ShapeOutline*> reference;
+  std::vector<double> tolerance;
+};
+
 // The inner loop on a fixed topology: optimizes mesh->shapes in place. `iteration_base` numbers
-// iterations globally for callbacks.
+// iterations globally for callbacks. With `outlines` and `bounds` (may be null), every outline
+// slider's chords stay within the bounds (OutlineGuard).
 absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int threads,
-                       const std::vector<ShapeOutline>* outlines, const CancelToken* cancel,
-                       const ProgressFn& progress, int iteration_base, InnerStats* stats,
-                       SharedFactors* factors) {
+                       const std::vector<ShapeOutline>* outlines, const OutlineBounds* bounds,
+                       const CancelToken* cancel, const ProgressFn& progress, int iteration_base,
+                       InnerStats* stats, SharedFactors* factors) {
   Stopwatch clock;
   auto cancelled_at = [&](int iter) {
     return absl::CancelledError(
@@ -1091,6 +1105,17 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
   };
   std::optional<VertexRelaxer> relaxer;
   if (options.relax_fraction > 0.0) relaxer.emplace(*objective);
+  // guard_slot[i]: var i's slot in the guard, or -1.
+  std::optional<OutlineGuard> guard;
+  std::vector<int> guard_slot(layout.vars().size(), -1);
+  if (outlines != nullptr && bounds != nullptr) {
+    for (size_t i = 0; i < layout.vars().size(); ++i) {
+      const Layout::Var& var = layout.vars()[i];
+      if (var.outline < 0) continue;
+      if (!guard) guard.emplace(bounds->reference, bounds->tolerance);
+      guard_slot[i] = guard->Add(var.shape, var.vertex, var.prev, var.next, shapes[var.shape]);
+    }
+  }
   stats->phases.hessian += clock.Lap();
 
   VectorXd z = layout.Gather(shapes);
@@ -1188,9 +1213,42 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
     // Inversion-free backtracking line search.
     if (!disp_is_d) layout.Displacements(d, &disp);
     if (Cancelled(cancel)) return cancelled_at(iter);
-    const double max_step =
-        MaxNonInvertingStep(mesh->triangles, shapes, disp, objective->threads());
+    double max_step = MaxNonInvertingStep(mesh->triangles, shapes, disp, objective->threads());
     double step = std::min(1.0, options.max_step_fraction * max_step);
+    if (guard) {
+      // An outline slider whose own move (its neighbours where they are) would take a chord
+      // beyond the bound stays put for this iteration, so the others still move; the line search
+      // below holds the chords between two moving sliders.
+      bool held = false;
+      for (size_t i = 0; i < guard_slot.size(); ++i) {
+        const Layout::Var& var = layout.vars()[i];
+        if (guard_slot[i] < 0 || d[var.offset] == 0.0) continue;
+        const Point p = layout.OutlinePoint(var, z[var.offset] + step * d[var.offset]);
+        if (!guard->HoldsAt(guard_slot[i], p, shapes[var.shape])) {
+          d[var.offset] = 0.0;
+          held = true;
+        }
+      }
+      if (held) {
+        slope = g.dot(d);
+        if (!(slope < 0.0)) {  // what is left does not descend: the free part of -g
+          const VectorXd kept = d;
+          d = -g;
+          for (size_t i = 0; i < guard_slot.size(); ++i) {
+            const int offset = layout.vars()[i].offset;
+            if (guard_slot[i] >= 0 && kept[offset] == 0.0) d[offset] = 0.0;
+          }
+          slope = g.dot(d);
+          if (!(slope < 0.0)) {
+            stats->stop_reason = "outline";
+            return absl::OkStatus();
+          }
+        }
+        layout.Displacements(d, &disp);
+        max_step = MaxNonInvertingStep(mesh->triangles, shapes, disp, objective->threads());
+        step = std::min(1.0, options.max_step_fraction * max_step);
+      }
+    }
     stats->phases.step_bound += clock.Lap();
     bool accepted = false;
     double f_new = f;
@@ -1201,6 +1259,10 @@ absl::Status InnerLoop(Multimesh* mesh, const ComeshOptions& options, int thread
       z_new = z + step * d;
       layout.Scatter(z_new, &trial);
       if (Cancelled(cancel)) return cancelled_at(iter);
+      if (guard && !guard->Holds(trial)) {
+        step *= 0.5;  // a chord strays beyond the bound: shorter, like a non-finite trial
+        continue;
+      }
       f_new = objective->Evaluate(trial, &trial_grad, &trial_energies, cancel);
       ++stats->evaluations;
       // And after it (f_new is NaN if it was cancelled inside; ~0.1 s at 311k vertices): with
@@ -1376,12 +1438,19 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       !(options.mips_damping >= 0.0 && std::isfinite(options.mips_damping)) ||
       std::isnan(options.relax_fraction) || !(options.relax_over_mean >= 0.0) ||
       options.relax_max_vertices < 0 || options.relax_steps < 0 ||
-      !(options.outline_corner_degrees >= 0.0 && options.outline_corner_degrees <= 180.0)) {
+      !(options.outline_corner_degrees >= 0.0 && options.outline_corner_degrees <= 180.0) ||
+      !(options.outline_tolerance >= 0.0 && std::isfinite(options.outline_tolerance))) {
     return absl::InvalidArgumentError(
         "comesh options: max_iterations, history, max_outer, relax_max_vertices and relax_steps "
         "must be >= 0, max_step_fraction in (0, 1), cure_keep in [0, 1), blend and "
         "relax_over_mean >= 0, mips_damping finite and >= 0, relax_fraction a number, "
-        "outline_corner_degrees in [0, 180]");
+        "outline_corner_degrees in [0, 180], outline_tolerance finite and >= 0");
+  }
+  if (!options.outline_reference.empty() &&
+      static_cast<int>(options.outline_reference.size()) != mesh.num_shapes()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "comesh options: outline_reference has ", options.outline_reference.size(),
+        " drawings' outlines for ", mesh.num_shapes(), " shapes"));
   }
   const int threads = ResolveThreads(options.threads);
   const absl::Status not_started = absl::CancelledError("comesh optimization cancelled at start");
@@ -1432,6 +1501,22 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     // and the run is the one without it, bit for bit.
     if (!curved) outlines.clear();
   }
+  // The outline guard (OutlineGuard): against each drawing's outline when given, else the input's.
+  std::vector<ShapeOutline> drawn;
+  std::optional<OutlineBounds> bounds;
+  if (!outlines.empty() && options.outline_tolerance > 0.0) {
+    bounds.emplace();
+    for (int s = 0; s < mesh.num_shapes(); ++s) {
+      if (!options.outline_reference.empty()) {
+        drawn.emplace_back(options.outline_reference[s], options.outline_corner_degrees);
+      }
+    }
+    for (int s = 0; s < mesh.num_shapes(); ++s) {
+      const ShapeOutline* reference = drawn.empty() ? &outlines[s] : &drawn[s];
+      bounds->reference.push_back(reference);
+      bounds->tolerance.push_back(options.outline_tolerance * reference->diagonal());
+    }
+  }
   SharedFactors factors;
   // Stage 0 is the run without outline sliding, to convergence; stage 1 (curved outlines with
   // slide_outline only) continues from its result with the boundary sliding along the outlines:
@@ -1446,7 +1531,8 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
     auto inner = [&](int max_iterations) {
       ComeshOptions run = options;
       run.max_iterations = max_iterations;
-      absl::Status st = InnerLoop(&current, run, threads, stage_outlines, cancel, progress,
+      absl::Status st = InnerLoop(&current, run, threads, stage_outlines,
+                                  bounds ? &*bounds : nullptr, cancel, progress,
                                   stats.iterations, &stats, &factors);
       if (st.ok()) rep.objective_trace.push_back(stats.objective);
       return st;

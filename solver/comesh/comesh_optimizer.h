@@ -69,7 +69,9 @@
 // outline_corner_degrees) and stops at the hard ones, at cohesive vertices and at marks. Every
 // boundary vertex thus stays on its input outline; the outline of a shape changes only by chords
 // across soft corners that a vertex has left (the objective, area-invariant then, neither rewards
-// nor penalizes the area that changes). At a polyline point, where the path bends, the gradient
+// nor penalizes the area that changes), each held within outline_tolerance of the drawing by the
+// outline guard (a slider whose own move would break it keeps still for the iteration; a trial
+// step that breaks it is shortened like one that inverts). At a polyline point, where the path bends, the gradient
 // is the one-sided derivative of the side along which the objective falls. The line search's
 // inversion bound follows the
 // tangent (first order across a soft corner); the trial's own evaluation, infinite for any
@@ -163,6 +165,20 @@ struct ComeshOptions {
   // On by default (off: every boundary vertex off a straight stretch stays where it is).
   bool slide_outline = true;
   double outline_corner_degrees = 25.0;
+  // The outline guard (OutlineGuard, comesh_outline.h): with slide_outline, no accepted step
+  // takes a chord at an outline slider farther than outline_tolerance times the drawing's
+  // bounding-box diagonal from the drawing's outline (the distance of the outline points the
+  // chord spans from it), so a rounded tip the build kept within MultimeshOptions'
+  // boundary_tolerance is not cut off again; a slider whose own move would do so waits. A chord
+  // beyond the bound at the start (a build with a fixed vertex count) keeps its own deviation as
+  // its bound. 0: off (the outline then strays by the chords across whatever soft corners the
+  // sliders leave; keys up to 0.5% of the diagonal off on rounded icons, docs/benchmarks.md).
+  double outline_tolerance = 1e-3;
+  // The drawings' outlines the guard measures against, one entry per shape (its closed loops, as
+  // Drawing::outlines): the outlines the multimesh was built from. Empty: the input mesh's own
+  // outline, which the build placed within its tolerance of the drawing, so the keys may then
+  // stray up to the build's deviation plus outline_tolerance.
+  std::vector<std::vector<Points>> outline_reference;
   // Local relaxation (comesh_relax.h): after each accepted step shorter than the unit step (one
   // that backtracked or met the inversion bound), every vertex (of one shape) whose gradient holds
   // at least relax_fraction of |g|^2 and relax_over_mean times an even share of it, at most
@@ -254,7 +270,8 @@ struct ComeshReport {
   int energy_evaluations = 0;
   ComeshPhaseSeconds phase_seconds;
   std::string stop_reason;  // last inner run: "gradient", "decrease", "max_iterations",
-                            // "line_search", "no_free"
+                            // "line_search", "no_free", "outline" (every slider that would
+                            // descend is held by the outline guard)
   // Sliver removal (ComeshOptions::min_quality): triangles below min_quality before it, the
   // operations it made, and the worst triangle quality of the result over every shape.
   int slivers = 0;

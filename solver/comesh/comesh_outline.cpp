@@ -14,30 +14,51 @@ ShapeOutline::ShapeOutline(const Multimesh& mesh, int shape, double corner_degre
   const std::vector<std::vector<int>> loops =
       mesh.boundary_loops.empty() ? std::vector<std::vector<int>>{mesh.boundary}
                                   : mesh.boundary_loops;
+  std::vector<Points> points;
+  std::vector<std::vector<char>> fixed_points;
+  for (const std::vector<int>& ids : loops) {
+    Points& p = points.emplace_back();
+    std::vector<char>& f = fixed_points.emplace_back();
+    for (int v : ids) {
+      p.push_back(x[v]);
+      f.push_back(v < static_cast<int>(fixed.size()) && fixed[v]);
+    }
+  }
+  Init(points, fixed_points, corner_degrees);
+}
+
+ShapeOutline::ShapeOutline(const std::vector<Points>& loops, double corner_degrees) {
+  std::vector<std::vector<char>> fixed;
+  for (const Points& loop : loops) fixed.emplace_back(loop.size(), 0);
+  Init(loops, fixed, corner_degrees);
+}
+
+void ShapeOutline::Init(const std::vector<Points>& loops,
+                        const std::vector<std::vector<char>>& fixed, double corner_degrees) {
   const double cos_corner = std::cos(corner_degrees * std::numbers::pi / 180.0);
   Point lo = Point::Constant(std::numeric_limits<double>::infinity());
   Point hi = -lo;
   double total = 0.0;
   int segments = 0;
-  for (const std::vector<int>& ids : loops) {
-    const int m = static_cast<int>(ids.size());
+  for (size_t i = 0; i < loops.size(); ++i) {
+    const Points& x = loops[i];
+    const int m = static_cast<int>(x.size());
     if (m < 3) continue;
     Loop loop;
     loop.arc.push_back(0.0);
     for (int k = 0; k < m; ++k) {
-      const Point& p = x[ids[k]];
+      const Point& p = x[k];
       loop.points.push_back(p);
-      loop.arc.push_back(loop.arc.back() + (x[ids[(k + 1) % m]] - p).norm());
+      loop.arc.push_back(loop.arc.back() + (x[(k + 1) % m] - p).norm());
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
     }
     for (int k = 0; k < m; ++k) {
-      const Point in = x[ids[k]] - x[ids[(k + m - 1) % m]];
-      const Point out = x[ids[(k + 1) % m]] - x[ids[k]];
+      const Point in = x[k] - x[(k + m - 1) % m];
+      const Point out = x[(k + 1) % m] - x[k];
       const double norms = in.norm() * out.norm();
-      const bool is_fixed = ids[k] < static_cast<int>(fixed.size()) && fixed[ids[k]];
       // A turn above corner_degrees means cos(turn) below cos(corner_degrees).
-      if (is_fixed || !(norms > 0.0) || in.dot(out) < cos_corner * norms) {
+      if (fixed[i][k] || !(norms > 0.0) || in.dot(out) < cos_corner * norms) {
         loop.hard.push_back(loop.arc[k]);
       } else if (std::abs(in.x() * out.y() - in.y() * out.x()) > 1e-9 * norms) {
         curved_ = true;  // a soft corner (StrictlyInsideSegment's straightness tolerance)
@@ -49,7 +70,8 @@ ShapeOutline::ShapeOutline(const Multimesh& mesh, int shape, double corner_degre
   }
   if (segments == 0) return;
   origin_ = lo;
-  cell_ = std::max(total / segments, 1e-9 * std::max((hi - lo).norm(), 1e-300));
+  diagonal_ = (hi - lo).norm();
+  cell_ = std::max(total / segments, 1e-9 * std::max(diagonal_, 1e-300));
   for (int l = 0; l < num_loops(); ++l) {
     const Loop& loop = loops_[l];
     const int m = static_cast<int>(loop.points.size());
@@ -209,6 +231,69 @@ std::optional<Point> ShapeOutline::SplitPoint(const Point& a, const Point& b,
     }
   }
   return At(la->loop, la->u + 0.5 * d);
+}
+
+double ShapeOutline::ChordDeviation(const Point& a, const Point& b,
+                                    double locate_tolerance) const {
+  const std::optional<Location> la = Locate(a, locate_tolerance),
+                                lb = Locate(b, locate_tolerance);
+  if (!la || !lb || la->loop != lb->loop) return 0.0;
+  const Loop& loop = loops_[la->loop];
+  const int m = static_cast<int>(loop.points.size());
+  const double length = loop.arc.back();
+  // The shorter arc, walked forwards from its start.
+  double from = la->u, span = Wrap(loop, lb->u - la->u);
+  if (span > 0.5 * length) {
+    from = lb->u;
+    span = length - span;
+  }
+  const Point ab = b - a;
+  const double len2 = ab.squaredNorm();
+  double worst = 0.0;
+  // Points strictly inside the arc: from the first point after `from` while within the span.
+  int k = SegmentAt(loop, from) + 1;
+  for (int steps = 0; steps < m; ++steps, ++k) {
+    const int j = k % m;
+    const double along = (k >= m ? length : 0.0) + loop.arc[j] - from;
+    if (!(along < span)) break;
+    const Point& p = loop.points[j];
+    const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    worst = std::max(worst, (p - (a + t * ab)).norm());
+  }
+  return worst;
+}
+
+OutlineGuard::OutlineGuard(std::vector<const ShapeOutline*> reference,
+                           std::vector<double> tolerance)
+    : reference_(std::move(reference)), tolerance_(std::move(tolerance)) {}
+
+double OutlineGuard::Deviation(int s, const Point& a, const Point& b) const {
+  // Vertices sit on the input outline, which is within the tolerance of the reference (a build
+  // that met it); twice the bound finds them on the reference with room to spare.
+  return reference_[s]->ChordDeviation(a, b, 2.0 * tolerance_[s] + reference_[s]->tolerance());
+}
+
+int OutlineGuard::Add(int s, int v, int prev, int next, const Points& x) {
+  // A chord already beyond the bound keeps its own deviation as its bound (plus rounding).
+  auto allowed = [&](int a, int b) {
+    return std::max(tolerance_[s], Deviation(s, x[a], x[b]) * (1.0 + 1e-9));
+  };
+  slots_.push_back({s, v, prev, next, allowed(prev, v), allowed(v, next)});
+  return static_cast<int>(slots_.size()) - 1;
+}
+
+bool OutlineGuard::HoldsAt(int i, const Point& p, const Points& x) const {
+  const Slot& slot = slots_[i];
+  return Deviation(slot.shape, x[slot.prev], p) <= slot.allowed_prev &&
+         Deviation(slot.shape, p, x[slot.next]) <= slot.allowed_next;
+}
+
+bool OutlineGuard::Holds(const std::vector<Points>& shapes) const {
+  for (size_t i = 0; i < slots_.size(); ++i) {
+    const Points& x = shapes[slots_[i].shape];
+    if (!HoldsAt(static_cast<int>(i), x[slots_[i].vertex], x)) return false;
+  }
+  return true;
 }
 
 }  // namespace inbetween::solver

@@ -34,6 +34,9 @@ class ShapeOutline {
   // points are left out.
   ShapeOutline(const Multimesh& mesh, int shape, double corner_degrees,
                const std::vector<char>& fixed);
+  // Closed polylines given as points (a drawing's outlines: the reference OutlineGuard measures
+  // against); every turn above corner_degrees is hard.
+  ShapeOutline(const std::vector<Points>& loops, double corner_degrees);
 
   struct Location {
     int loop;
@@ -66,6 +69,16 @@ class ShapeOutline {
   // 1e-9 of the longest loop: the tolerance the optimizer and the topology pass locate with.
   double tolerance() const;
 
+  // How far the chord a-b strays from the outline it replaces: the largest distance from the
+  // segment a-b of the outline's points strictly inside the shorter arc between a and b (both
+  // located within `locate_tolerance`; 0 if either is not, or they are on different loops: the
+  // chord then runs along a cut or an opening, not the outline). For the short arcs a boundary
+  // edge spans this is the Hausdorff distance between chord and arc.
+  double ChordDeviation(const Point& a, const Point& b, double locate_tolerance) const;
+
+  // The diagonal of the outline's bounding box.
+  double diagonal() const { return diagonal_; }
+
   // True if some loop has a soft corner: a point that turns, but by no more than corner_degrees
   // (and is not fixed). Without one, sliding along the outline is sliding along its straight
   // stretches between hard points, which the optimizer's straight sliders already do.
@@ -86,12 +99,51 @@ class ShapeOutline {
   // Unit direction of segment j (taken modulo the loop's size); zero for a degenerate segment.
   Point Direction(const Loop& loop, int j) const;
   int64_t CellKey(int64_t ix, int64_t iy) const { return (ix << 32) ^ (iy & 0xffffffff); }
+  // Points of each loop and whether point k is hard, then arcs, bounding box and the grid.
+  void Init(const std::vector<Points>& loops, const std::vector<std::vector<char>>& fixed,
+            double corner_degrees);
 
   std::vector<Loop> loops_;
   bool curved_ = false;
   double cell_ = 1.0;
   Point origin_ = Point::Zero();
+  double diagonal_ = 0.0;
   std::unordered_map<int64_t, std::vector<std::pair<int, int>>> grid_;  // cell -> (loop, segment)
+};
+
+// Keeps comesh optimization from cutting a drawing's tips: outline sliders (comesh_optimizer.h)
+// move along the frozen input outline, so the mesh outline changes only by chords across the soft
+// corners a vertex has left, and at a rounded tip drawn with many small turns those chords cut
+// the tip off. The guard holds every chord at an outline slider within `tolerance` of a reference
+// outline (ShapeOutline::ChordDeviation): the drawing's own outline when given, else the input
+// mesh's. A chord that already strays further when the run starts (a build with a fixed vertex
+// count) may keep its deviation but not grow it.
+class OutlineGuard {
+ public:
+  // reference[s]: shape s's reference outline (not owned; must outlive the guard); tolerance[s]
+  // its bound in its own units.
+  OutlineGuard(std::vector<const ShapeOutline*> reference, std::vector<double> tolerance);
+
+  // Registers the chords of boundary vertex v of shape s with its boundary neighbours prev and
+  // next at positions x (the run's start); returns the slot Holds and HoldsAt take.
+  int Add(int s, int v, int prev, int next, const Points& x);
+
+  // True if slot i's two chords are within their bound with its vertex at p and the neighbours
+  // at x.
+  bool HoldsAt(int i, const Point& p, const Points& x) const;
+  // True if every slot's chords are within their bounds at `shapes`.
+  bool Holds(const std::vector<Points>& shapes) const;
+
+ private:
+  struct Slot {
+    int shape, vertex, prev, next;
+    double allowed_prev, allowed_next;  // the bound of chord prev-v and of chord v-next
+  };
+  double Deviation(int s, const Point& a, const Point& b) const;
+
+  std::vector<const ShapeOutline*> reference_;
+  std::vector<double> tolerance_;
+  std::vector<Slot> slots_;
 };
 
 }  // namespace inbetween::solver

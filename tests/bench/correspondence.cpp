@@ -457,6 +457,10 @@ Result RunOnce(const Case& c, const MultimeshOptions& options, bool optimize) {
   if (mesh.ok() && optimize) {
     ComeshOptions co;
     co.threads = 1;
+    // The guard measures against the drawings, as the server's OptimizeComesh does; the legacy
+    // row (boundary_tolerance 0) runs without it, as before the guard.
+    co.outline_tolerance = options.boundary_tolerance;
+    co.outline_reference = {LoopsOf(c.a), LoopsOf(c.b)};
     mesh = OptimizeComesh(*mesh, co, nullptr, nullptr, nullptr);
   }
   if (!mesh.ok()) {

@@ -572,11 +572,15 @@ void ExpectResumedFrom(const Multimesh& m, ComeshOptions options,
 
 // Resuming from a checkpoint in the middle gives the uninterrupted run, bit for bit: the same
 // multimesh, the same report (seconds aside), the same iterates numbered on.
+// `guard`: ComeshOptions::outline_tolerance and outline_reference (else the guard is off).
 void ExpectResumedRunEqualsUninterrupted(const absl::StatusOr<Multimesh>& m,
-                                         bool slide_outline = false) {
+                                         bool slide_outline = false,
+                                         const ComeshOptions* guard = nullptr) {
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
   options.slide_outline = slide_outline;
+  options.outline_tolerance = guard != nullptr ? guard->outline_tolerance : 0.0;
+  if (guard != nullptr) options.outline_reference = guard->outline_reference;
   // Short runs between passes and no outer tolerance: several passes, so that a checkpoint in
   // the middle has passes (and the outer stops) after it.
   options.outer_inner_iterations = 5;
@@ -724,6 +728,9 @@ TEST(ComeshOptimizerTest, CurvedOutlinesSlideAlongTheirPolylines) {
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
   options.slide_outline = true;
+  // The sliding itself, on a fixed 48-vertex outline whose vertices must travel far along the
+  // circle: the outline guard (tested below) would hold them to chords within 0.1%.
+  options.outline_tolerance = 0.0;
   ComeshReport on, off;
   absl::StatusOr<Multimesh> slid = OptimizeComesh(*m, options, nullptr, nullptr, &on);
   ASSERT_TRUE(slid.ok()) << slid.status();
@@ -921,6 +928,104 @@ TEST(ComeshOptimizerTest, CorrespondenceMarksStayPinned) {
     }
   }
   EXPECT_GT(moved, 0) << "without pins the marks' vertices would have stayed anyway";
+}
+
+// Distance from p to the nearest segment of the closed polylines `loops`.
+double DistanceToLoops(const Point& p, const std::vector<Points>& loops) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Points& loop : loops) {
+    for (size_t k = 0; k < loop.size(); ++k) {
+      const Point& a = loop[k];
+      const Point ab = loop[(k + 1) % loop.size()] - a;
+      const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+      best = std::min(best, (p - (a + t * ab)).norm());
+    }
+  }
+  return best;
+}
+
+// The Hausdorff distance (both ways, over the polylines' points) between shape s's boundary
+// loops and drawing d's outlines, relative to the drawing's bounding-box diagonal.
+double KeyDeviation(const Multimesh& m, int s, const Drawing& d) {
+  std::vector<Points> key, drawn;
+  for (const std::vector<int>& loop : m.boundary_loops) {
+    Points& points = key.emplace_back();
+    for (int v : loop) points.push_back(m.shapes[s][v]);
+  }
+  Point lo = Point::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Outline& o : d.outlines) {
+    drawn.push_back(o.points);
+    for (const Point& p : o.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  }
+  double worst = 0.0;
+  for (const Points& loop : drawn) {
+    for (const Point& p : loop) worst = std::max(worst, DistanceToLoops(p, key));
+  }
+  for (const Points& loop : key) {
+    for (const Point& p : loop) worst = std::max(worst, DistanceToLoops(p, drawn));
+  }
+  return worst / (hi - lo).norm();
+}
+
+// A drop (body of radius sx x sy) whose tip is a small round cap drawn with many small turns,
+// each below the sliders' 25-degree hard corners.
+Drawing Drop(double sx, double sy) {
+  Drawing d;
+  Points outline;
+  const int body = 60, cap = 24;
+  // The body: a circle of radius 1 from angle -60 to 240 degrees (y down), then two straight
+  // sides to a cap of radius 0.08 at the top.
+  for (int i = 0; i <= body; ++i) {
+    const double t = (-60.0 + 300.0 * i / body) * std::numbers::pi / 180.0;
+    outline.push_back(Point(sx * std::cos(t), sy * (1.0 + std::sin(t))));
+  }
+  const Point tip(0.0, sy * -1.2);
+  for (int i = 0; i <= cap; ++i) {
+    const double t = (210.0 + 120.0 * i / cap) * std::numbers::pi / 180.0;
+    outline.push_back(tip + Point(0.08 * sx * std::cos(t), 0.08 * sy * std::sin(t)));
+  }
+  d.outlines.push_back({outline});
+  return d;
+}
+
+// A drop -> the same drop squashed wide. Built to the default outline tolerance
+// (0.1% of the diagonal), then optimized: without the outline guard the sliders leave the cap's
+// points and the chords cut the tip off; with it (the default, against the drawings) every key
+// stays within the tolerance of its drawing, and the run still lowers the objective.
+TEST(ComeshOptimizerTest, OutlineGuardKeepsTheKeysWithinTheBuildTolerance) {
+  const std::vector<Drawing> drawings = {Drop(1.0, 1.0), Drop(1.6, 0.7)};
+  absl::StatusOr<Multimesh> m = BuildMultimesh(drawings, MultimeshOptions{});
+  ASSERT_TRUE(m.ok()) << m.status();
+  const double tolerance = MultimeshOptions{}.boundary_tolerance;
+  for (int s = 0; s < 2; ++s) ASSERT_LE(KeyDeviation(*m, s, drawings[s]), tolerance * 1.001);
+
+  ComeshOptions options;
+  options.max_outer = 6;
+  for (const Drawing& d : drawings) options.outline_reference.push_back({d.outlines[0].points});
+  ComeshOptions unguarded = options;
+  unguarded.outline_tolerance = 0.0;
+  ComeshReport report, unguarded_report;
+  absl::StatusOr<Multimesh> guarded = OptimizeComesh(*m, options, nullptr, nullptr, &report);
+  absl::StatusOr<Multimesh> free = OptimizeComesh(*m, unguarded, nullptr, nullptr, &unguarded_report);
+  ASSERT_TRUE(guarded.ok()) << guarded.status();
+  ASSERT_TRUE(free.ok()) << free.status();
+  double free_worst = 0.0;
+  for (int s = 0; s < 2; ++s) {
+    free_worst = std::max(free_worst, KeyDeviation(*free, s, drawings[s]));
+    EXPECT_LE(KeyDeviation(*guarded, s, drawings[s]), tolerance * 1.001) << "shape " << s;
+  }
+  EXPECT_GT(free_worst, 1.5 * tolerance);  // the case needs the guard
+  EXPECT_LT(report.objective_after, report.objective_before);
+  EXPECT_TRUE(ValidateMultimesh(*guarded).ok());
+}
+
+// A run with the guard resumed from a checkpoint of its sliding stage is the uninterrupted run.
+TEST(ComeshOptimizerTest, ResumedRunWithTheOutlineGuardEqualsTheUninterruptedRun) {
+  const std::vector<Drawing> drawings = {Drop(1.0, 1.0), Drop(1.6, 0.7)};
+  ComeshOptions guard;
+  for (const Drawing& d : drawings) guard.outline_reference.push_back({d.outlines[0].points});
+  ExpectResumedRunEqualsUninterrupted(BuildMultimesh(drawings, MultimeshOptions{}),
+                                      /*slide_outline=*/true, &guard);
 }
 
 }  // namespace
