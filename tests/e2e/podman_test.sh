@@ -18,13 +18,22 @@ command -v runc >/dev/null || skip "runc is not installed (scripts/setup --test 
 "$PY" -c 'import yaml' 2>/dev/null || skip "python3-yaml is not installed (scripts/setup --test)"
 containers() { "$PY" "$INBETWEEN_SRC/scripts/containers" "$@"; }
 
+# Podman's overlay driver bind-mounts its storage onto itself and leaves the mount behind; where
+# no container can run (a chroot), that mount would outlive the test and pin the root it is in.
+release_storage() {
+  local graph
+  graph=$(containers podman info --format '{{.Store.GraphRoot}}' 2>/dev/null || true)
+  if [[ -n "$graph" ]] && mountpoint -q "$graph/overlay"; then umount "$graph/overlay" || true; fi
+}
 if ! containers base >"$WORK/base.log" 2>&1; then
   cat "$WORK/base.log"
+  release_storage
   skip "no local base image and none could be made (debootstrap and Debian's mirror needed)"
 fi
 if ! containers podman run --rm --network host localhost/debian:bookworm-local true \
     >"$WORK/probe.log" 2>&1; then
   cat "$WORK/probe.log"
+  release_storage
   skip "podman cannot run a container here"
 fi
 
