@@ -22,8 +22,10 @@ containers() { "$PY" "$INBETWEEN_SRC/scripts/containers" "$@"; }
 # no container can run (a chroot), that mount would outlive the test and pin the root it is in.
 release_storage() {
   local graph
+  # (podman info itself fails where podman cannot run: then its default root)
   graph=$(containers podman info --format '{{.Store.GraphRoot}}' 2>/dev/null || true)
-  if [[ -n "$graph" ]] && mountpoint -q "$graph/overlay"; then umount "$graph/overlay" || true; fi
+  graph=${graph:-/var/lib/containers/storage}
+  if mountpoint -q "$graph/overlay"; then umount "$graph/overlay" || true; fi
 }
 if ! containers base >"$WORK/base.log" 2>&1; then
   cat "$WORK/base.log"
