@@ -1506,10 +1506,8 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   std::optional<OutlineBounds> bounds;
   if (!outlines.empty() && options.outline_tolerance > 0.0) {
     bounds.emplace();
-    for (int s = 0; s < mesh.num_shapes(); ++s) {
-      if (!options.outline_reference.empty()) {
-        drawn.emplace_back(options.outline_reference[s], options.outline_corner_degrees);
-      }
+    for (const std::vector<Points>& loops : options.outline_reference) {
+      drawn.emplace_back(loops, options.outline_corner_degrees);
     }
     for (int s = 0; s < mesh.num_shapes(); ++s) {
       const ShapeOutline* reference = drawn.empty() ? &outlines[s] : &drawn[s];
@@ -1517,6 +1515,10 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
       bounds->tolerance.push_back(options.outline_tolerance * reference->diagonal());
     }
   }
+  // What every inner run takes (its max_iterations aside); the drawings' outlines are in `bounds`,
+  // so the runs' copies leave them out.
+  ComeshOptions per_run = options;
+  per_run.outline_reference.clear();
   SharedFactors factors;
   // Stage 0 is the run without outline sliding, to convergence; stage 1 (curved outlines with
   // slide_outline only) continues from its result with the boundary sliding along the outlines:
@@ -1529,7 +1531,7 @@ absl::StatusOr<Multimesh> OptimizeComesh(const Multimesh& mesh, const ComeshOpti
   for (; stage <= last_stage; ++stage) {
     const std::vector<ShapeOutline>* stage_outlines = stage == 1 ? &outlines : nullptr;
     auto inner = [&](int max_iterations) {
-      ComeshOptions run = options;
+      ComeshOptions run = per_run;
       run.max_iterations = max_iterations;
       absl::Status st = InnerLoop(&current, run, threads, stage_outlines,
                                   bounds ? &*bounds : nullptr, cancel, progress,

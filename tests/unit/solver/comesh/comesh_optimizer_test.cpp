@@ -935,10 +935,7 @@ double DistanceToLoops(const Point& p, const std::vector<Points>& loops) {
   double best = std::numeric_limits<double>::infinity();
   for (const Points& loop : loops) {
     for (size_t k = 0; k < loop.size(); ++k) {
-      const Point& a = loop[k];
-      const Point ab = loop[(k + 1) % loop.size()] - a;
-      const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
-      best = std::min(best, (p - (a + t * ab)).norm());
+      best = std::min(best, testing::DistanceToSegment(p, loop[k], loop[(k + 1) % loop.size()]));
     }
   }
   return best;
