@@ -145,10 +145,16 @@ class BreakingProxy:
         for s in victims:
             try:
                 # A reset rather than an orderly close: the connection dies as with a crash.
+                # close() alone does not release a socket that a pump thread is blocked reading
+                # (Linux keeps it until that recv returns, and a quiet peer never wakes it: the
+                # client would wait on a connection that is neither alive nor reset);
+                # shutdown(SHUT_RD) wakes the read without sending anything, and the release
+                # then sends the reset.
                 s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
-                s.close()
+                s.shutdown(socket.SHUT_RD)
             except OSError:
                 pass
+            s.close()
 
     def close(self) -> None:
         self._listener.close()
