@@ -21,15 +21,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-
-// LAPACK's Cholesky factorization of a dense block, as CHOLMOD calls it (32-bit BLAS integers; the
-// trailing length of the character argument that gfortran-built LAPACKs take is passed through).
-// The kCancelPoint below explains why this file defines it.
-extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info,
-                        size_t uplo_length);
-extern "C" void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k,
-                       const double* alpha, const double* a, const int* lda, const double* beta,
-                       double* c, const int* ldc, size_t uplo_length, size_t trans_length);
+#include "solver/core/factorization_cancel_point.h"
 
 namespace inbetween::solver {
 
@@ -430,17 +422,14 @@ bool SparseCholesky::Impl::Substitute(double* y, int columns, const CancelToken*
 namespace {
 
 // Supernodal factorizations call the system BLAS (Debian's alternative for libblas.so.3; the
-// solves are our own substitutions). Two properties matter, and both are settled once per process:
-// - Threads: OpenBLAS's pthread build (what scripts/setup installs) would split each call over
-//   every core, on top of our own threads, and its sums would then depend on the thread count.
-//   It is set to one thread (openblas_set_num_threads, looked up at run time because the binary
-//   links the generic libblas), so results are bit-identical for any thread count of ours.
-// - Reentrancy: OpenBLAS's serial build (libopenblas0-serial, openblas_get_parallel() == 0) is
-//   not reentrant: two concurrent factorizations of positive definite matrices failed with "not
-//   positive definite" (measured). Only then do the BLAS-using calls take one process-wide lock;
-//   the pthread and OpenMP builds, BLIS and the reference BLAS run concurrently (measured: the
-//   pthread build passed SparseCholeskyTest.ConcurrentSupernodalFactorizationsAreCorrect 8 of 8
-//   times unlocked, the serial one failed 6 of 6). Simplicial factors use no BLAS.
+// solves are our own substitutions). Reentrancy: OpenBLAS's serial build (libopenblas0-serial,
+// openblas_get_parallel() == 0) is not reentrant: two concurrent factorizations of positive
+// definite matrices failed with "not positive definite" (measured). Only then do the BLAS-using
+// calls take one process-wide lock; the pthread and OpenMP builds, BLIS and the reference BLAS run
+// concurrently (measured: the pthread build passed
+// SparseCholeskyTest.ConcurrentSupernodalFactorizationsAreCorrect 8 of 8 times unlocked, the
+// serial one failed 6 of 6). Simplicial factors use no BLAS. The BLAS's own thread count is the
+// program's to set (process_overrides.cpp pins OpenBLAS to one thread in our executables).
 struct BlasSetup {
   bool serialize = false;
 };
@@ -448,80 +437,27 @@ struct BlasSetup {
 const BlasSetup& Blas() {
   static const BlasSetup setup = [] {
     using GetParallel = int (*)();
-    using SetThreads = void (*)(int);
     auto* get = reinterpret_cast<GetParallel>(dlsym(RTLD_DEFAULT, "openblas_get_parallel"));
-    auto* set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
-    if (set != nullptr) set(1);
     return BlasSetup{.serialize = get != nullptr && get() == 0};
   }();
   return setup;
 }
 
-// CHOLMOD's large arrays (a supernodal factor's values: 34 MB for a 35k-vertex comesh shape,
-// hundreds of MB beyond) come from glibc's mmap path, fresh zero pages every time, and every 4 KiB
-// page costs a fault when first written (perf: 14% of the 35k-vertex row of S-Table 2; on a
-// cancelled factorization CHOLMOD zeroes the unfactored rest, faulting it all in). SuiteSparse
-// allocates through SuiteSparse_config's function pointers; ours ask the kernel for transparent
-// huge pages (madvise MADV_HUGEPAGE: 2 MiB pages, 512 times fewer faults) on blocks of
-// kHugeBlock bytes or more, and are glibc's malloc and friends otherwise. Where THP is off or
-// unsupported the madvise fails and changes nothing. Measured (docs/benchmarks.md, fifth
-// session): no change in S-Table 2's times beyond this VM's noise; the worst cancellation
-// latency at 35k vertices 121 -> 74 ms before the xsize change below made that zeroing moot.
-constexpr size_t kHugeBlock = size_t{4} << 20;
-
-void AdviseHugePages(void* p, size_t bytes) {
-  if (p == nullptr || bytes < kHugeBlock) return;
-  const uintptr_t page = 4096;
-  const uintptr_t begin = (reinterpret_cast<uintptr_t>(p) + page - 1) & ~(page - 1);
-  const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(page - 1);
-  if (end > begin) (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-}
-
-void* HugeMalloc(size_t bytes) {
-  void* p = std::malloc(bytes);
-  AdviseHugePages(p, bytes);
-  return p;
-}
-
-void* HugeCalloc(size_t count, size_t size) {
-  void* p = std::calloc(count, size);
-  if (size != 0 && count <= SIZE_MAX / size) AdviseHugePages(p, count * size);
-  return p;
-}
-
-void* HugeRealloc(void* old, size_t bytes) {
-  void* p = std::realloc(old, bytes);
-  AdviseHugePages(p, bytes);
-  return p;
-}
-
-void InstallAllocator() {
-  static const bool installed = [] {
-    SuiteSparse_config.malloc_func = HugeMalloc;
-    SuiteSparse_config.calloc_func = HugeCalloc;
-    SuiteSparse_config.realloc_func = HugeRealloc;
-    SuiteSparse_config.free_func = std::free;
-    return true;
-  }();
-  (void)installed;
-}
-
 // kCancelPoint: a supernodal factorization (CHOLMOD's cholmod_super_numeric) has no callback, but
 // it calls LAPACK's dpotrf_ once per supernode, on the supernode's dense diagonal block, and stops
 // as soon as one reports that block not positive definite at its first column (info == 1: the
-// status becomes CHOLMOD_NOT_POSDEF). This file defines dpotrf_ (and the BLAS-3 routines CHOLMOD
-// calls: dsyrk_, dgemm_, dtrsm_), which the dynamic linker binds CHOLMOD's calls to (a definition
-// in the executable comes before the libraries'), and forwards each call to the next definition
-// (LAPACK's, the BLAS's), large dense blocks in panels with a poll between them (kDensePanel).
-// Inside a cancellable Factorize whose token is set, the BLAS routines do nothing and dpotrf_
-// answers info = 1, recording that the stop was a cancellation, not a failed pivot. Before
+// status becomes CHOLMOD_NOT_POSDEF). Programs that link inbetween_process_overrides
+// (process_overrides.cpp: our CLI, server, benches and tests) define dpotrf_ and the BLAS-3
+// routines CHOLMOD calls, and ask this file, through factorization_cancel_point.h, whether the
+// calling thread's factorization is cancelled: the BLAS routines then do nothing and dpotrf_
+// answers info = 1, and Factorize below reports the cancellation, not a failed pivot. Before
 // returning, CHOLMOD zeroes the values of the factor from that supernode to the end (L->x up to
-// L->xsize: at 73k vertices, tens of MB of memory not touched yet, 50-80 ms measured); the hook
+// L->xsize: at 73k vertices, tens of MB of memory not touched yet, 50-80 ms measured); the stop
 // sets L->xsize to 0 for that moment (the zeroing loop then does nothing) and Factorize restores
 // it as soon as CHOLMOD returns. The factor's values are then meaningless, which is what "not
-// factorized" already says: the next Factorize writes every supernode anew. So a cancelled
-// supernodal factorization ends within one panel's work; callers outside a cancellable Factorize
-// get LAPACK's and the BLAS's results (large blocks computed in panels).
+// factorized" already says: the next Factorize writes every supernode anew. Without the
+// overrides a supernodal factorization runs to its end once started, and the cancellation is
+// seen at the next poll after it.
 thread_local const CancelToken* tls_factor_cancel = nullptr;
 thread_local cholmod_factor* tls_factor = nullptr;
 thread_local bool tls_factor_cancelled = false;
@@ -610,7 +546,6 @@ absl::Status CheckShape(const Eigen::SparseMatrix<double>& a) {
 }  // namespace
 
 SparseCholesky::Impl::Impl(Method method) {
-  InstallAllocator();
   cholmod_start(&common);
   common.print = 0;  // errors come back as absl::Status, not on stderr
   common.supernodal = method == Method::kAuto         ? CHOLMOD_AUTO
@@ -620,8 +555,8 @@ SparseCholesky::Impl::Impl(Method method) {
   // Supernodal from flops / nnz(L) >= 100 (CHOLMOD's default switch is 40): on the comesh
   // Hessians (2 unknowns per vertex) the simplicial factor with our substitutions is faster up to
   // the 8.6k-vertex row of S-Table 2 (at 40 the 2k and 4k rows took ~10% longer), the supernodal
-  // one from 17k (~9% less time there than at 200, once CHOLMOD's OpenMP teams were gone; see
-  // GOMP_parallel below and docs/benchmarks.md, sixth session).
+  // one from 17k (~9% less time there than at 200, with CHOLMOD's OpenMP teams gone: see
+  // GOMP_parallel in process_overrides.cpp and docs/benchmarks.md).
   common.supernodal_switch = 100.0;
   common.nmethods = 1;
   common.method[0].ordering = CHOLMOD_AMD;
@@ -928,67 +863,16 @@ bool SparseCholesky::supernodal() const {
   return impl_->factor != nullptr && impl_->factor->is_super;
 }
 
-}  // namespace inbetween::solver
+namespace internal {
 
-namespace inbetween::solver {
-namespace {
-
-// The next definitions (LAPACK's and the BLAS's) of the routines this file defines, looked up
-// once; a missing one is a broken installation, reported and fatal.
-template <class Fn>
-Fn NextDefinition(const char* name) {
-  auto* next = reinterpret_cast<Fn>(dlsym(RTLD_NEXT, name));
-  if (next == nullptr) {
-    std::fprintf(stderr, "inbetween: %s not found after this executable (%s)\n", name, dlerror());
-    std::abort();
-  }
-  return next;
-}
-
-using DpotrfFn = void (*)(const char*, const int*, double*, const int*, int*, size_t);
-using DsyrkFn = void (*)(const char*, const char*, const int*, const int*, const double*,
-                         const double*, const int*, const double*, double*, const int*, size_t,
-                         size_t);
-using DgemmFn = void (*)(const char*, const char*, const int*, const int*, const int*,
-                         const double*, const double*, const int*, const double*, const int*,
-                         const double*, double*, const int*, size_t, size_t);
-using DtrsmFn = void (*)(const char*, const char*, const char*, const char*, const int*, const int*,
-                         const double*, const double*, const int*, double*, const int*, size_t,
-                         size_t, size_t, size_t);
-
-// Each Fn type above names one routine, so one cached lookup per type.
-template <class Fn>
-Fn Next(const char* name) {
-  static const Fn f = NextDefinition<Fn>(name);
-  return f;
-}
-DpotrfFn LapackPotrf() { return Next<DpotrfFn>("dpotrf_"); }
-DsyrkFn BlasSyrk() { return Next<DsyrkFn>("dsyrk_"); }
-DgemmFn BlasGemm() { return Next<DgemmFn>("dgemm_"); }
-DtrsmFn BlasTrsm() { return Next<DtrsmFn>("dtrsm_"); }
-
-// True once the calling thread's factorization is cancelled (and from then on): the BLAS hooks
-// below skip their work, the factor being thrown away anyway.
-bool FactorizationCancelled() {
+bool SupernodalFactorizationCancelled() {
   if (tls_factor_cancelled) return true;
   if (!Cancelled(tls_factor_cancel)) return false;
   tls_factor_cancelled = true;
   return true;
 }
 
-// kDensePanel: the dense blocks of a supernodal factorization are factored and updated in panels
-// of this many columns, with a poll between panels (kCancelPoint). The last supernodes of S-Table
-// 2's 311k-vertex row are 2,492 columns wide: LAPACK's dpotrf_ on it took 118 ms and a dsyrk_ of
-// 1,926 x 735 95 ms, single calls (measured with a temporary timer on every call, ninth session).
-// A panel of 256 columns bounds the work between polls to ~30 ms there. Blocks below
-// kPanelFrom columns go to LAPACK/BLAS whole. The panelling depends on sizes only, never on
-// whether a token is set, so results are the same with and without one.
-constexpr int kDensePanel = SparseCholesky::kDensePanel;
-constexpr int kPanelFrom = 2 * kDensePanel;
-
-// Answers CHOLMOD's dpotrf_ call as a failed first pivot, so that it stops at this supernode, and
-// takes the factor's xsize for the moment CHOLMOD zeroes the rest (see kCancelPoint).
-void StopAtThisSupernode(int* info) {
+void StopSupernodalFactorizationHere(int* info) {
   if (!tls_factor_xsize_taken && tls_factor != nullptr) {
     tls_factor_xsize = tls_factor->xsize;
     tls_factor->xsize = 0;  // CHOLMOD's zeroing of the rest: nothing to do
@@ -997,126 +881,6 @@ void StopAtThisSupernode(int* info) {
   *info = 1;  // "not positive definite at the block's first column"
 }
 
-// Lower-triangular dense Cholesky of the n x n column-major block `a`, right-looking in panels of
-// kDensePanel columns: factor the panel's diagonal block (LAPACK), solve the rows below it
-// (dtrsm_), subtract their outer product from the trailing block (dsyrk_). Polls before every
-// panel; cancelled: *info = 1 (see kCancelPoint). info > 0 otherwise names the first column whose
-// pivot is not positive, as LAPACK's does.
-void PanelledPotrf(int n, double* a, int lda, int* info) {
-  const double one = 1.0, minus_one = -1.0;
-  const auto at = [&](int row, int col) { return a + row + static_cast<size_t>(col) * lda; };
-  for (int j = 0; j < n; j += kDensePanel) {
-    if (FactorizationCancelled()) {
-      StopAtThisSupernode(info);
-      return;
-    }
-    const int b = std::min(kDensePanel, n - j), rest = n - j - b;
-    LapackPotrf()("L", &b, at(j, j), &lda, info, 1);
-    if (*info != 0) {
-      *info += j;
-      return;
-    }
-    if (rest == 0) break;
-    BlasTrsm()("R", "L", "T", "N", &rest, &b, &one, at(j, j), &lda, at(j + b, j), &lda, 1, 1, 1, 1);
-    // Through this file's dsyrk_, which panels a large update again.
-    dsyrk_("L", "N", &rest, &b, &minus_one, at(j + b, j), &lda, &one, at(j + b, j + b), &lda, 1, 1);
-  }
-  *info = 0;
-}
+}  // namespace internal
 
-// The BLAS is set up (Blas(): one thread) while the process loads, not at the first supernodal
-// factorization. Set up late, in a child forked from a process that had not factored and whose
-// address space was then capped (RLIMIT_AS), OpenBLAS 0.3.21's first factorization of a
-// 10k- or 22k-unknown matrix spun in blas_memory_alloc, retrying a 128 MiB mmap forever (OpenBLAS
-// issue #5289; 0.3.30 exits instead), where it should have answered RESOURCE_EXHAUSTED or factored:
-// seen in MapToBoundaryTest.OutOfMemory* and
-// SparseCholeskyTest.FirstSupernodalFactorizationUnder... Set up at load, neither hangs.
-const bool kBlasSetUpAtLoad = [] {
-  (void)Blas();
-  return true;
-}();
-
-}  // namespace
 }  // namespace inbetween::solver
-
-extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info,
-                        size_t uplo_length) {
-  namespace sv = inbetween::solver;
-  if (sv::FactorizationCancelled()) {
-    sv::StopAtThisSupernode(info);
-    return;
-  }
-  if (*n >= sv::kPanelFrom && (*uplo == 'L' || *uplo == 'l')) {
-    sv::PanelledPotrf(*n, a, *lda, info);
-    return;
-  }
-  sv::LapackPotrf()(uplo, n, a, lda, info, uplo_length);
-}
-
-// C = alpha A A^T + beta C (lower, A not transposed: CHOLMOD's update of an ancestor) in column
-// panels of kDensePanel: each panel's diagonal block (dsyrk_) and the rows below it (dgemm_), a
-// poll before each; every entry of C is still one call's sum over all of A's columns. Other forms
-// and small blocks go to the BLAS whole. Skipped once the factorization is cancelled.
-extern "C" void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k,
-                       const double* alpha, const double* a, const int* lda, const double* beta,
-                       double* c, const int* ldc, size_t uplo_length, size_t trans_length) {
-  namespace sv = inbetween::solver;
-  if (sv::FactorizationCancelled()) return;
-  const bool lower_n = (*uplo == 'L' || *uplo == 'l') && (*trans == 'N' || *trans == 'n');
-  if (!lower_n || *n < sv::kPanelFrom) {
-    sv::BlasSyrk()(uplo, trans, n, k, alpha, a, lda, beta, c, ldc, uplo_length, trans_length);
-    return;
-  }
-  for (int j = 0; j < *n; j += sv::kDensePanel) {
-    if (j > 0 && sv::FactorizationCancelled()) return;
-    const int b = std::min(sv::kDensePanel, *n - j), rest = *n - j - b;
-    double* cj = c + j + static_cast<size_t>(j) * *ldc;
-    sv::BlasSyrk()("L", "N", &b, k, alpha, a + j, lda, beta, cj, ldc, 1, 1);
-    if (rest > 0) {
-      sv::BlasGemm()("N", "T", &rest, &b, k, alpha, a + j + b, lda, a + j, lda, beta, cj + b, ldc,
-                     1, 1);
-    }
-  }
-}
-
-// CHOLMOD's other BLAS-3 calls in a supernodal factorization: passed through, skipped once the
-// factorization is cancelled (their largest took under 10 ms at 311k vertices).
-extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
-                       const int* k, const double* alpha, const double* a, const int* lda,
-                       const double* b, const int* ldb, const double* beta, double* c,
-                       const int* ldc, size_t transa_length, size_t transb_length) {
-  namespace sv = inbetween::solver;
-  if (sv::FactorizationCancelled()) return;
-  sv::BlasGemm()(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, transa_length,
-                 transb_length);
-}
-
-extern "C" void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag,
-                       const int* m, const int* n, const double* alpha, const double* a,
-                       const int* lda, double* b, const int* ldb, size_t side_length,
-                       size_t uplo_length, size_t transa_length, size_t diag_length) {
-  namespace sv = inbetween::solver;
-  if (sv::FactorizationCancelled()) return;
-  sv::BlasTrsm()(side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb, side_length, uplo_length,
-                 transa_length, diag_length);
-}
-
-// CHOLMOD's OpenMP regions run on the calling thread. Debian's CHOLMOD (SuiteSparse 5.12, built
-// with OpenMP) opens parallel regions inside the supernodal factorization, per supernode (copying
-// A into it, clearing and scattering), each with a fixed team of 4 threads (the compiled call
-// passes 3 * test + 1 as the team size, the test being the region's size condition, so
-// OMP_NUM_THREADS does not change it). On a 2-core machine where our own threads already factor the
-// two shapes of a comesh concurrently, those teams oversubscribe the cores, and even a team of one
-// costs a futex system call per region (libgomp's barrier): measured on S-Table 2's 35k row
-// (docs/benchmarks.md, sixth session). The executable defines GOMP_parallel, the libgomp entry
-// point gcc compiles `#pragma omp parallel` to (the dynamic linker binds CHOLMOD's calls to this
-// definition, as for dpotrf_ above), and runs the region's body once on the calling thread, as
-// libgomp does for a team of one: outside any team, omp_get_num_threads() is 1 and
-// omp_get_thread_num() 0, so the body's worksharing loops (static schedules: CHOLMOD imports no
-// other libgomp entry point) cover every iteration, in order. CHOLMOD is the only library here
-// that uses OpenMP (our own code is not built with it); its regions only move data, so the factor
-// is the same.
-extern "C" void GOMP_parallel(void (*fn)(void*), void* data, unsigned /*num_threads*/,
-                              unsigned /*flags*/) {
-  fn(data);
-}

@@ -10,14 +10,19 @@
 // Method::kAuto lets CHOLMOD choose a supernodal LL^T factor when the matrix is large enough for
 // dense kernels to pay (flops / nnz(L) >= 100; CHOLMOD's own switch is 40, but our simplicial
 // substitutions were faster below 100 on the comesh Hessians; else the same simplicial factor): a
-// supernodal factorization runs on BLAS (scripts/setup installs Debian's OpenBLAS, pthread build,
-// which SparseCholesky sets to one thread), measured 2.6 s against 70 s simplicial for a
-// 320k-unknown planar mesh matrix (docs/benchmarks.md). Its solves are our own substitutions over
-// the supernodes' dense blocks (no BLAS: solves on several threads never contend for OpenBLAS's
-// buffer lock). Single-threaded BLAS and a fixed ordering keep the result bit-identical run to run
-// on one machine. Objects on different threads factor and solve concurrently (with a non-reentrant
-// BLAS, the serial OpenBLAS, those calls are serialized). CHOLMOD's own OpenMP regions run on the
-// calling thread (see GOMP_parallel in the .cpp): a factorization never starts threads of its own.
+// supernodal factorization runs on BLAS (scripts/setup installs Debian's OpenBLAS, pthread build),
+// measured 2.6 s against 70 s simplicial for a 320k-unknown planar mesh matrix
+// (docs/benchmarks.md). Its solves are our own substitutions over the supernodes' dense blocks
+// (no BLAS: solves on several threads never contend for OpenBLAS's buffer lock). A fixed
+// ordering keeps the result bit-identical run to run on one machine. Objects on different threads
+// factor and solve concurrently (with a non-reentrant BLAS, the serial OpenBLAS, those calls are
+// serialized).
+//
+// Programs that link inbetween_process_overrides (process_overrides.cpp; our executables do)
+// also get: OpenBLAS pinned to one thread (results independent of the machine's core count),
+// CHOLMOD's OpenMP regions run on the calling thread (a factorization never starts threads of its
+// own), huge pages for CHOLMOD's large arrays, and a cancelled supernodal factorization that stops
+// within one dense panel instead of at its end (docs/install.md, "Process-wide overrides").
 #pragma once
 
 #include <Eigen/Core>
@@ -65,9 +70,10 @@ class SparseCholesky {
   // it is set (then the object is not factorized; Factorize again to use it): a simplicial factor
   // is computed in row blocks of kCancelRows rows (CHOLMOD's incremental row factorization, the
   // same operations in the same order, so the factor is bit-identical to an uncancellable one),
-  // a supernodal one stops at the next supernode or, in a supernode of 2 * kDensePanel columns or
-  // more, at the next panel of kDensePanel columns (see kCancelPoint in the .cpp); the first one
-  // after an analysis also while its value array is allocated and its pages touched, per 4 MB.
+  // a supernodal one, in programs that link inbetween_process_overrides, stops at the next
+  // supernode or, in a supernode of 2 * kDensePanel columns or more, at the next panel of
+  // kDensePanel columns (see kCancelPoint in the .cpp; without them it runs to its end); the
+  // first one after an analysis also while its value array is allocated and its pages touched, per 4 MB.
   absl::Status Factorize(const Eigen::SparseMatrix<double>& a, const CancelToken* cancel = nullptr);
   static constexpr int kCancelRows = 256;
   static constexpr int kDensePanel = 256;

@@ -243,7 +243,7 @@ TEST(SparseCholeskyTest, SupernodalWhenAskedEvenOnSmallMatrices) {
 // test runs alone) and capped at 16 MiB above its address space factors a 10k-unknown matrix
 // supernodally or answers out of memory, in either case soon; it is killed after 60 s. With the
 // BLAS set up at the first factorization instead of at load, it spun in OpenBLAS's
-// blas_memory_alloc (sparse_cholesky.cpp, kBlasSetUpAtLoad).
+// blas_memory_alloc (process_overrides.cpp, kSetUpAtLoad).
 TEST(SparseCholeskyTest, FirstSupernodalFactorizationUnderAMemoryCapDoesNotHang) {
   if (testing::kSanitizerBuild) GTEST_SKIP() << "RLIMIT_AS caps do not apply under ASan/TSan";
   const Eigen::SparseMatrix<double> a = GridMatrix(100, 0.1);
@@ -326,7 +326,7 @@ TEST(SparseCholeskyTest, FloatSubstitutionsSolveCloselyOnSupernodalFactorsOnly) 
 }
 
 // CHOLMOD's OpenMP regions run on the calling thread (the GOMP_parallel definition in
-// sparse_cholesky.cpp): a supernodal factorization starts no thread. Without that definition
+// process_overrides.cpp, which the test binaries link): a supernodal factorization starts no thread. Without that definition
 // libgomp starts a pool of 3 workers at the first region with its team of 4 (they stay alive).
 // ctest runs every test in its own process, so no earlier test has started them.
 int ThreadCount() {
@@ -492,7 +492,7 @@ Eigen::SparseMatrix<double> DenseSpd(int n, unsigned seed) {
 }
 
 // A dense block of SparseCholesky::kDensePanel * 2 columns or more (one supernode here) is
-// factored in panels by this file's dpotrf_/dsyrk_ (sparse_cholesky.cpp): the solution is right,
+// factored in panels by the overrides' dpotrf_/dsyrk_ (process_overrides.cpp): the solution is right,
 // and a pivot that fails in a later panel is reported at its own column, as LAPACK would.
 TEST(SparseCholeskyTest, LargeDenseSupernodesAreFactoredInPanels) {
   const int n = 5 * SparseCholesky::kDensePanel + 37;
@@ -524,7 +524,7 @@ TEST(SparseCholeskyTest, LargeDenseSupernodesAreFactoredInPanels) {
       << status;
 }
 
-// sparse_cholesky.cpp defines dgemm_ (for CHOLMOD), skipping the work while a cancelled
+// process_overrides.cpp defines dgemm_ (for CHOLMOD), skipping the work while a cancelled
 // factorization winds down on the calling thread.
 extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
                        const int* k, const double* alpha, const double* a, const int* lda,

@@ -1,0 +1,101 @@
+// The solver library as another program links it: without inbetween_process_overrides (no BLAS,
+// LAPACK or libgomp entry points of ours, OpenBLAS and SuiteSparse's allocator left as the
+// program set them). Factorizations are still right and cancellable; CHOLMOD's calls go to the
+// system's LAPACK and libgomp.
+#include <dlfcn.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <Eigen/Dense>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "solver/core/cancel.h"
+#include "solver/core/sparse_cholesky.h"
+
+namespace inbetween::solver {
+namespace {
+
+// The file that defines `symbol` in this process, as the dynamic linker resolves it.
+std::string DefiningFile(const char* symbol) {
+  void* address = dlsym(RTLD_DEFAULT, symbol);
+  Dl_info info{};
+  if (address == nullptr || dladdr(address, &info) == 0 || info.dli_fname == nullptr) return "";
+  return info.dli_fname;
+}
+
+std::string ThisProgram() {
+  std::vector<char> path(4096, '\0');
+  const ssize_t n = readlink("/proc/self/exe", path.data(), path.size() - 1);
+  return n > 0 ? std::string(path.data(), static_cast<size_t>(n)) : "";
+}
+
+// A dense SPD matrix (upper triangle stored): one supernode wider than the overrides' panels.
+Eigen::SparseMatrix<double> DenseSpd(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::MatrixXd b(n, n);
+  for (Eigen::Index k = 0; k < b.size(); ++k) b.data()[k] = u(rng);
+  const Eigen::MatrixXd a = b * b.transpose() / n + Eigen::MatrixXd::Identity(n, n);
+  std::vector<Eigen::Triplet<double>> upper;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i <= j; ++i) upper.emplace_back(i, j, a(i, j));
+  }
+  Eigen::SparseMatrix<double> m(n, n);
+  m.setFromTriplets(upper.begin(), upper.end());
+  m.makeCompressed();
+  return m;
+}
+
+TEST(SolverLibraryTest, LinksNoneOfTheProcessWideOverrides) {
+  const std::string program = ThisProgram();
+  ASSERT_FALSE(program.empty());
+  for (const char* symbol : {"dpotrf_", "dsyrk_", "dgemm_", "dtrsm_", "GOMP_parallel"}) {
+    const std::string file = DefiningFile(symbol);
+    EXPECT_FALSE(file.empty()) << symbol << " is not defined in this process";
+    EXPECT_NE(file, program) << symbol << " is defined by the test program itself";
+  }
+}
+
+TEST(SolverLibraryTest, SupernodalFactorizationIsRightWithTheSystemLapack) {
+  const int n = 5 * SparseCholesky::kDensePanel + 37;
+  const Eigen::SparseMatrix<double> a = DenseSpd(n, 5);
+  SparseCholesky super(SparseCholesky::Method::kAuto), simplicial;
+  ASSERT_TRUE(super.Compute(a).ok());
+  ASSERT_TRUE(super.supernodal());
+  ASSERT_TRUE(simplicial.Compute(a).ok());
+  const Eigen::SparseMatrix<double> full = a.selfadjointView<Eigen::Upper>();
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Random(n, 2);
+  Eigen::MatrixXd x = b, y = b;
+  ASSERT_TRUE(super.SolveInPlace(&x).ok());
+  ASSERT_TRUE(simplicial.SolveInPlace(&y).ok());
+  EXPECT_LT((full * x - b).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 1e-10 * y.cwiseAbs().maxCoeff());
+}
+
+// Without the overrides' cancel points a started supernodal factorization runs to its end, but a
+// token set before it is still answered (the value array's allocation and the scatter poll), and
+// the factor is right afterwards.
+TEST(SolverLibraryTest, CancelledSupernodalFactorizationAnswersCancelledAndCanBeRedone) {
+  const int n = 3 * SparseCholesky::kDensePanel;
+  const Eigen::SparseMatrix<double> a = DenseSpd(n, 7);
+  SparseCholesky chol(SparseCholesky::Method::kAuto);
+  ASSERT_TRUE(chol.Analyze(a).ok());
+  ASSERT_TRUE(chol.supernodal());
+  CancelToken token;
+  token.Cancel();
+  EXPECT_EQ(chol.Factorize(a, &token).code(), absl::StatusCode::kCancelled);
+  ASSERT_TRUE(chol.Factorize(a).ok());
+  EXPECT_EQ(chol.Factorize(2.0 * a, &token).code(), absl::StatusCode::kCancelled);
+  ASSERT_TRUE(chol.Factorize(2.0 * a).ok());
+  const Eigen::SparseMatrix<double> full = 2.0 * Eigen::SparseMatrix<double>(
+                                                     a.selfadjointView<Eigen::Upper>());
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Ones(n, 1);
+  Eigen::MatrixXd x = b;
+  ASSERT_TRUE(chol.SolveInPlace(&x).ok());
+  EXPECT_LT((full * x - b).cwiseAbs().maxCoeff(), 1e-10);
+}
+
+}  // namespace
+}  // namespace inbetween::solver
