@@ -38,7 +38,6 @@ struct InbetweenOptions {
   // inbetweener.cpp), when one is given. The rotation gauge is what makes the warm start safe
   // for examples that differ by a rigid turn (the energy alone cannot tell rotated copies apart).
   bool warm_start = true;
-  // Added by issue 6:
   // ... or when no vertex moved by more than this times the reference size sqrt(total area) in
   // the last plain local-global step (whichever comes first).
   double displacement_tolerance = 1e-4;
@@ -77,7 +76,6 @@ struct FrameReport {
   double energy = 0.0;  // the kZhu17 objective at the frame (blended_arap.h + cohesive + inertia)
   double seconds = 0.0;
   int inverted = 0;
-  // Added by issue 6:
   int overlaps = 0;           // boundary vertices inside the shape + crossing boundary segments
   int separated_edges = 0;    // cohesive edge pairs whose zone is open (S-eq.6 capped)
   bool warm_started = false;  // kZhu17 started from `previous`
@@ -86,7 +84,7 @@ struct FrameReport {
   // with the frame's weights (1 = area kept; <= 0 = inverted).
   double min_area_ratio = 1.0;
   double max_area_ratio = 1.0;
-  // Added by issue 6 (non-overlap): above 0 when pushing the boundary out of the shape (W_O)
+  // Non-overlap: above 0 when pushing the boundary out of the shape (W_O)
   // could not make the frame clean, so it stopped short of its solution: the fraction of the way
   // from the previous frame to the solution it was held back (the frame is the furthest point on
   // that way with no overlap and no inverted triangle; 1 = it did not move).

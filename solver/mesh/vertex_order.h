@@ -5,7 +5,7 @@
 // Measured on the 311k-vertex S-Table 2 row (one run each): Hessian set-up 20%, step bound 33%
 // and topology passes 40% less time, 16% less in total (270 inner iterations against 260: the
 // iteration counts move with the numbering); at 35k-73k the set-up and topology gains remain and
-// the rest is within noise (docs/benchmarks.md, seventh session).
+// the rest is within noise (docs/benchmarks.md, "Decisions and what they rest on").
 #pragma once
 
 #include <vector>

@@ -1,4 +1,4 @@
-// Inbetweening speed (issue 6): frames per second of kZhu17 and kAlexa for 2 and 16 examples on
+// Inbetweening speed: frames per second of kZhu17 and kAlexa for 2 and 16 examples on
 // generated 4 x 1 bars of ~1.6k, 10k and 50k vertices, iterations per frame, the floor
 // iteration (one prefactored 2-RHS solve + one local step, measured in the same run) and peak
 // memory, and the accuracy of the default stopping rule: the largest vertex distance (relative to

@@ -1,4 +1,4 @@
-// Injective mapping benchmark (issue 4, item 4): a CGAL mesh of a 4 x 1 bar (~1.7k vertices)
+// Injective mapping benchmark: a CGAL mesh of a 4 x 1 bar (~1.7k vertices)
 // mapped by MapToBoundary onto the same bar bent into a half circle about its centre line (a
 // half annulus of mid radius 4 / pi). LIM (Schueller et al. 2013) reports ~285 ms for this
 // case; the target is < 100 ms. Prints the median and minimum over several runs, the vertex

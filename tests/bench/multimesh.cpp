@@ -4,8 +4,7 @@
 // baseline measured in the same run, against itself (the same meshing and loop matching, a map
 // with nothing to pull). Prints both times, their ratio, the vertex count and the overlays; the
 // copy's map pulls the mesh onto boundaries whose arc-length correspondence slides the holes'
-// corners along their sides (docs/benchmarks.md, twenty-ninth session: the 30 x 30 grid took
-// more than 5 minutes before).
+// corners along their sides (docs/benchmarks.md, "Multimesh construction").
 // Usage: multimesh [--max-holes N (grids up to N x N)] [--json FILE] (one JSON row per case:
 // {"case", "vertices", "seconds", "seconds_itself", "ratio", "overlays"}).
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Inbetweening quality (issue 6): per case and method (zhu17, alexa, linear) the worst frame's
+// Inbetweening quality: per case and method (zhu17, alexa, linear) the worst frame's
 // inverted triangles and boundary overlaps over a 25-frame sequence (24 frames per key pair,
 // solved in order with warm starts), the max isometric distortion max(sigma_1, 1 / sigma_2) of
 // the middle frame measured from the straight bar (example 0; the keys' own values are printed

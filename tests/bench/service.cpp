@@ -1,4 +1,4 @@
-// Service overhead (issue 7): the same Inbetween job (square -> hexagon meshed to ~1.6k vertices,
+// Service overhead: the same Inbetween job (square -> hexagon meshed to ~1.6k vertices,
 // zhu17, N frames) streamed from one InbetweenServer over its in-process channel (what the
 // embedded CLI uses) and over loopback TCP gRPC, alternating runs in one process. Per transport:
 // frames per second (frames / time from the request to the last frame) and per-frame latency

@@ -9,7 +9,7 @@ printf 'tok-main main\ntok-other other\ntok-healthy healthy\n' >"$WORK/tokens"
 # Four heavy slots so the healthy stream and a case's heavy call never wait on each other.
 start_server --tokens "$WORK/tokens" --max-heavy-jobs 4 --log-level warn
 # Sanitizer builds (scripts/sanitize) run the server several times slower: under TSan the largest
-# allowed drawing took 54-81 s of a 60 s per-call deadline (2026-12-03).
+# allowed drawing took 54-81 s of a 60 s per-call deadline.
 deadline=60 budget=240
 [[ -n ${INBETWEEN_SANITIZER:-} ]] && deadline=300 budget=840  # ctest stops it at 900 s
 timeout "$budget" "$RUNNER" --server "$SERVER_ADDR" --token tok-main --other-token tok-other \
@@ -19,7 +19,7 @@ kill -0 "$SERVER_PID" || { cat "$WORK/server.log"; echo "server died"; exit 1; }
 # Memory stays bounded by the limits: the peak resident set over the whole catalogue (largest
 # allowed drawing, 10M-vertex message refused, bombs refused) stays under MAX_RSS_MB.
 # Not under ThreadSanitizer (scripts/sanitize tsan): its shadow memory and history take several
-# times the program's own (5.4 GB measured for this catalogue, 2026-12-03); the bound is checked
+# times the program's own (5.4 GB measured for this catalogue); the bound is checked
 # by every uninstrumented run (scripts/test) and under ASan.
 peak_kb=$(awk '/^VmHWM:/{print $2}' "/proc/$SERVER_PID/status")
 echo "server peak RSS: $((peak_kb / 1024)) MB"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The server's per-RPC log lines (issue 7, observability), in both formats: one line per finished
+# The server's per-RPC log lines (observability), in both formats: one line per finished
 # RPC with its request id, method, session, status and duration (and the error for a failure).
 # --log-format json: every line on stderr/stdout that is not the port banner is one JSON object
 # {"time","level","thread","msg"}, whatever a client put in names (a drawing name with quotes,

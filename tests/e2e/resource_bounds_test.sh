@@ -18,7 +18,7 @@ if [[ -n "${INBETWEEN_SANITIZER:-}" ]]; then
   sanitizer=$INBETWEEN_SANITIZER
 else
   # ldd's output captured first: `ldd | grep -q` under pipefail fails when grep exits before
-  # ldd has written everything (SIGPIPE); build/asan's server ran under the cap once, 2026-12-02.
+  # ldd has written everything (SIGPIPE): build/asan's server once ran under the cap that way.
   libs=$(ldd "$SERVER_BIN" 2>/dev/null || true)
   symbols=$(nm -D "$SERVER_BIN" 2>/dev/null || true)
   if [[ $libs =~ lib(asan|tsan)\.so ]]; then

@@ -46,7 +46,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   options.boundary_vertices = boundary_vertices;
   // A thin feature is refused quickly, not refined for hours; and the map of a mesh this size
   // (2000 iterations at most, each one factorization) stays well inside the hang timeout under
-  // ASan (20000 vertices took 40 s). 300 (3000 until the twelfth session) for throughput.
+  // ASan (20000 vertices took 40 s). 300 rather than 3000 for throughput.
   options.max_mesh_vertices = 300;
   // A spike whose boundary pull never converges ran the whole 2,000-iteration budget (9.6 s
   // here) before its FAILED_PRECONDITION; 200 still run three stages of the pull (60 iterations

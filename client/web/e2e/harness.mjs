@@ -5,7 +5,7 @@ import { chromium } from "playwright-core";
 
 // Headless Debian Chromium for pages on loopback. The launch gets at least 90 s whatever the
 // step timeout: on a loaded 2-core CI machine a cold Chromium start once took over 30 s
-// (CI 2026-12-02, lottie_web_test 'browserType.launch: Timeout 30000ms exceeded').
+// (lottie_web_test: 'browserType.launch: Timeout 30000ms exceeded').
 const LAUNCH_MS = 90000;
 export function launchChromium(executablePath, timeout) {
   return chromium.launch({

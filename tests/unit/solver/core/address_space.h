@@ -1,7 +1,7 @@
 // For tests that cap a forked child's address space (RLIMIT_AS) to see allocations fail: the
 // process's mapped address space now, and whether this is a sanitizer build (ASan reserves
 // terabytes of shadow address space and answers an allocation that does not fit under a cap with
-// its own report, then a failed CHECK that hangs the child: seen in build/asan, 2026-12-02; such
+// its own report, then a failed CHECK that hangs the child, as seen in build/asan; such
 // tests skip there).
 #pragma once
 

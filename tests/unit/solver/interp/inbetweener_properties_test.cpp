@@ -1,4 +1,4 @@
-// Issue 6 properties of the kZhu17 inbetweener: a 4x1 bar curled 270 degrees, non-overlap,
+// Properties of the kZhu17 inbetweener: a 4x1 bar curled 270 degrees, non-overlap,
 // dynamics (epsilon = 0 is the plain inbetween), stiffness regions, warm starts.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Inbetweener properties over frames and iterations (issue 6): stiffness regions under keys that
+// Inbetweener properties over frames and iterations: stiffness regions under keys that
 // genuinely conflict, cohesive hysteresis across a frame sequence, monotone descent for
 // alpha != 1/2, timing curves through the solver, and the accuracy of the default stopping rule.
 #include <gtest/gtest.h>
