@@ -92,6 +92,16 @@ v1::Session Prepare(v1::Inbetween::Stub& stub, const std::string& examples, doub
   return session;
 }
 
+// The session's version now (GetSession).
+uint64_t CurrentVersion(v1::Inbetween::Stub& stub, const std::string& session_id) {
+  grpc::ClientContext context;
+  v1::GetSessionRequest request;
+  request.set_session_id(session_id);
+  v1::GetSessionResponse response;
+  if (auto s = stub.GetSession(&context, request, &response); !s.ok()) Fail("get", s);
+  return response.session().version();
+}
+
 // inbetween_rpcs_total{method=METHOD,code="CANCELLED"} in the server's metrics text.
 uint64_t CancelledCount(const inbetween::server::InbetweenServer& server,
                         const std::string& method) {
@@ -337,11 +347,20 @@ int main(int argc, char** argv) {
           }
           reader->Finish();
         }));
+    // A cancelled run stores its checkpoints (each a new session version): every trial starts
+    // from the version the session has now, and its comesh parameters make every topology pass
+    // (seconds of work, far longer than the 200 ms).
+    const uint64_t version = CurrentVersion(*inprocess, session.id());
     cancel_optimize.push_back(
         CancelLatencyMs(**server, "OptimizeComesh", [&](grpc::ClientContext* context) {
           v1::OptimizeComeshRequest request;
           request.set_session_id(session.id());
-          request.set_expected_version(session.version());
+          request.set_expected_version(version);
+          v1::ComeshParameters* comesh = request.mutable_comesh();
+          comesh->set_max_outer_iterations(1000);
+          comesh->set_max_inner_iterations(100000);
+          comesh->set_tolerance(1e-15);
+          comesh->set_outer_tolerance(0.0);
           auto reader = inprocess->OptimizeComesh(context, request);
           v1::OptimizeComeshResponse response;
           while (reader->Read(&response)) {
