@@ -697,8 +697,11 @@ absl::Status RunInspect(const std::string& session_id, const RunContext& ctx) {
     auto sessions = ctx.client->ListSessions();
     if (!sessions.ok()) return sessions.status();
     for (const auto& s : *sessions) {
-      std::printf("%s\tversion %llu\t%d drawings\t%s\t%s\n", s.id().c_str(),
-                  static_cast<unsigned long long>(s.version()), s.drawings_size(),
+      // Summaries carry the count, not the drawings; a server that does not keep it: "?".
+      const std::string drawings =
+          s.has_drawing_count() ? std::to_string(s.drawing_count()) : "?";
+      std::printf("%s\tversion %llu\t%s drawings\t%s\t%s\n", s.id().c_str(),
+                  static_cast<unsigned long long>(s.version()), drawings.c_str(),
                   v1::Stage_Name(s.stage()).c_str(), s.display_name().c_str());
     }
     return absl::OkStatus();

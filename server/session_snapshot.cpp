@@ -219,6 +219,12 @@ v1::Session SessionSummary(const v1::Session& session) {
   out.set_stage(session.stage());
   out.set_created_unix_ms(session.created_unix_ms());
   out.set_updated_unix_ms(session.updated_unix_ms());
+  // A summary of a summary (a store's listing) keeps the count it carries.
+  if (session.drawings_size() > 0 || !session.has_drawing_count()) {
+    out.set_drawing_count(static_cast<uint32_t>(session.drawings_size()));
+  } else {
+    out.set_drawing_count(session.drawing_count());
+  }
   return out;
 }
 

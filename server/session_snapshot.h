@@ -26,7 +26,7 @@ namespace inbetween::server {
 
 struct SnapshotHead {
   std::string owner;
-  inbetween::v1::Session summary;  // id, version, display_name, stage, timestamps
+  inbetween::v1::Session summary;  // SessionSummary: no drawings, their count
 };
 
 std::string EncodeSnapshot(const SessionState& state);
@@ -35,7 +35,8 @@ std::string EncodeSnapshot(const SessionState& state);
 absl::StatusOr<SessionState> DecodeSnapshot(absl::string_view bytes, absl::string_view where);
 absl::StatusOr<SnapshotHead> DecodeSnapshotHead(absl::string_view bytes, absl::string_view where);
 
-// The ListSessions summary of a session: id, version, display_name, stage, timestamps.
+// The ListSessions summary of a session: id, version, display_name, stage, timestamps and the
+// number of drawings.
 inbetween::v1::Session SessionSummary(const inbetween::v1::Session& session);
 
 }  // namespace inbetween::server

@@ -46,7 +46,9 @@ start_server
 "$CLI_BIN" --server "$SERVER_ADDR" animate square.svg hexagon.svg --frames 4 --out remote -q > remote.out
 sid=$(awk '/^session /{print $2}' remote.out)
 [[ -n "$sid" ]] || { echo "no session id printed"; cat remote.out; exit 1; }
-"$CLI_BIN" --server "$SERVER_ADDR" inspect | grep -q "^$sid" || { echo "inspect does not list $sid"; exit 1; }
+"$CLI_BIN" --server "$SERVER_ADDR" inspect > list.out
+grep -q "^$sid" list.out || { echo "inspect does not list $sid"; cat list.out; exit 1; }
+grep "^$sid" list.out | grep -q $'\t2 drawings\t' || { echo "inspect miscounts drawings"; cat list.out; exit 1; }
 "$CLI_BIN" --server "$SERVER_ADDR" inspect "$sid" | grep -q "STAGE_MULTIMESH"
 
 # validate uploads a project's drawings as animate does: a cut given in the project file (not in

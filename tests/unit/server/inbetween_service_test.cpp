@@ -216,6 +216,23 @@ TEST_F(InbetweenServiceTest, ListSessionsPages) {
             grpc::StatusCode::INVALID_ARGUMENT);
 }
 
+TEST_F(InbetweenServiceTest, ListSessionsSummariesCountTheDrawings) {
+  v1::Session session = CreateSession("two");
+  v1::PutDrawingResponse put;
+  ASSERT_TRUE(PutPolylines(session, SquareOutline(0, 0, 10), &put).ok());
+  ASSERT_TRUE(PutPolylines(put.session(), SquareOutline(0, 0, 20), &put).ok());
+  CreateSession("none");
+  grpc::ClientContext context;
+  v1::ListSessionsResponse response;
+  ASSERT_TRUE(stub_->ListSessions(&context, v1::ListSessionsRequest(), &response).ok());
+  ASSERT_EQ(response.sessions_size(), 2);
+  for (const v1::Session& s : response.sessions()) {
+    EXPECT_EQ(s.drawings_size(), 0);
+    ASSERT_TRUE(s.has_drawing_count()) << s.display_name();
+    EXPECT_EQ(s.drawing_count(), s.display_name() == "two" ? 2u : 0u) << s.display_name();
+  }
+}
+
 TEST_F(InbetweenServiceTest, StaleExpectedVersionIsAborted) {
   v1::Session session = CreateSession();
   v1::PutDrawingResponse put;

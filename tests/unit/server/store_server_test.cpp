@@ -78,6 +78,36 @@ TEST(StoreServerTest, IdleSessionsAreEvictedFromMemoryAndReloadOnTheNextCall) {
   fs::remove_all(root);
 }
 
+// A restarted server lists a dir store's sessions from their heads (nothing else loaded): the
+// summaries still count the drawings.
+TEST(StoreServerTest, ListingAfterARestartCountsTheDrawings) {
+  const fs::path root = fs::temp_directory_path() / ("list_count_test_" + std::to_string(getpid()));
+  fs::remove_all(root);
+  std::string id;
+  {
+    auto server = StartWithStore("dir:" + root.string(), std::chrono::seconds(0));
+    ASSERT_TRUE(server);
+    auto stub = v1::Inbetween::NewStub(server->InProcessChannel());
+    v1::PutDrawingResponse put;
+    ASSERT_TRUE(Rename(*stub, Create(*stub, "one"), &put).ok());
+    id = put.session().id();
+  }
+  {
+    auto server = StartWithStore("dir:" + root.string(), std::chrono::seconds(0));
+    ASSERT_TRUE(server);
+    EXPECT_EQ(server->store().CachedCount(), 0u);
+    auto stub = v1::Inbetween::NewStub(server->InProcessChannel());
+    grpc::ClientContext context;
+    v1::ListSessionsResponse listed;
+    ASSERT_TRUE(stub->ListSessions(&context, v1::ListSessionsRequest(), &listed).ok());
+    ASSERT_EQ(listed.sessions_size(), 1);
+    EXPECT_EQ(listed.sessions(0).id(), id);
+    ASSERT_TRUE(listed.sessions(0).has_drawing_count());
+    EXPECT_EQ(listed.sessions(0).drawing_count(), 1u);
+  }
+  fs::remove_all(root);
+}
+
 TEST(StoreServerTest, ZeroIdleEvictKeepsSessionsInMemory) {
   const fs::path root = fs::temp_directory_path() / ("no_evict_test_" + std::to_string(getpid()));
   fs::remove_all(root);
