@@ -178,6 +178,29 @@ v1::Session Compact(const v1::Session& session) {
 // stored multimesh's (embedded by BuildMultimesh and again after OptimizeComesh).
 constexpr size_t kArtMessageBytes = 1 << 20;
 
+// Frame `index` of an Inbetween stream as sent: its time, key weights, vertices and stats
+// (`seconds`: the caller's timing, when the solver's report has none).
+v1::InbetweenFrame FrameMessage(int index, const solver::FrameTiming& timing,
+                                const solver::Frame& frame, const solver::FrameReport& report,
+                                double seconds) {
+  v1::InbetweenFrame out;
+  out.set_index(index);
+  out.set_time(timing.time);
+  for (double w : timing.weights) out.add_weights(w);
+  ToProto(frame.vertices, out.mutable_vertices());
+  v1::FrameStats* stats = out.mutable_stats();
+  stats->set_iterations(report.iterations);
+  stats->set_energy(report.energy);
+  stats->set_inverted_triangles(report.inverted);
+  stats->set_boundary_overlaps(report.overlaps);
+  stats->set_min_area_ratio(report.min_area_ratio);
+  stats->set_max_area_ratio(report.max_area_ratio);
+  stats->set_separated_cohesive_edges(report.separated_edges);
+  stats->set_overlap_hold_back(report.hold_back);
+  stats->set_seconds(report.seconds > 0 ? report.seconds : seconds);
+  return out;
+}
+
 std::vector<v1::InbetweenResponse> AddKeyArt(const solver::Multimesh& mesh,
                                              v1::InbetweenHeader* header) {
   std::vector<v1::InbetweenResponse> more;
@@ -1130,48 +1153,10 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
         if (!plan.ok()) return plan.status();
         plan->options.stiffness = StiffnessPerTriangle(mesh, parameters.stiffness());
         plan->options.threads = options_.solver_threads;
-        if (plan->frames > options_.limits.max_frames) {
-          return absl::ResourceExhaustedError(
-              absl::StrCat("parameters.frames = ", plan->frames, " exceeds the limit of ",
-                           options_.limits.max_frames, " frames per request (--max-frames)"));
-        }
-        const int num_drawings = session.drawings_size();
-        if (plan->frames < num_drawings) {
-          return absl::InvalidArgumentError(
-              absl::StrCat("parameters.frames = ", plan->frames, " is fewer than the ",
-                           num_drawings, " drawings (every drawing is a key frame)"));
-        }
-        if (request->start_frame() >= static_cast<uint32_t>(plan->frames)) {
-          return absl::InvalidArgumentError(absl::StrCat("start_frame = ", request->start_frame(),
-                                                         " is not in [0, frames = ", plan->frames,
-                                                         ")"));
-        }
-        // Key times: parameters.key_times when set, else the drawings' key_time when every
-        // drawing has one, else evenly spaced keys.
-        std::vector<double> key_times(parameters.key_times().begin(), parameters.key_times().end());
-        const bool from_parameters = !key_times.empty();
-        if (!from_parameters) {
-          for (const v1::Drawing& drawing : session.drawings()) {
-            if (drawing.has_key_time()) key_times.push_back(drawing.key_time());
-          }
-          if (!key_times.empty() && static_cast<int>(key_times.size()) != num_drawings) {
-            return absl::InvalidArgumentError(
-                absl::StrCat("key_time is set on ", key_times.size(), " of ", num_drawings,
-                             " drawings: set it on every drawing or on none"));
-          }
-        }
-        absl::StatusOr<solver::TimingOptions> timing =
-            ToTimingOptions(parameters, num_drawings, "parameters");
-        if (!timing.ok()) return timing.status();
-        absl::StatusOr<solver::Schedule> schedule =
-            solver::MakeSchedule(num_drawings, plan->frames, key_times, *timing);
-        if (!schedule.ok()) {
-          return absl::Status(schedule.status().code(),
-                              absl::StrCat(from_parameters     ? "parameters.key_times: "
-                                           : key_times.empty() ? "frame schedule: "
-                                                               : "drawings' key_time: ",
-                                           schedule.status().message()));
-        }
+        const absl::StatusOr<solver::Schedule> schedule =
+            ScheduleFrames(parameters, session, plan->frames, request->start_frame(),
+                           options_.limits.max_frames);
+        if (!schedule.ok()) return schedule.status();
 
         absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
         if (!slot.ok()) return slot.status();
@@ -1234,21 +1219,7 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
           }
           if (i >= static_cast<int>(request->start_frame())) {
             message.Clear();
-            v1::InbetweenFrame* out = message.mutable_frame();
-            out->set_index(i);
-            out->set_time(timing.time);
-            for (double w : timing.weights) out->add_weights(w);
-            ToProto(frame->vertices, out->mutable_vertices());
-            v1::FrameStats* stats = out->mutable_stats();
-            stats->set_iterations(report.iterations);
-            stats->set_energy(report.energy);
-            stats->set_inverted_triangles(report.inverted);
-            stats->set_boundary_overlaps(report.overlaps);
-            stats->set_min_area_ratio(report.min_area_ratio);
-            stats->set_max_area_ratio(report.max_area_ratio);
-            stats->set_separated_cohesive_edges(report.separated_edges);
-            stats->set_overlap_hold_back(report.hold_back);
-            stats->set_seconds(report.seconds > 0 ? report.seconds : seconds);
+            *message.mutable_frame() = FrameMessage(i, timing, *frame, report, seconds);
             if (!writer->Write(message)) return StoppedStatus(*context, "Inbetween");
           }
           previous = *std::move(frame);

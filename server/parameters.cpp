@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 
@@ -308,6 +309,51 @@ absl::StatusOr<solver::TimingOptions> ToTimingOptions(const inbetween::v1::Inbet
       break;
   }
   return timing;
+}
+
+absl::StatusOr<solver::Schedule> ScheduleFrames(const inbetween::v1::InbetweenParameters& params,
+                                                const inbetween::v1::Session& session, int frames,
+                                                uint32_t start_frame, int max_frames) {
+  if (frames > max_frames) {
+    return absl::ResourceExhaustedError(absl::StrCat("parameters.frames = ", frames,
+                                                     " exceeds the limit of ", max_frames,
+                                                     " frames per request (--max-frames)"));
+  }
+  const int num_drawings = session.drawings_size();
+  if (frames < num_drawings) {
+    return absl::InvalidArgumentError(absl::StrCat("parameters.frames = ", frames,
+                                                   " is fewer than the ", num_drawings,
+                                                   " drawings (every drawing is a key frame)"));
+  }
+  if (start_frame >= static_cast<uint32_t>(frames)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("start_frame = ", start_frame, " is not in [0, frames = ", frames, ")"));
+  }
+  std::vector<double> key_times(params.key_times().begin(), params.key_times().end());
+  const bool from_parameters = !key_times.empty();
+  if (!from_parameters) {
+    for (const inbetween::v1::Drawing& drawing : session.drawings()) {
+      if (drawing.has_key_time()) key_times.push_back(drawing.key_time());
+    }
+    if (!key_times.empty() && static_cast<int>(key_times.size()) != num_drawings) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("key_time is set on ", key_times.size(), " of ", num_drawings,
+                       " drawings: set it on every drawing or on none"));
+    }
+  }
+  absl::StatusOr<solver::TimingOptions> timing =
+      ToTimingOptions(params, num_drawings, "parameters");
+  if (!timing.ok()) return timing.status();
+  absl::StatusOr<solver::Schedule> schedule =
+      solver::MakeSchedule(num_drawings, frames, key_times, *timing);
+  if (!schedule.ok()) {
+    return absl::Status(schedule.status().code(),
+                        absl::StrCat(from_parameters     ? "parameters.key_times: "
+                                     : key_times.empty() ? "frame schedule: "
+                                                         : "drawings' key_time: ",
+                                     schedule.status().message()));
+  }
+  return schedule;
 }
 
 }  // namespace inbetween::server

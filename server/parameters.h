@@ -64,4 +64,14 @@ absl::StatusOr<InbetweenPlan> ToInbetweenPlan(const inbetween::v1::InbetweenPara
 absl::StatusOr<solver::TimingOptions> ToTimingOptions(
     const inbetween::v1::InbetweenParameters& params, int num_drawings, absl::string_view field);
 
+// The frames of one Inbetween stream: how many, and each frame's time and key weights.
+// Key times are parameters.key_times when set, else the drawings' key_time when every drawing
+// has one, else evenly spaced keys. Errors name what is wrong: fewer frames than drawings or
+// start_frame past the end (INVALID_ARGUMENT), more frames than `max_frames` (RESOURCE_EXHAUSTED,
+// --max-frames), key_time set on some drawings only, or a schedule the key times or timing
+// curve cannot make (prefixed with the field it came from).
+absl::StatusOr<solver::Schedule> ScheduleFrames(const inbetween::v1::InbetweenParameters& params,
+                                                const inbetween::v1::Session& session, int frames,
+                                                uint32_t start_frame, int max_frames);
+
 }  // namespace inbetween::server

@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 namespace inbetween::server {
 namespace {
@@ -188,6 +192,62 @@ TEST(ParametersTest, KeyTimesAreRangeCheckedAndMerged) {
   request.add_key_times(0.3);
   request.add_key_times(1.0);
   EXPECT_EQ(MergeInbetween(session, request).key_times_size(), 3);
+}
+
+// A session of `n` drawings, with key_time on the first `timed` of them (times i / (n - 1)).
+v1::Session SessionOfDrawings(int n, int timed) {
+  v1::Session session;
+  for (int i = 0; i < n; ++i) {
+    v1::Drawing* drawing = session.add_drawings();
+    if (i < timed) drawing->set_key_time(static_cast<double>(i) / (n - 1));
+  }
+  return session;
+}
+
+TEST(ParametersTest, FramesAreScheduledFromTheKeyTimesTheRequestOrTheDrawingsGive) {
+  v1::InbetweenParameters p;
+  // Evenly spaced: 3 drawings over 9 frames hit frames 0, 4 and 8.
+  absl::StatusOr<solver::Schedule> even = ScheduleFrames(p, SessionOfDrawings(3, 0), 9, 0, 100);
+  ASSERT_TRUE(even.ok()) << even.status();
+  EXPECT_EQ(even->keys, (std::vector<int>{0, 4, 8}));
+  EXPECT_EQ(even->frames.size(), 9u);
+  // The drawings' key times when every drawing has one.
+  v1::Session session = SessionOfDrawings(3, 3);
+  session.mutable_drawings(1)->set_key_time(0.25);
+  absl::StatusOr<solver::Schedule> drawn = ScheduleFrames(p, session, 9, 0, 100);
+  ASSERT_TRUE(drawn.ok()) << drawn.status();
+  EXPECT_EQ(drawn->keys, (std::vector<int>{0, 2, 8}));
+  // The request's key times over the drawings'.
+  p.add_key_times(0.0);
+  p.add_key_times(0.75);
+  p.add_key_times(1.0);
+  absl::StatusOr<solver::Schedule> asked = ScheduleFrames(p, session, 9, 0, 100);
+  ASSERT_TRUE(asked.ok()) << asked.status();
+  EXPECT_EQ(asked->keys, (std::vector<int>{0, 6, 8}));
+}
+
+TEST(ParametersTest, FrameSchedulesThatCannotBeMadeNameTheReason) {
+  const v1::InbetweenParameters p;
+  auto error = [](const absl::StatusOr<solver::Schedule>& s) {
+    return std::make_pair(s.status().code(), std::string(s.status().message()));
+  };
+  auto [code, message] = error(ScheduleFrames(p, SessionOfDrawings(3, 0), 101, 0, 100));
+  EXPECT_EQ(code, absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(message, HasSubstr("--max-frames"));
+  std::tie(code, message) = error(ScheduleFrames(p, SessionOfDrawings(3, 0), 2, 0, 100));
+  EXPECT_EQ(code, absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(message, HasSubstr("fewer than the 3 drawings"));
+  std::tie(code, message) = error(ScheduleFrames(p, SessionOfDrawings(3, 0), 9, 9, 100));
+  EXPECT_EQ(code, absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(message, HasSubstr("start_frame = 9"));
+  std::tie(code, message) = error(ScheduleFrames(p, SessionOfDrawings(3, 2), 9, 0, 100));
+  EXPECT_EQ(code, absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(message, HasSubstr("key_time is set on 2 of 3 drawings"));
+  v1::Session session = SessionOfDrawings(3, 3);
+  session.mutable_drawings(1)->set_key_time(0.01);  // snaps onto the first key's frame
+  std::tie(code, message) = error(ScheduleFrames(p, session, 4, 0, 100));
+  EXPECT_NE(code, absl::StatusCode::kOk);
+  EXPECT_THAT(message, HasSubstr("drawings' key_time: "));
 }
 
 }  // namespace
