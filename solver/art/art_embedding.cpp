@@ -5,17 +5,17 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "solver/art/triangle_grid.h"
+#include "solver/geometry/primitives.h"
 
 namespace inbetween::solver {
 namespace {
-
-double Cross(const Point& u, const Point& v) { return u.x() * v.y() - u.y() * v.x(); }
 
 // Parameters t in (0, 1) where segment pq crosses an edge of a triangle from `candidates`,
 // ascending, none within `min_gap` of 0, 1 or one another.
@@ -199,11 +199,9 @@ absl::StatusOr<EmbeddedArt> EmbedArt(const Multimesh& mesh, int key,
   }
   const int nv = mesh.num_vertices();
   for (const Triangle& t : mesh.triangles) {
-    for (int v : t) {
-      if (v < 0 || v >= nv) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("art embedding: triangle vertex ", v, " out of range [0, ", nv, ")"));
-      }
+    if (const std::optional<int> v = IndexOutOfRange(t, nv)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("art embedding: triangle vertex ", *v, " out of range [0, ", nv, ")"));
     }
   }
   for (size_t l = 0; l < art.size(); ++l) {

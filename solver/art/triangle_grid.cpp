@@ -5,17 +5,10 @@
 #include <cmath>
 #include <limits>
 
+#include "solver/geometry/primitives.h"
+
 namespace inbetween::solver {
 namespace {
-
-double Cross(const Point& u, const Point& v) { return u.x() * v.y() - u.y() * v.x(); }
-
-double DistanceToSegment(const Point& a, const Point& b, const Point& p) {
-  const Point d = b - a;
-  const double l2 = d.squaredNorm();
-  const double t = l2 > 0.0 ? std::clamp((p - a).dot(d) / l2, 0.0, 1.0) : 0.0;
-  return (a + t * d - p).norm();
-}
 
 // Segment pq meets the closed box (slab test).
 bool SegmentMeetsBox(const Point& p, const Point& q, const Eigen::AlignedBox2d& box) {
@@ -47,7 +40,7 @@ Eigen::Vector3d Barycentric(const Point& a, const Point& b, const Point& c, cons
 double DistanceToTriangle(const Point& a, const Point& b, const Point& c, const Point& p) {
   if (Barycentric(a, b, c, p).minCoeff() >= 0.0) return 0.0;
   return std::min(
-      {DistanceToSegment(a, b, p), DistanceToSegment(b, c, p), DistanceToSegment(c, a, p)});
+      {DistanceToSegment(p, a, b), DistanceToSegment(p, b, c), DistanceToSegment(p, c, a)});
 }
 
 TriangleGrid::TriangleGrid(const std::vector<Triangle>& triangles, const Points& vertices,
@@ -75,7 +68,7 @@ TriangleGrid::TriangleGrid(const std::vector<Triangle>& triangles, const Points&
     const Point& a = vertices[triangles[t][0]];
     const Point& b = vertices[triangles[t][1]];
     const Point& c = vertices[triangles[t][2]];
-    if (!(Cross(b - a, c - a) > 0.0)) continue;
+    if (!(SignedArea2(a, b, c) > 0.0)) continue;
     Box box(a);
     box.extend(b).extend(c);
     const Eigen::Vector2i lo = CellOf(box.min()), hi = CellOf(box.max());

@@ -3,6 +3,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
@@ -53,7 +54,7 @@ void MipsEdgeHessians(const Eigen::Matrix2d& p, const Eigen::Matrix2d& q, Matrix
                       Matrix4* hq) {
   Eigen::Matrix2d adj_p;
   adj_p << p(1, 1), -p(0, 1), -p(1, 0), p(0, 0);
-  const double d = q(0, 0) * q(1, 1) - q(0, 1) * q(1, 0);
+  const double d = q.determinant();
   if (hp != nullptr) {
     Matrix4 t = Matrix4::Zero();  // vec(adj P) = T vec(P)
     t(0, 3) = 1.0;

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -12,6 +13,7 @@
 #include "solver/comesh/mips_energy.h"
 #include "solver/comesh/odt_energy.h"
 #include "solver/core/parallel_chunks.h"
+#include "solver/geometry/primitives.h"
 
 namespace inbetween::solver {
 
@@ -33,13 +35,11 @@ absl::StatusOr<ComeshObjective> ComeshObjective::Create(const std::vector<Triang
   }
   for (size_t t = 0; t < triangles.size(); ++t) {
     const Triangle& tri = triangles[t];
-    for (int k = 0; k < 3; ++k) {
-      if (tri[k] < 0 || tri[k] >= n) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("triangle ", t, " has vertex index ", tri[k], " outside [0, ", n, ")"));
-      }
+    if (const std::optional<int> v = IndexOutOfRange(tri, n)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("triangle ", t, " has vertex index ", *v, " outside [0, ", n, ")"));
     }
-    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+    if (RepeatsVertex(tri)) {
       return absl::InvalidArgumentError(absl::StrCat("triangle ", t, " repeats a vertex"));
     }
   }
@@ -49,11 +49,7 @@ absl::StatusOr<ComeshObjective> ComeshObjective::Create(const std::vector<Triang
   o.map_weight_ = map_weight;
   for (size_t s = 0; s < rest.size(); ++s) {
     double area = 0.0;
-    for (const Triangle& t : triangles) {
-      const Point ab = rest[s][t[1]] - rest[s][t[0]];
-      const Point ac = rest[s][t[2]] - rest[s][t[0]];
-      area += 0.5 * std::abs(ab.x() * ac.y() - ab.y() * ac.x());
-    }
+    for (const Triangle& t : triangles) area += 0.5 * std::abs(SignedArea2(t, rest[s]));
     if (!(area > 0.0) || !std::isfinite(area)) {
       return absl::InvalidArgumentError(absl::StrCat("shape ", s, " has zero or invalid area"));
     }
@@ -165,7 +161,7 @@ double ComeshObjective::Evaluate(const std::vector<Points>& shapes, std::vector<
     for (int i = 0; i < n; ++i) {
       const Points& x = shapes[i];
       for (const auto& [a, b] : boundary_edges_) {
-        area[i] += 0.5 * (x[a].x() * x[b].y() - x[b].x() * x[a].y());
+        area[i] += 0.5 * Cross(x[a], x[b]);
       }
       if (!(area[i] > 0.0) || !std::isfinite(area[i])) return kInf;
       const double r = area[i] / areas_[i];

@@ -6,6 +6,8 @@
 #include <limits>
 #include <numbers>
 
+#include "solver/geometry/primitives.h"
+
 namespace inbetween::solver {
 
 ShapeOutline::ShapeOutline(const Multimesh& mesh, int shape, double corner_degrees,
@@ -60,7 +62,7 @@ void ShapeOutline::Init(const std::vector<Points>& loops,
       // A turn above corner_degrees means cos(turn) below cos(corner_degrees).
       if (fixed[i][k] || !(norms > 0.0) || in.dot(out) < cos_corner * norms) {
         loop.hard.push_back(loop.arc[k]);
-      } else if (std::abs(in.x() * out.y() - in.y() * out.x()) > 1e-9 * norms) {
+      } else if (std::abs(Cross(in, out)) > 1e-9 * norms) {
         curved_ = true;  // a soft corner (StrictlyInsideSegment's straightness tolerance)
       }
     }
@@ -104,9 +106,9 @@ std::optional<ShapeOutline::Location> ShapeOutline::Locate(const Point& p,
       for (const auto& [l, k] : it->second) {
         const Loop& loop = loops_[l];
         const Point& a = loop.points[k];
-        const Point ab = loop.points[(k + 1) % loop.points.size()] - a;
-        const double len2 = ab.squaredNorm();
-        const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+        const Point& b = loop.points[(k + 1) % loop.points.size()];
+        const Point ab = b - a;
+        const double t = ab.squaredNorm() > 0.0 ? SegmentParameter(p, a, b) : 0.0;
         const double distance = (p - (a + t * ab)).norm();
         // Ties (a polyline point is on two segments) go to the first segment found in this
         // fixed cell order, so the result is deterministic.
@@ -247,8 +249,6 @@ double ShapeOutline::ChordDeviation(const Point& a, const Point& b,
     from = lb->u;
     span = length - span;
   }
-  const Point ab = b - a;
-  const double len2 = ab.squaredNorm();
   double worst = 0.0;
   // Points strictly inside the arc: from the first point after `from` while within the span.
   int k = SegmentAt(loop, from) + 1;
@@ -256,9 +256,7 @@ double ShapeOutline::ChordDeviation(const Point& a, const Point& b,
     const int j = k % m;
     const double along = (k >= m ? length : 0.0) + loop.arc[j] - from;
     if (!(along < span)) break;
-    const Point& p = loop.points[j];
-    const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    worst = std::max(worst, (p - (a + t * ab)).norm());
+    worst = std::max(worst, DistanceToSegment(loop.points[j], a, b));
   }
   return worst;
 }

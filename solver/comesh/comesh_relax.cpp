@@ -10,6 +10,7 @@
 
 #include "solver/comesh/mips_energy.h"
 #include "solver/comesh/odt_energy.h"
+#include "solver/geometry/primitives.h"
 
 namespace inbetween::solver {
 namespace {
@@ -18,8 +19,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Which corner of t is v.
 int CornerOf(const Triangle& t, int v) { return t[0] == v ? 0 : (t[1] == v ? 1 : 2); }
-
-double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 }  // namespace
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "solver/comesh/comesh_objective.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/validate.h"
 #include "solver/mesh/vertex_star.h"
 
@@ -22,11 +23,6 @@ namespace {
 
 bool LexicographicLess(const Point& p, const Point& q) {
   return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y());
-}
-
-double Area2(const Point& a, const Point& b, const Point& c) {
-  const Point ab = b - a, ac = c - a;
-  return ab.x() * ac.y() - ab.y() * ac.x();
 }
 
 // Edges (a, b), a < b, grouped by a in linear time: `for_each_edge(emit)` calls emit(a, b) for
@@ -125,8 +121,7 @@ class Editor {
     }
     for (int s = 0; s < num_shapes; ++s) {
       double area = 0.0, length = 0.0;
-      for (const Triangle& t : triangles_)
-        area += 0.5 * Area2(shapes_[s][t[0]], shapes_[s][t[1]], shapes_[s][t[2]]);
+      for (const Triangle& t : triangles_) area += 0.5 * SignedArea2(t, shapes_[s]);
       for (const auto& [edge, count] : uses) {
         length += (shapes_[s][edge.first] - shapes_[s][edge.second]).norm();
       }
@@ -251,7 +246,7 @@ class Editor {
   // Twice the area the boundary polygon of shape s changes by when boundary vertex v leaves it.
   double DropArea2(size_t s, int v) const {
     const Points& x = shapes_[s];
-    return std::abs(Area2(x[boundary_nbrs_[v][0]], x[v], x[boundary_nbrs_[v][1]]));
+    return std::abs(SignedArea2(x[boundary_nbrs_[v][0]], x[v], x[boundary_nbrs_[v][1]]));
   }
 
   // Length of edge (a, b) relative to the mean edge length, max (or min) over shapes.
@@ -829,7 +824,7 @@ class Editor {
   bool Positive(const Triangle& t) const {
     for (size_t s = 0; s < shapes_.size(); ++s) {
       const Points& x = shapes_[s];
-      if (!(Area2(x[t[0]], x[t[1]], x[t[2]]) > min_area2_[s])) return false;
+      if (!(SignedArea2(t, x) > min_area2_[s])) return false;
     }
     return true;
   }
@@ -975,8 +970,7 @@ bool StrictlyInsideSegment(const Point& a, const Point& b, const Point& v) {
   // line relative to |ab|: a corner whose neighbour has slid to within 1e-9 |ab| of it is off
   // that line by less than that and was taken for straight, then slid or collapsed away.
   const Point av = v - a, vb = b - v;
-  return av.dot(vb) > 0.0 &&
-         std::abs(av.x() * vb.y() - av.y() * vb.x()) <= 1e-9 * av.norm() * vb.norm();
+  return av.dot(vb) > 0.0 && std::abs(Cross(av, vb)) <= 1e-9 * av.norm() * vb.norm();
 }
 
 absl::StatusOr<Multimesh> ImproveTopology(const Multimesh& mesh, double map_weight,

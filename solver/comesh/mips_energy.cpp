@@ -2,6 +2,7 @@
 // (see mips_energy.h for the derivation).
 #include "solver/comesh/mips_energy.h"
 
+#include <Eigen/LU>
 #include <cmath>
 #include <limits>
 
@@ -9,8 +10,6 @@ namespace inbetween::solver {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double Det(const Eigen::Matrix2d& m) { return m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0); }
 
 Eigen::Matrix2d Adjugate(const Eigen::Matrix2d& m) {
   Eigen::Matrix2d a;
@@ -38,8 +37,8 @@ Eigen::Matrix2d EdgeMatrix(const Points& x, const Triangle& t) {
 }
 
 double MipsSigma(const Eigen::Matrix2d& p, const Eigen::Matrix2d& q) {
-  const double det_p = Det(p);
-  const double det_q = Det(q);
+  const double det_p = p.determinant();
+  const double det_q = q.determinant();
   if (!(det_p > 0.0) || !(det_q > 0.0)) return kInf;
   return (q * Adjugate(p)).squaredNorm() / (det_p * det_q);
 }
@@ -48,8 +47,8 @@ double MipsTriangleEnergy(const std::array<Point, 3>& xi, const std::array<Point
                           std::array<Point, 3>* gradient_i, std::array<Point, 3>* gradient_j) {
   const Eigen::Matrix2d p = EdgeMatrix(xi);
   const Eigen::Matrix2d q = EdgeMatrix(xj);
-  const double det_p = Det(p);
-  const double det_q = Det(q);
+  const double det_p = p.determinant();
+  const double det_q = q.determinant();
   if (!(det_p > 0.0) || !(det_q > 0.0)) return kInf;
   const Eigen::Matrix2d adj_p = Adjugate(p);
   const Eigen::Matrix2d m = q * adj_p;

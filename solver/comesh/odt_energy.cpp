@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "solver/geometry/primitives.h"
+
 namespace inbetween::solver {
 
 double OdtTriangleEnergy(const Point& a, const Point& b, const Point& c,
@@ -11,7 +13,7 @@ double OdtTriangleEnergy(const Point& a, const Point& b, const Point& c,
   const Point ab = b - a;
   const Point ac = c - a;
   const Point bc = c - b;
-  const double area = 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
+  const double area = 0.5 * Cross(ab, ac);
   if (!(area > 0.0)) return std::numeric_limits<double>::infinity();
   const double sum_sq = ab.squaredNorm() + ac.squaredNorm() + bc.squaredNorm();
   if (gradient != nullptr) {
@@ -46,11 +48,7 @@ double OdtEnergy(const std::vector<Triangle>& triangles, const Points& x, Points
 double OdtNormalization(const std::vector<Triangle>& triangles, const Points& x) {
   if (triangles.empty()) return 0.0;
   double area = 0.0;
-  for (const Triangle& t : triangles) {
-    const Point ab = x[t[1]] - x[t[0]];
-    const Point ac = x[t[2]] - x[t[0]];
-    area += 0.5 * std::abs(ab.x() * ac.y() - ab.y() * ac.x());
-  }
+  for (const Triangle& t : triangles) area += 0.5 * std::abs(SignedArea2(t, x));
   return area * area / (std::sqrt(3.0) * static_cast<double>(triangles.size()));
 }
 

@@ -11,6 +11,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/cgal_predicates.h"
 
 namespace inbetween::solver {
@@ -19,15 +20,6 @@ namespace {
 struct Segment {
   Point a, b;
 };
-
-// The point of segment a-b nearest to p.
-Point NearestOnSegment(const Point& p, const Point& a, const Point& b) {
-  const Point d = b - a;
-  const double len2 = d.squaredNorm();
-  if (len2 == 0) return a;
-  const double t = std::clamp((p - a).dot(d) / len2, 0.0, 1.0);
-  return a + t * d;
-}
 
 // The point of the closed loop nearest to p.
 Point NearestOnLoop(const Point& p, const Points& loop) {
@@ -179,15 +171,14 @@ std::optional<Segment> SplitCut(const BoundaryGraph& g, int outer_loop,
     q = std::move(thin);
   }
   const size_t m = q.size();
-  const auto cross = [](const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); };
-  std::vector<double> prefix(m + 1, 0.0);  // prefix[k] = sum of cross(q_i, q_i+1), i < k
-  for (size_t i = 0; i < m; ++i) prefix[i + 1] = prefix[i] + cross(q[i], q[(i + 1) % m]);
+  std::vector<double> prefix(m + 1, 0.0);  // prefix[k] = sum of Cross(q_i, q_i+1), i < k
+  for (size_t i = 0; i < m; ++i) prefix[i + 1] = prefix[i] + Cross(q[i], q[(i + 1) % m]);
   const double total = 0.5 * prefix[m];
   if (!(total > 0)) return std::nullopt;
   std::vector<std::pair<double, std::pair<int, int>>> chords;
   for (size_t i = 0; i < m; ++i) {
     for (size_t j = i + 2; j < m; ++j) {
-      const double part = 0.5 * (prefix[j] - prefix[i] + cross(q[j], q[i]));
+      const double part = 0.5 * (prefix[j] - prefix[i] + Cross(q[j], q[i]));
       if (std::min(part, total - part) < min_part * total) continue;
       chords.push_back({(q[j] - q[i]).squaredNorm(), {static_cast<int>(i), static_cast<int>(j)}});
     }

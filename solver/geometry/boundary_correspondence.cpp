@@ -16,6 +16,7 @@
 #include "solver/geometry/affine_fit.h"
 #include "solver/geometry/loop_alignment.h"
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 #include "solver/geometry/resample_outline.h"
 
 namespace inbetween::solver {
@@ -50,25 +51,14 @@ struct Curve {
   Points p;
   std::vector<double> cum;  // cum[k] = arc length at p[k]; cum[n] = perimeter
   double length() const { return cum.back(); }
-  Point At(double u) const {
-    const double total = length();
-    u = std::fmod(u, total);
-    if (u < 0) u += total;
-    const size_t n = p.size();
-    size_t i = std::upper_bound(cum.begin(), cum.end(), u) - cum.begin();
-    i = std::clamp<size_t>(i, 1, n) - 1;
-    const double len = cum[i + 1] - cum[i];
-    const double t = len > 0 ? std::clamp((u - cum[i]) / len, 0.0, 1.0) : 0.0;
-    if (t == 0.0) return p[i];
-    if (t == 1.0) return p[(i + 1) % n];
-    return p[i] + t * (p[(i + 1) % n] - p[i]);
-  }
+  Point At(double u) const { return PointAtArcLength(p, cum, u, SegmentEnds::kExact); }
   double Project(const Point& q, double* distance) const {
     double best = std::numeric_limits<double>::infinity(), at = 0;
     for (size_t i = 0; i < p.size(); ++i) {
-      const Point a = p[i], d = p[(i + 1) % p.size()] - a;
-      const double t = std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-      const double dist = (a + t * d - q).norm();
+      const Point& a = p[i];
+      const Point& b = p[(i + 1) % p.size()];
+      const double t = SegmentParameter(q, a, b);
+      const double dist = (a + t * (b - a) - q).norm();
       if (dist < best) best = dist, at = cum[i] + t * (cum[i + 1] - cum[i]);
     }
     if (distance) *distance = best;
@@ -79,9 +69,7 @@ struct Curve {
 Curve MakeCurve(const Points& p) {
   Curve c;
   c.p = p;
-  c.cum.assign(p.size() + 1, 0.0);
-  for (size_t i = 0; i < p.size(); ++i)
-    c.cum[i + 1] = c.cum[i] + (p[(i + 1) % p.size()] - p[i]).norm();
+  c.cum = CumulativeLength(p);
   return c;
 }
 
@@ -185,7 +173,7 @@ Point Centroid(const Points& p) {
     for (size_t i = 0; i < n; ++i) {
       const Point& a = p[i];
       const Point& b = p[(i + 1) % n];
-      c += (a + b) * (a.x() * b.y() - b.x() * a.y());
+      c += (a + b) * Cross(a, b);
     }
     return c / (6 * area);
   }
@@ -308,7 +296,7 @@ double AlignStart(const Curve& a, const Curve& b, const Point& ca, double sa, co
       // the m^2 loop: it was most of a many-part drawing's loop matching).
       const Point& u = ua[k];
       const Point& v = ub[(k + s) % m];
-      sn += u.y() * v.x() - u.x() * v.y(), cs += u.x() * v.x() + u.y() * v.y();
+      sn += Cross(v, u), cs += u.x() * v.x() + u.y() * v.y();
       position += (pa[k] - pb[(k + s) % m]).squaredNorm();
     }
     // sum_k (1 - cos(d_k - rotation)) at the best rotation = m - |sum e^{i d_k}|.
@@ -579,7 +567,7 @@ std::vector<Corner> CornersOf(const Curve& c, double corner_angle_degrees) {
   const size_t n = c.p.size();
   for (int k : FindCorners(c.p, corner_angle_degrees)) {
     const Point in = c.p[k] - c.p[(k + n - 1) % n], next = c.p[(k + 1) % n] - c.p[k];
-    const double cross = in.x() * next.y() - in.y() * next.x();
+    const double cross = Cross(in, next);
     out.push_back({c.cum[k], cross > 0.0 ? 1 : -1, std::atan2(std::abs(cross), in.dot(next))});
   }
   std::sort(out.begin(), out.end(), [](const Corner& a, const Corner& b) { return a.arc < b.arc; });
@@ -675,8 +663,7 @@ std::vector<std::pair<double, std::vector<double>>> MatchCornersAbove(
 // the chord between its ends, and the arc of its farthest vertex.
 double ChordDeviation(const Curve& c, double a0, double a1, double* farthest) {
   const double length = c.length();
-  const Point p = c.At(a0), q = c.At(a1), d = q - p;
-  const double dd = d.squaredNorm();
+  const Point p = c.At(a0), q = c.At(a1);
   const int n = static_cast<int>(c.p.size());
   double worst = 0.0;
   *farthest = 0.5 * (a0 + a1);
@@ -688,9 +675,7 @@ double ChordDeviation(const Curve& c, double a0, double a1, double* farthest) {
     const double arc = base + wrap * length + c.cum[idx];
     if (arc >= a1) break;
     if (arc <= a0) continue;
-    const Point& x = c.p[idx];
-    const double t = dd > 0 ? std::clamp((x - p).dot(d) / dd, 0.0, 1.0) : 0.0;
-    const double dist = (p + t * d - x).norm();
+    const double dist = DistanceToSegment(c.p[idx], p, q);
     if (dist > worst) worst = dist, *farthest = arc;
   }
   return worst;

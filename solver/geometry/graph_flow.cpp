@@ -11,14 +11,13 @@
 #include "absl/strings/str_join.h"
 #include "solver/geometry/correspondence.h"
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/cgal_predicates.h"
 
 namespace inbetween::solver {
 namespace {
 
 std::string Where(const Point& p) { return absl::StrCat("(", p.x(), ", ", p.y(), ")"); }
-
-double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // Clockwise angle in (0, 2pi] from direction a to direction b (a full turn for b == a).
 double ClockwiseAngle(const Point& a, const Point& b) {
@@ -154,7 +153,7 @@ absl::StatusOr<BoundaryGraph> BuildBoundaries(const Drawing& drawing, int drawin
     Point snapped = p;
     for (int s = 0; s < num_outline_segments; ++s) {
       const Point a = segments[s].a, d = segments[s].b - a;
-      const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      const double t = SegmentParameter(p, a, segments[s].b);
       const Point q = (a - p).squaredNorm() <= snap * snap ? a : a + t * d;
       const double dist = (q - p).norm();
       if (dist > 0 && dist <= best) best = dist, snapped = q;

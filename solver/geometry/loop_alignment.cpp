@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "solver/geometry/primitives.h"
 #include "solver/geometry/resample_outline.h"
 
 namespace inbetween::solver {
@@ -30,7 +31,7 @@ struct Sampled {
 double TurnAt(const Points& p, int i) {
   const int n = static_cast<int>(p.size());
   const Point a = p[i] - p[(i + n - 1) % n], b = p[(i + 1) % n] - p[i];
-  return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+  return std::atan2(Cross(a, b), a.dot(b));
 }
 
 // Corners of `loop` and points spread by arc length (module doc of the header), with each
@@ -38,8 +39,7 @@ double TurnAt(const Points& p, int i) {
 // neighbouring samples.
 Sampled SampleLoop(const Points& loop, const LoopAlignmentOptions& options) {
   const int n = static_cast<int>(loop.size());
-  std::vector<double> cum(n + 1, 0.0);
-  for (int i = 0; i < n; ++i) cum[i + 1] = cum[i] + (loop[(i + 1) % n] - loop[i]).norm();
+  const std::vector<double> cum = CumulativeLength(loop);
   Sampled out;
   out.length = cum[n];
   const std::vector<int> corners = FindCorners(loop, options.corner_angle_degrees);

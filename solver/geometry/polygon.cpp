@@ -1,4 +1,4 @@
-// Basic predicates on closed polygons: signed area, containment, convexity, self-intersection.
+// Basic predicates on closed polygons: containment, convexity, self-intersection.
 #include "solver/geometry/polygon.h"
 
 #include <Eigen/Geometry>
@@ -6,21 +6,10 @@
 #include <cmath>
 #include <numeric>
 
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/cgal_predicates.h"
 
 namespace inbetween::solver {
-namespace {
-
-double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-}  // namespace
-
-double PolygonSignedArea(const Points& polygon) {
-  const size_t n = polygon.size();
-  double sum = 0.0;
-  for (size_t i = 0; i < n; ++i) sum += Cross(polygon[i], polygon[(i + 1) % n]);
-  return 0.5 * sum;
-}
 
 bool PolygonContains(const Points& polygon, const Point& q) {
   bool inside = false;

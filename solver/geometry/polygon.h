@@ -1,16 +1,15 @@
-// Basic predicates on closed polygons (an Outline's points): signed area, point containment and
-// the first self-intersection. Shared by SVG import, correspondence and the mesh builder.
+// Basic predicates on closed polygons (an Outline's points): point containment, convexity and
+// the first self-intersection; the signed area (PolygonSignedArea) is in primitives.h, included
+// here for its callers. Shared by SVG import, correspondence and the mesh builder.
 #pragma once
 
 #include <cstdint>
 #include <optional>
 
 #include "solver/core/types.h"
+#include "solver/geometry/primitives.h"  // PolygonSignedArea
 
 namespace inbetween::solver {
-
-// Signed area 0.5 * sum(x_i * y_{i+1} - x_{i+1} * y_i); positive = the convention of types.h.
-double PolygonSignedArea(const Points& polygon);
 
 // Even-odd point-in-polygon test (points exactly on the boundary may go either way).
 bool PolygonContains(const Points& polygon, const Point& q);

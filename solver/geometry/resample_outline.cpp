@@ -5,31 +5,9 @@
 #include <cmath>
 #include <numeric>
 
+#include "solver/geometry/primitives.h"
+
 namespace inbetween::solver {
-namespace {
-
-// Cumulative arc length at each vertex of the closed polyline; back() is the perimeter.
-std::vector<double> CumulativeLength(const Points& p) {
-  const size_t n = p.size();
-  std::vector<double> cum(n + 1, 0.0);
-  for (size_t i = 0; i < n; ++i) cum[i + 1] = cum[i] + (p[(i + 1) % n] - p[i]).norm();
-  return cum;
-}
-
-Point PointAt(const Points& p, const std::vector<double>& cum, double u) {
-  const double total = cum.back();
-  u = std::fmod(u, total);
-  if (u < 0) u += total;
-  const size_t n = p.size();
-  // Segment i spans [cum[i], cum[i+1]).
-  size_t i = std::upper_bound(cum.begin(), cum.end(), u) - cum.begin();
-  i = std::clamp<size_t>(i, 1, n) - 1;
-  const double len = cum[i + 1] - cum[i];
-  const double t = len > 0 ? (u - cum[i]) / len : 0.0;
-  return p[i] + std::clamp(t, 0.0, 1.0) * (p[(i + 1) % n] - p[i]);
-}
-
-}  // namespace
 
 std::vector<int> FindCorners(const Points& outline, double corner_angle_degrees) {
   const int n = static_cast<int>(outline.size());
@@ -38,7 +16,7 @@ std::vector<int> FindCorners(const Points& outline, double corner_angle_degrees)
   for (int i = 0; i < n; ++i) {
     const Point a = outline[i] - outline[(i + n - 1) % n];
     const Point b = outline[(i + 1) % n] - outline[i];
-    const double turn = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+    const double turn = std::atan2(Cross(a, b), a.dot(b));
     if (std::abs(turn) > threshold) corners.push_back(i);
   }
   return corners;
@@ -51,7 +29,9 @@ Points ResampleOutline(const Points& outline, int count, const ResampleOptions& 
   Points out;
   out.reserve(count);
   if (corners.empty() || static_cast<int>(corners.size()) > count) {
-    for (int k = 0; k < count; ++k) out.push_back(PointAt(outline, cum, total * k / count));
+    for (int k = 0; k < count; ++k) {
+      out.push_back(PointAtArcLength(outline, cum, total * k / count, SegmentEnds::kInterpolate));
+    }
     return out;
   }
   // Arcs between consecutive corners get the remaining vertices in proportion to their length
@@ -81,7 +61,8 @@ Points ResampleOutline(const Points& outline, int count, const ResampleOptions& 
   for (int j = 0; j < k_corners; ++j) {
     out.push_back(outline[corners[j]]);
     for (int k = 1; k <= extra[j]; ++k) {
-      out.push_back(PointAt(outline, cum, cum[corners[j]] + length[j] * k / (extra[j] + 1)));
+      const double u = cum[corners[j]] + length[j] * k / (extra[j] + 1);
+      out.push_back(PointAtArcLength(outline, cum, u, SegmentEnds::kInterpolate));
     }
   }
   return out;

@@ -3,8 +3,10 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
+#include "solver/geometry/primitives.h"
 #include "solver/interp/polar.h"
 
 namespace inbetween::solver {
@@ -37,17 +39,13 @@ absl::StatusOr<ArapEnergy> ArapEnergy::Create(const std::vector<Triangle>& trian
   e.gradients_.resize(num_t);
   e.areas_.resize(num_t);
   e.weights_.resize(num_t);
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(9 * static_cast<size_t>(num_t));
   for (int t = 0; t < num_t; ++t) {
     const Triangle& tri = triangles[t];
-    for (int k = 0; k < 3; ++k) {
-      if (tri[k] < 0 || tri[k] >= n) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("triangle ", t, " has vertex index ", tri[k], " outside [0, ", n, ")"));
-      }
+    if (const std::optional<int> v = IndexOutOfRange(tri, n)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("triangle ", t, " has vertex index ", *v, " outside [0, ", n, ")"));
     }
-    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+    if (RepeatsVertex(tri)) {
       return absl::InvalidArgumentError(absl::StrCat("triangle ", t, " repeats a vertex (", tri[0],
                                                      ", ", tri[1], ", ", tri[2], ")"));
     }
@@ -73,16 +71,30 @@ absl::StatusOr<ArapEnergy> ArapEnergy::Create(const std::vector<Triangle>& trian
     e.gradients_[t] = g;
     e.areas_[t] = area;
     e.weights_[t] = kappa * area;
-    const Eigen::Matrix3d local = e.weights_[t] * (g.transpose() * g);
+  }
+  e.laplacian_ = AssembleLaplacian(n, triangles, e.gradients_, e.weights_);
+  return e;
+}
+
+Eigen::SparseMatrix<double> AssembleLaplacian(
+    int num_vertices, const std::vector<Triangle>& triangles,
+    const std::vector<Eigen::Matrix<double, 2, 3>>& gradients, const std::vector<double>& weights) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(9 * triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const Eigen::Matrix<double, 2, 3>& g = gradients[t];
+    const Eigen::Matrix3d local = weights[t] * (g.transpose() * g);
     for (int j = 0; j < 3; ++j) {
-      for (int k = 0; k < 3; ++k) triplets.emplace_back(tri[j], tri[k], local(j, k));
+      for (int k = 0; k < 3; ++k) {
+        triplets.emplace_back(triangles[t][j], triangles[t][k], local(j, k));
+      }
     }
   }
-  e.laplacian_.resize(n, n);
+  Eigen::SparseMatrix<double> laplacian(num_vertices, num_vertices);
   // setFromTriplets keeps explicit zeros, so the pattern depends on the triangle list only.
-  e.laplacian_.setFromTriplets(triplets.begin(), triplets.end());
-  e.laplacian_.makeCompressed();
-  return e;
+  laplacian.setFromTriplets(triplets.begin(), triplets.end());
+  laplacian.makeCompressed();
+  return laplacian;
 }
 
 Eigen::Matrix2d ArapEnergy::DeformationGradient(const Coords& x, int t) const {

@@ -71,4 +71,12 @@ class ArapEnergy {
   Eigen::SparseMatrix<double> laplacian_;
 };
 
+// K = sum_t weights[t] G_t^T G_t on num_vertices vertices, G_t = gradients[t] (columns: the
+// gradients of triangle t's hat functions). Nine triplets per triangle, in triangle order, summed
+// by setFromTriplets: explicit zeros are kept, so the pattern depends on the triangle list only.
+// Shared by ArapEnergy and BlendedArap.
+Eigen::SparseMatrix<double> AssembleLaplacian(
+    int num_vertices, const std::vector<Triangle>& triangles,
+    const std::vector<Eigen::Matrix<double, 2, 3>>& gradients, const std::vector<double>& weights);
+
 }  // namespace inbetween::solver

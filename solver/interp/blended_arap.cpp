@@ -83,8 +83,6 @@ absl::StatusOr<BlendedArap> BlendedArap::Create(const std::vector<Triangle>& tri
   for (Eigen::Matrix2d& mean : e.mean_stretch_) mean /= static_cast<double>(num_shapes);
   e.angles_ = std::move(rotations.angles);
   e.examples_.assign(num_shapes, std::vector<Eigen::Matrix2d>(num_t));
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(9 * static_cast<size_t>(num_t));
   for (int t = 0; t < num_t; ++t) {
     const Triangle& tri = triangles[t];
     const Eigen::Matrix2d d = e.mean_stretch_[t] * EdgeMatrix(shapes[0], tri);
@@ -97,14 +95,8 @@ absl::StatusOr<BlendedArap> BlendedArap::Create(const std::vector<Triangle>& tri
     e.gradients_[t] = g;
     e.areas_[t] = 0.5 * d.determinant();
     e.weights_[t] = (stiffness.empty() ? 1.0 : stiffness[t]) * e.areas_[t];
-    const Eigen::Matrix3d local = e.weights_[t] * (g.transpose() * g);
-    for (int j = 0; j < 3; ++j) {
-      for (int k = 0; k < 3; ++k) triplets.emplace_back(tri[j], tri[k], local(j, k));
-    }
   }
-  e.laplacian_.resize(n, n);
-  e.laplacian_.setFromTriplets(triplets.begin(), triplets.end());
-  e.laplacian_.makeCompressed();
+  e.laplacian_ = AssembleLaplacian(n, triangles, e.gradients_, e.weights_);
   e.incidence_start_.assign(n + 1, 0);
   for (const Triangle& tri : triangles) {
     for (int v : tri) ++e.incidence_start_[v + 1];

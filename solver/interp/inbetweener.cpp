@@ -50,6 +50,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "solver/core/sparse_cholesky.h"
+#include "solver/geometry/primitives.h"
 #include "solver/interp/arap_energy.h"
 #include "solver/interp/blended_arap.h"
 #include "solver/interp/cohesive_energy.h"
@@ -60,19 +61,16 @@
 namespace inbetween::solver {
 namespace {
 
+// Twice the signed area of triangle t in the coordinates x (one row per vertex).
 double DoubleArea(const Triangle& t, const Coords& x) {
-  const Eigen::Vector2d e1 = x.row(t[1]) - x.row(t[0]);
-  const Eigen::Vector2d e2 = x.row(t[2]) - x.row(t[0]);
-  return e1.x() * e2.y() - e1.y() * e2.x();
+  return SignedArea2(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose());
 }
 
 // Signed area <= 0 in raw coordinates (see types.h for the orientation convention).
 int CountInverted(const std::vector<Triangle>& triangles, const Coords& x) {
   int inverted = 0;
   for (const Triangle& t : triangles) {
-    const Eigen::Vector2d e1 = x.row(t[1]) - x.row(t[0]);
-    const Eigen::Vector2d e2 = x.row(t[2]) - x.row(t[0]);
-    if (!(e1.x() * e2.y() - e1.y() * e2.x() > 0.0)) ++inverted;
+    if (!(DoubleArea(t, x) > 0.0)) ++inverted;
   }
   return inverted;
 }
@@ -321,10 +319,7 @@ absl::Status Inbetweener::Impl::Setup(const Multimesh& mesh) {
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
     double area = 0.0;
     for (int i = 0; i < num_shapes; ++i) {
-      const Triangle& tri = triangles[t];
-      const Eigen::Vector2d e1 = mesh.shapes[i][tri[1]] - mesh.shapes[i][tri[0]];
-      const Eigen::Vector2d e2 = mesh.shapes[i][tri[2]] - mesh.shapes[i][tri[0]];
-      area += 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+      area += 0.5 * SignedArea2(triangles[t], mesh.shapes[i]);
     }
     area /= static_cast<double>(num_shapes);
     for (int k = 0; k < 3; ++k) mass[triangles[t][k]] += area / 3.0;

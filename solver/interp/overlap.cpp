@@ -9,6 +9,8 @@
 #include <queue>
 #include <utility>
 
+#include "solver/geometry/primitives.h"
+
 namespace inbetween::solver {
 
 // Median-split AABB tree. The topology is built once (from the first positions seen: a continuous
@@ -99,10 +101,6 @@ class OverlapChecker::Bvh {
 };
 
 namespace {
-
-double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  return a.x() * b.y() - a.y() * b.x();
-}
 
 Eigen::Vector2d P(const Coords& x, int v) { return x.row(v).transpose(); }
 

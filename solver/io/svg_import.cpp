@@ -39,6 +39,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 #include "solver/io/paint_union.h"
 
 namespace inbetween::solver {
@@ -90,7 +91,7 @@ void FlattenCubic(const Point& p0, const Point& p1, const Point& p2, const Point
   const double len = chord.norm();
   auto distance = [&](const Point& p) {
     if (len < 1e-300) return (p - p0).norm();
-    return std::abs(chord.x() * (p.y() - p0.y()) - chord.y() * (p.x() - p0.x())) / len;
+    return std::abs(Cross(chord, p - p0)) / len;
   };
   if (depth >= kMaxSubdivisionDepth || std::max(distance(p1), distance(p2)) <= tolerance) {
     out->push_back(p3);
@@ -423,9 +424,7 @@ class Context {
     const Point cq(coef * rx * q.y() / ry, -coef * ry * q.x() / rx);  // (cx', cy')
     const Point center(c * cq.x() - s * cq.y() + 0.5 * (p1.x() + p2.x()),
                        s * cq.x() + c * cq.y() + 0.5 * (p1.y() + p2.y()));
-    auto angle = [](const Point& u, const Point& v) {
-      return std::atan2(u.x() * v.y() - u.y() * v.x(), u.dot(v));
-    };
+    auto angle = [](const Point& u, const Point& v) { return std::atan2(Cross(u, v), u.dot(v)); };
     const Point u((q.x() - cq.x()) / rx, (q.y() - cq.y()) / ry);
     const Point v((-q.x() - cq.x()) / rx, (-q.y() - cq.y()) / ry);
     const double theta1 = angle(Point(1, 0), u);
@@ -606,10 +605,7 @@ class Context {
       }
       double distance = kInf;
       for (size_t j = 0; j < m && distance > eps; ++j) {
-        const Point s = b[j], d = b[(j + 1) % m] - s;
-        const double len2 = d.squaredNorm();
-        const double t = len2 > 0 ? std::clamp((q - s).dot(d) / len2, 0.0, 1.0) : 0.0;
-        distance = std::min(distance, (s + t * d - q).norm());
+        distance = std::min(distance, DistanceToSegment(q, b[j], b[(j + 1) % m]));
       }
       if (distance > eps) return PolygonContains(b, q);
     }

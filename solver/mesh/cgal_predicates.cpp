@@ -8,6 +8,8 @@
 
 #include <algorithm>
 
+#include "solver/geometry/primitives.h"
+
 namespace inbetween::solver {
 namespace {
 
@@ -19,11 +21,6 @@ P2 ToCgal(const Point& p) { return P2(p.x(), p.y()); }
 // c is collinear with a-b: is it inside the closed segment?
 bool Between(const Point& a, const Point& b, const Point& c) {
   return CGAL::collinear_are_ordered_along_line(ToCgal(a), ToCgal(c), ToCgal(b));
-}
-
-double ParameterOf(const Point& a, const Point& b, const Point& c) {
-  const Point d = b - a;
-  return std::clamp((c - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
 }
 
 }  // namespace
@@ -46,9 +43,8 @@ SegmentContact ExactSegmentContact(const Point& p1, const Point& p2, const Point
   const int d3 = ExactOrientation(p1, p2, q1), d4 = ExactOrientation(p1, p2, q2);
   if (d1 * d2 < 0 && d3 * d4 < 0) {
     // Proper crossing: the point from the exactly-signed but rounded orientation values.
-    const auto cross = [](const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); };
-    const double o1 = cross(q2 - q1, p1 - q1), o2 = cross(q2 - q1, p2 - q1);
-    const double o3 = cross(p2 - p1, q1 - p1), o4 = cross(p2 - p1, q2 - p1);
+    const double o1 = Cross(q2 - q1, p1 - q1), o2 = Cross(q2 - q1, p2 - q1);
+    const double o3 = Cross(p2 - p1, q1 - p1), o4 = Cross(p2 - p1, q2 - p1);
     out.kind = SegmentContact::kCross;
     out.t_p = std::clamp(o1 / (o1 - o2), 0.0, 1.0);
     out.t_q = std::clamp(o3 / (o3 - o4), 0.0, 1.0);
@@ -65,7 +61,7 @@ SegmentContact ExactSegmentContact(const Point& p1, const Point& p2, const Point
     out.kind = lo == hi ? SegmentContact::kTouch : SegmentContact::kOverlap;
     out.t_p = lo;
     out.point = lo == 0.0 ? p1 : lo == 1.0 ? p2 : (a < b ? q1 : q2);
-    out.t_q = ParameterOf(q1, q2, out.point);
+    out.t_q = SegmentParameter(out.point, q1, q2);
     return out;
   }
   for (const auto& [c, on_q] :
@@ -75,8 +71,8 @@ SegmentContact ExactSegmentContact(const Point& p1, const Point& p2, const Point
     if (collinear && (on_q ? Between(q1, q2, c) : Between(p1, p2, c))) {
       out.kind = SegmentContact::kTouch;
       out.point = c;
-      out.t_p = ParameterOf(p1, p2, c);
-      out.t_q = ParameterOf(q1, q2, c);
+      out.t_p = SegmentParameter(c, p1, p2);
+      out.t_q = SegmentParameter(c, q1, q2);
       return out;
     }
   }

@@ -23,6 +23,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 
 namespace inbetween::solver {
 namespace {
@@ -176,17 +177,13 @@ double Diagonal(const std::vector<Points>& loops) {
   return (hi - lo).norm();
 }
 
-double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
-
 }  // namespace
 
 absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
                                                      const TriangulateOptions& options) {
   const int n = static_cast<int>(boundary.size());
   if (n < 3) return absl::InvalidArgumentError("triangulate: polygon has fewer than 3 points");
-  double area2 = 0.0;
-  for (int i = 0; i < n; ++i) area2 += Cross(boundary[i], boundary[(i + 1) % n]);
-  if (!(area2 > 0)) {
+  if (!(PolygonSignedArea2(boundary) > 0)) {
     return absl::InvalidArgumentError("triangulate: polygon must have positive signed area");
   }
   if (!(options.shape_bound > 0)) {
@@ -232,9 +229,7 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
       if (!f->is_in_domain()) continue;
       Triangle t = {index.at(f->vertex(0)), index.at(f->vertex(1)), index.at(f->vertex(2))};
-      const Point e1 = out.vertices[t[1]] - out.vertices[t[0]];
-      const Point e2 = out.vertices[t[2]] - out.vertices[t[0]];
-      if (Cross(e1, e2) < 0) std::swap(t[1], t[2]);
+      if (SignedArea2(t, out.vertices) < 0) std::swap(t[1], t[2]);
       out.triangles.push_back(t);
     }
     // Steiner vertices on a constrained edge lie on the boundary: find their segment.
@@ -252,9 +247,10 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
         BoundarySteiner best{vi, -1, 0.0};
         double best_distance = std::numeric_limits<double>::infinity();
         for (int s = 0; s < n; ++s) {
-          const Point a = boundary[s], d = boundary[(s + 1) % n] - a;
-          const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-          const double dist = (a + t * d - p).norm();
+          const Point& a = boundary[s];
+          const Point& b = boundary[(s + 1) % n];
+          const double t = SegmentParameter(p, a, b);
+          const double dist = (a + t * (b - a) - p).norm();
           if (dist < best_distance) best_distance = dist, best.segment = s, best.t = t;
         }
         out.boundary_steiner.push_back(best);
@@ -352,9 +348,7 @@ absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Poin
       if (!in_domain((out.vertices[t[0]] + out.vertices[t[1]] + out.vertices[t[2]]) / 3.0)) {
         continue;
       }
-      const Point e1 = out.vertices[t[1]] - out.vertices[t[0]];
-      const Point e2 = out.vertices[t[2]] - out.vertices[t[0]];
-      if (Cross(e1, e2) < 0) std::swap(t[1], t[2]);
+      if (SignedArea2(t, out.vertices) < 0) std::swap(t[1], t[2]);
       out.triangles.push_back(t);
     }
     // Steiner chains: walk constrained edges from each loop edge's start to its end.

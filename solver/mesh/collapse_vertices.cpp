@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/validate.h"
 #include "solver/mesh/vertex_star.h"
 
@@ -163,11 +165,9 @@ absl::StatusOr<CollapseResult> CollapseVertices(const std::vector<Triangle>& tri
     }
   }
   for (size_t t = 0; t < triangles.size(); ++t) {
-    for (int v : triangles[t]) {
-      if (v < 0 || v >= n) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("collapse: triangle ", t + 1, " has vertex ", v, " of ", n));
-      }
+    if (const std::optional<int> v = IndexOutOfRange(triangles[t], n)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("collapse: triangle ", t + 1, " has vertex ", *v, " of ", n));
     }
   }
   Collapser collapser(triangles, shapes);

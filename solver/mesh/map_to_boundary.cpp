@@ -32,14 +32,13 @@
 #include "solver/core/sparse_lu.h"
 #include "solver/geometry/affine_fit.h"
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/validate.h"
 
 namespace inbetween::solver {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 struct TriangleFrame {
   double area = 0.0;                 // source area (weight)

@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "absl/strings/str_cat.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/cgal_predicates.h"
 #include "solver/mesh/cgal_triangulate.h"
 #include "solver/mesh/collapse_vertices.h"
@@ -22,8 +23,6 @@
 
 namespace inbetween::solver {
 namespace {
-
-double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // The chord triangulation of the new drawing, by boundary loop position k (0..nb-1).
 struct Chords {

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <iterator>
 
+#include "solver/geometry/primitives.h"
+
 namespace inbetween::solver {
 namespace {
-
-double Cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 double CornerAngle(const Points& x, const Triangle& t, int k) {
   const Point u = x[t[(k + 1) % 3]] - x[t[k]], w = x[t[(k + 2) % 3]] - x[t[k]];

@@ -5,19 +5,15 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <set>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/cgal_predicates.h"
 
 namespace inbetween::solver {
-
-double SignedArea2(const Triangle& t, const Points& x) {
-  const Point e1 = x[t[1]] - x[t[0]];
-  const Point e2 = x[t[2]] - x[t[0]];
-  return e1.x() * e2.y() - e1.y() * e2.x();
-}
 
 int CountInverted(const std::vector<Triangle>& triangles, const Points& x, double min_area2) {
   int count = 0;
@@ -29,8 +25,7 @@ int CountInverted(const std::vector<Triangle>& triangles, const Points& x, doubl
 }
 
 double TriangleQuality(const Point& a, const Point& b, const Point& c) {
-  const Point ab = b - a, ac = c - a;
-  const double area2 = ab.x() * ac.y() - ab.y() * ac.x();  // as SignedArea2
+  const double area2 = SignedArea2(a, b, c);
   const double edges = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
   return edges > 0.0 ? 2.0 * std::sqrt(3.0) * area2 / edges : 0.0;
 }
@@ -168,13 +163,11 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
   }
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const Triangle& tri = mesh.triangles[t];
-    for (int k = 0; k < 3; ++k) {
-      if (tri[k] < 0 || tri[k] >= n) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "multimesh triangle ", t, " has vertex index ", tri[k], " out of range [0, ", n, ")"));
-      }
+    if (const std::optional<int> v = IndexOutOfRange(tri, n)) {
+      return absl::InvalidArgumentError(absl::StrCat("multimesh triangle ", t, " has vertex index ",
+                                                     *v, " out of range [0, ", n, ")"));
     }
-    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+    if (RepeatsVertex(tri)) {
       return absl::InvalidArgumentError(
           absl::StrCat("multimesh triangle ", t, " repeats a vertex"));
     }

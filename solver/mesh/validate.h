@@ -6,12 +6,10 @@
 
 #include "absl/status/status.h"
 #include "solver/core/types.h"
+#include "solver/geometry/primitives.h"  // SignedArea2
 #include "solver/mesh/multimesh.h"
 
 namespace inbetween::solver {
-
-// Twice the signed area of triangle t in geometry x (positive = correctly oriented).
-double SignedArea2(const Triangle& t, const Points& x);
 
 // Number of triangles with signed area <= min_area2 / 2 (inverted or degenerate).
 int CountInverted(const std::vector<Triangle>& triangles, const Points& x, double min_area2 = 0.0);

@@ -17,7 +17,6 @@
 namespace inbetween::solver {
 namespace {
 
-using art_test::DistanceToSegment;
 using art_test::FillLayer;
 using art_test::JitteredGrid;
 using art_test::StrokeLayer;
@@ -80,7 +79,7 @@ TEST(ArtEmbeddingTest, EveryPointEmbeddedAndKeyReproduced) {
         }
         const Point& a = drawn.points[segment];
         const Point& b = drawn.points[(segment + 1) % n];
-        EXPECT_LT(DistanceToSegment(a, b, out[i]), 1e-12);
+        EXPECT_LT(DistanceToSegment(out[i], a, b), 1e-12);
         const double t = (out[i] - a).dot(b - a) / (b - a).squaredNorm();
         EXPECT_GT(t, along);
         along = t;
@@ -162,7 +161,7 @@ TEST(ArtEmbeddingTest, LongSegmentSplitWhereItCrossesEdges) {
     max_length = std::max(max_length, (key[i + 1] - key[i]).norm());
     const ArtLayer mid = FillLayer({0.5 * (key[i] + key[i + 1])}, 0);
     const Point m = PlacePath(EmbedArt(mesh, 0, {mid})->layers[0].paths[0], bent)[0];
-    EXPECT_LT(DistanceToSegment(frame[i], frame[i + 1], m), 1e-9);
+    EXPECT_LT(DistanceToSegment(m, frame[i], frame[i + 1]), 1e-9);
   }
   EXPECT_LT(max_length, 1.1);  // no piece longer than a triangle
 
@@ -192,7 +191,7 @@ TEST(ArtEmbeddingTest, SegmentAlongTheBoundaryFollowsItWhenBent) {
         const Point p = placed[k] + t * (placed[k + 1] - placed[k]);
         double d = std::numeric_limits<double>::infinity();
         for (size_t j = 0; j + 1 < bottom.size(); ++j) {
-          d = std::min(d, DistanceToSegment(bottom[j], bottom[j + 1], p));
+          d = std::min(d, DistanceToSegment(p, bottom[j], bottom[j + 1]));
         }
         worst = std::max(worst, d);
       }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "solver/core/art.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/multimesh.h"
 #include "tests/unit/solver/interp/test_meshes.h"
 
@@ -44,17 +45,11 @@ inline ArtLayer StrokeLayer(Points points, uint32_t rgb, double width, bool clos
   return layer;
 }
 
-inline double DistanceToSegment(const Point& a, const Point& b, const Point& p) {
-  const Point d = b - a;
-  const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-  return (a + t * d - p).norm();
-}
-
 inline double DistanceToPolyline(const Points& path, bool closed, const Point& p) {
   double best = (path[0] - p).norm();
   const size_t segments = closed ? path.size() : path.size() - 1;
   for (size_t i = 0; i < segments; ++i) {
-    best = std::min(best, DistanceToSegment(path[i], path[(i + 1) % path.size()], p));
+    best = std::min(best, DistanceToSegment(p, path[i], path[(i + 1) % path.size()]));
   }
   return best;
 }

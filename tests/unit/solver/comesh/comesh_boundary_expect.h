@@ -12,6 +12,7 @@
 
 #include "solver/comesh/comesh_topology.h"
 #include "solver/core/types.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/multimesh.h"
 
 namespace inbetween::solver::testing {
@@ -21,12 +22,7 @@ inline std::vector<std::vector<int>> LoopsOf(const Multimesh& m) {
   return m.boundary_loops.empty() ? std::vector<std::vector<int>>{m.boundary} : m.boundary_loops;
 }
 
-inline double DistanceToSegment(const Point& p, const Point& a, const Point& b) {
-  const Point ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (p - (a + t * ab)).norm();
-}
+using ::inbetween::solver::DistanceToSegment;  // callers name it testing::DistanceToSegment
 
 // `after` came from `before` by topology passes (boundary collapses drop vertices that lie on a
 // straight stretch in every shape) and inner runs (sliders move along their stretch). Checks, per

@@ -11,6 +11,7 @@
 
 #include "solver/comesh/mips_energy.h"
 #include "solver/comesh/odt_energy.h"
+#include "solver/geometry/primitives.h"
 
 namespace inbetween::solver {
 namespace {
@@ -22,8 +23,7 @@ Corners RandomTriangle(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (;;) {
     Corners c = {Point(u(rng), u(rng)), Point(u(rng), u(rng)), Point(u(rng), u(rng))};
-    const Point ab = c[1] - c[0], ac = c[2] - c[0];
-    if (ab.x() * ac.y() - ab.y() * ac.x() > 0.2) return c;
+    if (SignedArea2(c[0], c[1], c[2]) > 0.2) return c;
   }
 }
 

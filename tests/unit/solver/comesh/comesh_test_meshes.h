@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "solver/core/types.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/multimesh.h"
 
 namespace inbetween::solver::testing {
@@ -173,8 +174,7 @@ inline SizedMeshOptions SizeFor(int vertices, double perimeter, double diagonal,
 inline int CountNonPositive(const std::vector<Triangle>& triangles, const Points& x) {
   int count = 0;
   for (const Triangle& t : triangles) {
-    const Point ab = x[t[1]] - x[t[0]], ac = x[t[2]] - x[t[0]];
-    if (!(ab.x() * ac.y() - ab.y() * ac.x() > 0.0)) ++count;
+    if (!(SignedArea2(t, x) > 0.0)) ++count;
   }
   return count;
 }

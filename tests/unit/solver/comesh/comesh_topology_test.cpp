@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "solver/comesh/comesh_objective.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/validate.h"
 #include "tests/unit/solver/comesh/comesh_boundary_expect.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
@@ -447,7 +448,7 @@ double LoopArea2(const Multimesh& m, int s) {
   for (size_t k = 0; k < m.boundary.size(); ++k) {
     const Point& p = x[m.boundary[k]];
     const Point& q = x[m.boundary[(k + 1) % m.boundary.size()]];
-    a += p.x() * q.y() - p.y() * q.x();
+    a += Cross(p, q);
   }
   return a;
 }
@@ -498,7 +499,7 @@ TEST(ComeshSliverTest, SnapsAnInteriorVertexOntoTheBoundaryEdgeUnderIt) {
     const Point& a = out->shapes[s][0];
     const Point& b = out->shapes[s][1];
     const Point& c = out->shapes[s][4];
-    EXPECT_NEAR((c - a).x() * (b - a).y() - (c - a).y() * (b - a).x(), 0.0, 1e-12);
+    EXPECT_NEAR(Cross(c - a, b - a), 0.0, 1e-12);
   }
 }
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 
+#include "solver/geometry/primitives.h"
 #include "tests/unit/solver/comesh/comesh_test_meshes.h"
 
 namespace inbetween::solver {
@@ -68,8 +69,7 @@ TEST(OdtEnergyTest, InteriorGradientIsSupplementEquationOneRescaled) {
     const Point grad_area(0.5 * (b.y() - c.y()), 0.5 * (c.x() - b.x()));
     const double sum = (x[j] - b).squaredNorm() + (x[j] - c).squaredNorm();
     seq1 += grad_area * sum;
-    const Point ab = b - x[j], ac = c - x[j];
-    gamma += 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
+    gamma += 0.5 * SignedArea2(x[j], b, c);
   }
   seq1 /= 8.0 * gamma;
   EXPECT_NEAR((g[j] * 3.0 / (8.0 * gamma) - seq1).norm(), 0.0, 1e-12 * (1.0 + seq1.norm()));

@@ -5,15 +5,15 @@
 
 #include <cmath>
 
+#include "solver/geometry/primitives.h"
+
 namespace inbetween::solver {
 namespace {
 
 double DistanceToOutline(const Points& outline, const Point& p) {
   double best = INFINITY;
   for (size_t i = 0; i < outline.size(); ++i) {
-    const Point a = outline[i], d = outline[(i + 1) % outline.size()] - a;
-    const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-    best = std::min(best, (a + t * d - p).norm());
+    best = std::min(best, DistanceToSegment(p, outline[i], outline[(i + 1) % outline.size()]));
   }
   return best;
 }

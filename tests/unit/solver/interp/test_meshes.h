@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "solver/core/types.h"
+#include "solver/geometry/primitives.h"
 #include "solver/interp/polar.h"
 #include "solver/mesh/multimesh.h"
 
@@ -53,11 +54,7 @@ inline Points Bent(const Points& points, double length, double angle) {
   return out;
 }
 
-inline double SignedArea(const Points& x, const Triangle& t) {
-  const Point e1 = x[t[1]] - x[t[0]];
-  const Point e2 = x[t[2]] - x[t[0]];
-  return 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
-}
+inline double SignedArea(const Points& x, const Triangle& t) { return 0.5 * SignedArea2(t, x); }
 
 inline double MaxDistance(const Points& a, const Points& b) {
   double d = 0.0;

@@ -26,6 +26,7 @@
 #include "solver/geometry/boundary_correspondence.h"
 #include "solver/geometry/graph_flow.h"
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/build_multimesh.h"
 #include "solver/mesh/validate.h"
 #include "tests/unit/solver/mesh/example_projects.h"
@@ -40,12 +41,6 @@ using ::testing::HasSubstr;
 
 // ---- Polylines ----
 
-std::vector<double> Cumulative(const Points& p) {
-  std::vector<double> cum(p.size() + 1, 0.0);
-  for (size_t i = 0; i < p.size(); ++i) cum[i + 1] = cum[i] + (p[(i + 1) % p.size()] - p[i]).norm();
-  return cum;
-}
-
 // Nearest point of the closed polyline p to q (distance and arc length).
 struct Nearest {
   double distance = std::numeric_limits<double>::infinity();
@@ -54,12 +49,11 @@ struct Nearest {
 };
 
 Nearest NearestOn(const Points& p, const Point& q) {
-  const std::vector<double> cum = Cumulative(p);
+  const std::vector<double> cum = CumulativeLength(p);
   Nearest best;
   for (size_t i = 0; i < p.size(); ++i) {
     const Point a = p[i], d = p[(i + 1) % p.size()] - a;
-    const double t =
-        d.squaredNorm() > 0 ? std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+    const double t = d.squaredNorm() > 0 ? SegmentParameter(q, a, p[(i + 1) % p.size()]) : 0.0;
     const Point x = a + t * d;
     if ((x - q).norm() < best.distance)
       best = {(x - q).norm(), cum[i] + t * (cum[i + 1] - cum[i]), x};
@@ -75,19 +69,14 @@ std::vector<double> ArcsNear(const Points& p, const std::vector<double>& cum, co
   for (size_t i = 0; i < p.size(); ++i) {
     const Point a = p[i], d = p[(i + 1) % p.size()] - a;
     if (d.squaredNorm() == 0) continue;
-    const double t = std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    const double t = SegmentParameter(q, a, p[(i + 1) % p.size()]);
     if ((a + t * d - q).norm() <= tol) out.push_back(cum[i] + t * (cum[i + 1] - cum[i]));
   }
   return out;
 }
 
 Point AtArc(const Points& p, double u) {
-  const std::vector<double> cum = Cumulative(p);
-  u = std::fmod(std::fmod(u, cum.back()) + cum.back(), cum.back());
-  size_t i = std::upper_bound(cum.begin(), cum.end(), u) - cum.begin();
-  i = std::clamp<size_t>(i, 1, p.size()) - 1;
-  const double t = (u - cum[i]) / (cum[i + 1] - cum[i]);
-  return p[i] + t * (p[(i + 1) % p.size()] - p[i]);
+  return PointAtArcLength(p, CumulativeLength(p), u, SegmentEnds::kInterpolate);
 }
 
 double Diagonal(const std::vector<Points>& loops) {
@@ -117,7 +106,7 @@ struct LoopView {
 // the walk takes the nearest place ahead.
 AssertionResult WalksOnceForwards(const Points& x, const Points& ref, double tol,
                                   const std::string& what) {
-  const std::vector<double> cum = Cumulative(ref);
+  const std::vector<double> cum = CumulativeLength(ref);
   const double length = cum.back();
   const size_t n = x.size();
   std::vector<std::vector<double>> arcs(n);
@@ -436,7 +425,7 @@ std::vector<double> Fractions(std::mt19937& rng, int k) {
 std::vector<Point> MarksAt(std::mt19937& rng, const Points& p,
                            const std::vector<double>& fractions) {
   std::uniform_real_distribution<double> u(0, 1);
-  const std::vector<double> cum = Cumulative(p);
+  const std::vector<double> cum = CumulativeLength(p);
   const double length = cum.back();
   const double snap = 0.05 / (1.7 * std::max<size_t>(fractions.size(), 1)) * length;
   std::vector<Point> out;
@@ -1064,11 +1053,7 @@ std::vector<std::vector<double>> ComponentAreas(const Multimesh& mesh) {
   for (const Triangle& t : mesh.triangles) {
     std::vector<double>& a = area[find(t[0])];
     a.resize(mesh.shapes.size());
-    for (size_t d = 0; d < mesh.shapes.size(); ++d) {
-      const Points& x = mesh.shapes[d];
-      const Point ab = x[t[1]] - x[t[0]], ac = x[t[2]] - x[t[0]];
-      a[d] += 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
-    }
+    for (size_t d = 0; d < mesh.shapes.size(); ++d) a[d] += 0.5 * SignedArea2(t, mesh.shapes[d]);
   }
   std::vector<std::vector<double>> out;
   for (auto& [root, a] : area) out.push_back(std::move(a));

@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 #include "solver/io/svg_import.h"
 #include "solver/mesh/validate.h"
 #include "tests/unit/solver/io/read_example.h"
@@ -28,9 +29,7 @@ Drawing Example(const std::string& name) {
 double DistanceToOutline(const Points& outline, const Point& p) {
   double best = INFINITY;
   for (size_t i = 0; i < outline.size(); ++i) {
-    const Point a = outline[i], d = outline[(i + 1) % outline.size()] - a;
-    const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-    best = std::min(best, (a + t * d - p).norm());
+    best = std::min(best, DistanceToSegment(p, outline[i], outline[(i + 1) % outline.size()]));
   }
   return best;
 }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <string>
 
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/build_multimesh.h"
 #include "solver/mesh/cgal_triangulate.h"
 
@@ -50,12 +51,7 @@ TEST(CgalTriangulateBoundedTest, ThinSpikeIsRefusedInsteadOfRefinedForever) {
 // checked first.
 TEST(CgalTriangulateBoundedTest, CornersNearlyTouchingAreRefusedBeforeTheMesherSeesThem) {
   Points a = {{24 + 2.75e-9, 24 + 2.75e-9}, {24, 0}, {24 + 2.75e-9, 24}, {30, 3}};
-  double area2 = 0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    const Point p = a[i], q = a[(i + 1) % a.size()];
-    area2 += p.x() * q.y() - p.y() * q.x();
-  }
-  if (area2 < 0) std::reverse(a.begin(), a.end());
+  if (PolygonSignedArea2(a) < 0) std::reverse(a.begin(), a.end());
   Points b;
   for (const Point& p : a) {
     const Point s(0.6 * (p.x() - 0.5 * p.y()), 0.6 * p.y());

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 #include "solver/mesh/cgal_triangulate.h"
 #include "solver/mesh/collapse_vertices.h"
 #include "solver/mesh/validate.h"
@@ -55,9 +56,7 @@ double DistanceToEdges(const std::vector<Triangle>& triangles, const Points& x, 
   double best = INFINITY;
   for (const Triangle& t : triangles) {
     for (int k = 0; k < 3; ++k) {
-      const Point a = x[t[k]], d = x[t[(k + 1) % 3]] - a;
-      const double s = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-      best = std::min(best, (a + s * d - p).norm());
+      best = std::min(best, DistanceToSegment(p, x[t[k]], x[t[(k + 1) % 3]]));
     }
   }
   return best;

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "solver/core/types.h"
+#include "solver/geometry/primitives.h"
 
 namespace inbetween::solver::testing {
 
@@ -24,8 +25,7 @@ inline Point LimbNormal(double degrees) {
 }
 // p + s d where the line p + s d meets q + t e.
 inline Point LineIntersection(const Point& p, const Point& d, const Point& q, const Point& e) {
-  const double den = d.x() * e.y() - d.y() * e.x();
-  const double s = ((q.x() - p.x()) * e.y() - (q.y() - p.y()) * e.x()) / den;
+  const double s = Cross(q - p, e) / Cross(d, e);
   return p + s * d;
 }
 
