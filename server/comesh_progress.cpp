@@ -1,5 +1,6 @@
 // ComeshIterationStream: reads the numbers out of the optimizer's progress lines (the solver's
-// ProgressFn carries text only; solver/comesh/comesh_optimizer.cpp writes them).
+// ProgressFn carries text only; solver/comesh/comesh_inner_loop.cpp and comesh_optimizer.cpp
+// write them).
 #include "server/comesh_progress.h"
 
 #include <algorithm>

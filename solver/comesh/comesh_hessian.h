@@ -1,5 +1,5 @@
 // Second derivatives of the comesh energies of one triangle (S-eq.1, S-eq.2), for the Newton-type
-// preconditioner of the comesh optimizer (comesh_optimizer.h, "Hessian preconditioner").
+// preconditioner of the comesh optimizer (comesh_hessian_preconditioner.h).
 //
 // Both energies are translation invariant, so they are functions of a triangle's edge matrix
 // E = [x1 - x0, x2 - x0] alone. Derivatives are taken with respect to u = vec(E) (column major:
