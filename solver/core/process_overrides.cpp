@@ -246,20 +246,20 @@ extern "C" void dtrsm_(const char* side, const char* uplo, const char* transa, c
 }
 
 // CHOLMOD's OpenMP regions run on the calling thread. Debian's CHOLMOD (SuiteSparse 5.12, built
-// with OpenMP) opens parallel regions inside the supernodal factorization, per supernode (copying
-// A into it, clearing and scattering), each with a fixed team of 4 threads (the compiled call
-// passes 3 * test + 1 as the team size, the test being the region's size condition, so
-// OMP_NUM_THREADS does not change it). On a 2-core machine where our own threads already factor the
-// two shapes of a comesh concurrently, those teams oversubscribe the cores, and even a team of one
-// costs a futex system call per region (libgomp's barrier): measured on S-Table 2's 35k row
-// (docs/benchmarks.md, "Decisions and what they rest on"). The executable defines GOMP_parallel, the libgomp entry
-// point gcc compiles `#pragma omp parallel` to (the dynamic linker binds CHOLMOD's calls to this
+// with OpenMP) opens parallel regions inside the supernodal factorization, per supernode (copying A
+// into it, clearing and scattering), each with a fixed team of 4 threads (the compiled call passes
+// 3 * test + 1 as the team size, the test being the region's size condition, so OMP_NUM_THREADS
+// does not change it). On a 2-core machine where our own threads already factor the two shapes of a
+// comesh concurrently, those teams oversubscribe the cores, and even a team of one costs a futex
+// system call per region (libgomp's barrier): measured on S-Table 2's 35k row (docs/benchmarks.md,
+// "Decisions and what they rest on"). The executable defines GOMP_parallel, the libgomp entry point
+// gcc compiles `#pragma omp parallel` to (the dynamic linker binds CHOLMOD's calls to this
 // definition, as for dpotrf_ above), and runs the region's body once on the calling thread, as
 // libgomp does for a team of one: outside any team, omp_get_num_threads() is 1 and
 // omp_get_thread_num() 0, so the body's worksharing loops (static schedules: CHOLMOD imports no
-// other libgomp entry point) cover every iteration, in order. CHOLMOD is the only library here
-// that uses OpenMP (our own code is not built with it); its regions only move data, so the factor
-// is the same.
+// other libgomp entry point) cover every iteration, in order. CHOLMOD is the only library here that
+// uses OpenMP (our own code is not built with it); its regions only move data, so the factor is the
+// same.
 extern "C" void GOMP_parallel(void (*fn)(void*), void* data, unsigned /*num_threads*/,
                               unsigned /*flags*/) {
   fn(data);

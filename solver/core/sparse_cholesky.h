@@ -65,15 +65,15 @@ class SparseCholesky {
 
   // Numeric factorization of `a`, which must have exactly the analyzed pattern (same compressed
   // structure). FailedPrecondition if `a` is not positive definite. Analyze and Factorize answer
-  // RESOURCE_EXHAUSTED when CHOLMOD runs out of memory (it reports, never throws).
-  // With a `cancel` token the factorization polls it as it goes and answers CANCELLED soon after
-  // it is set (then the object is not factorized; Factorize again to use it): a simplicial factor
-  // is computed in row blocks of kCancelRows rows (CHOLMOD's incremental row factorization, the
-  // same operations in the same order, so the factor is bit-identical to an uncancellable one),
-  // a supernodal one, in programs that link inbetween_process_overrides, stops at the next
-  // supernode or, in a supernode of 2 * kDensePanel columns or more, at the next panel of
-  // kDensePanel columns (see kCancelPoint in the .cpp; without them it runs to its end); the
-  // first one after an analysis also while its value array is allocated and its pages touched, per 4 MB.
+  // RESOURCE_EXHAUSTED when CHOLMOD runs out of memory (it reports, never throws). With a `cancel`
+  // token the factorization polls it as it goes and answers CANCELLED soon after it is set (then
+  // the object is not factorized; Factorize again to use it): a simplicial factor is computed in
+  // row blocks of kCancelRows rows (CHOLMOD's incremental row factorization, the same operations in
+  // the same order, so the factor is bit-identical to an uncancellable one), a supernodal one, in
+  // programs that link inbetween_process_overrides, stops at the next supernode or, in a supernode
+  // of 2 * kDensePanel columns or more, at the next panel of kDensePanel columns (see kCancelPoint
+  // in the .cpp; without them it runs to its end); the first one after an analysis also while its
+  // value array is allocated and its pages touched, per 4 MB.
   absl::Status Factorize(const Eigen::SparseMatrix<double>& a, const CancelToken* cancel = nullptr);
   static constexpr int kCancelRows = 256;
   static constexpr int kDensePanel = 256;

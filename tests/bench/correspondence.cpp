@@ -29,8 +29,6 @@
 // counts, and the keys' outline tolerance (measured on the built multimesh).
 // Usage: correspondence [--json FILE] [--no-examples] [--no-synthetic] [--only NAME]
 //                       [--no-optimize] [--icons DIR] [--pairs N]
-#include <Eigen/LU>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -53,11 +51,13 @@
 #include "solver/interp/timing.h"
 #include "solver/io/svg_import.h"
 #include "solver/mesh/build_multimesh.h"
+#include "tests/bench/distortion.h"
 #include "tests/unit/solver/mesh/example_projects.h"
 
 namespace {
 
 using namespace inbetween::solver;  // NOLINT(build/namespaces): a benchmark program
+using inbetween::bench::MaxDistortion;
 
 constexpr double kPi = std::numbers::pi;
 using Map = std::function<Point(const Point&)>;
@@ -385,19 +385,6 @@ double KeyTolerance(const Multimesh& mesh, int s, const Drawing& d) {
   return worst / diagonal;
 }
 
-double MaxDistortion(const Multimesh& mesh, const Points& rest, const Points& x) {
-  double worst = 1.0;
-  for (const Triangle& t : mesh.triangles) {
-    Eigen::Matrix2d d, e;
-    d << rest[t[1]] - rest[t[0]], rest[t[2]] - rest[t[0]];
-    e << x[t[1]] - x[t[0]], x[t[2]] - x[t[0]];
-    const Eigen::Matrix2d j = e * d.inverse();
-    if (!(j.determinant() > 0.0)) return std::numeric_limits<double>::infinity();
-    const Eigen::Vector2d sv = Eigen::JacobiSVD<Eigen::Matrix2d>(j).singularValues();
-    worst = std::max({worst, sv(0), 1.0 / sv(1)});
-  }
-  return worst;
-}
 
 // Marks at f's images: every corner of drawing 1 (turning by more than 30 degrees) and points
 // spread evenly by arc length, at least 16 per loop, all taken from the densified outline (whose

@@ -14,8 +14,6 @@
 // measured from the frame's nearest key, and key_distort the worst between neighbouring keys.
 // Usage: quality [--json FILE] [--frames N] [--tolerance T (zhu17 displacement tolerance)]
 //                [--no-examples]
-#include <Eigen/LU>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -31,12 +29,14 @@
 #include "solver/interp/inbetweener.h"
 #include "solver/interp/timing.h"
 #include "solver/mesh/build_multimesh.h"
+#include "tests/bench/distortion.h"
 #include "tests/unit/solver/interp/test_meshes.h"
 #include "tests/unit/solver/mesh/example_projects.h"
 
 namespace {
 
 using namespace inbetween::solver;  // NOLINT(build/namespaces): a benchmark program
+using inbetween::bench::MaxDistortion;
 
 constexpr double kLength = 4.0;
 constexpr double kPi = std::numbers::pi;
@@ -112,20 +112,6 @@ int NearestKey(const ExampleWeights& w) {
   return static_cast<int>(std::max_element(w.begin(), w.end()) - w.begin());
 }
 
-// max over triangles of max(sigma_1, 1 / sigma_2) of the affine map rest -> x.
-double MaxDistortion(const Multimesh& mesh, const Points& rest, const Points& x) {
-  double worst = 1.0;
-  for (const Triangle& t : mesh.triangles) {
-    Eigen::Matrix2d d, e;
-    d << rest[t[1]] - rest[t[0]], rest[t[2]] - rest[t[0]];
-    e << x[t[1]] - x[t[0]], x[t[2]] - x[t[0]];
-    const Eigen::Matrix2d j = e * d.inverse();
-    if (!(j.determinant() > 0.0)) return std::numeric_limits<double>::infinity();
-    const Eigen::Vector2d s = Eigen::JacobiSVD<Eigen::Matrix2d>(j).singularValues();
-    worst = std::max({worst, s(0), 1.0 / s(1)});
-  }
-  return worst;
-}
 
 }  // namespace
 

@@ -7,12 +7,12 @@
 #include <unistd.h>
 
 #include <Eigen/Dense>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "solver/core/cancel.h"
 #include "solver/core/sparse_cholesky.h"
+#include "tests/unit/solver/core/spd_matrices.h"
 
 namespace inbetween::solver {
 namespace {
@@ -31,22 +31,7 @@ std::string ThisProgram() {
   return n > 0 ? std::string(path.data(), static_cast<size_t>(n)) : "";
 }
 
-// A dense SPD matrix (upper triangle stored): one supernode wider than the overrides' panels.
-Eigen::SparseMatrix<double> DenseSpd(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Eigen::MatrixXd b(n, n);
-  for (Eigen::Index k = 0; k < b.size(); ++k) b.data()[k] = u(rng);
-  const Eigen::MatrixXd a = b * b.transpose() / n + Eigen::MatrixXd::Identity(n, n);
-  std::vector<Eigen::Triplet<double>> upper;
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i <= j; ++i) upper.emplace_back(i, j, a(i, j));
-  }
-  Eigen::SparseMatrix<double> m(n, n);
-  m.setFromTriplets(upper.begin(), upper.end());
-  m.makeCompressed();
-  return m;
-}
+using testing::DenseSpd;
 
 TEST(SolverLibraryTest, LinksNoneOfTheProcessWideOverrides) {
   const std::string program = ThisProgram();

@@ -18,6 +18,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "tests/unit/solver/core/address_space.h"
+#include "tests/unit/solver/core/spd_matrices.h"
 
 namespace inbetween::solver {
 namespace {
@@ -326,9 +327,10 @@ TEST(SparseCholeskyTest, FloatSubstitutionsSolveCloselyOnSupernodalFactorsOnly) 
 }
 
 // CHOLMOD's OpenMP regions run on the calling thread (the GOMP_parallel definition in
-// process_overrides.cpp, which the test binaries link): a supernodal factorization starts no thread. Without that definition
-// libgomp starts a pool of 3 workers at the first region with its team of 4 (they stay alive).
-// ctest runs every test in its own process, so no earlier test has started them.
+// process_overrides.cpp, which the test binaries link): a supernodal factorization starts no
+// thread. Without that definition libgomp starts a pool of 3 workers at the first region with its
+// team of 4 (they stay alive). ctest runs every test in its own process, so no earlier test has
+// started them.
 int ThreadCount() {
   return static_cast<int>(std::distance(std::filesystem::directory_iterator("/proc/self/task"),
                                         std::filesystem::directory_iterator()));
@@ -474,26 +476,11 @@ TEST(SparseCholeskyTest, AnalyzesWithAGivenOrdering) {
             absl::StatusCode::kInvalidArgument);  // row 1 of a 1 x 1 pattern
 }
 
-// A dense SPD matrix as a sparse one (upper triangle): A = B B^T / n + I, B uniform in [-1, 1].
-Eigen::SparseMatrix<double> DenseSpd(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Eigen::MatrixXd b(n, n);
-  for (Eigen::Index k = 0; k < b.size(); ++k) b.data()[k] = u(rng);
-  const Eigen::MatrixXd a = b * b.transpose() / n + Eigen::MatrixXd::Identity(n, n);
-  std::vector<Eigen::Triplet<double>> upper;
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i <= j; ++i) upper.emplace_back(i, j, a(i, j));
-  }
-  Eigen::SparseMatrix<double> m(n, n);
-  m.setFromTriplets(upper.begin(), upper.end());
-  m.makeCompressed();
-  return m;
-}
+using testing::DenseSpd;
 
 // A dense block of SparseCholesky::kDensePanel * 2 columns or more (one supernode here) is
-// factored in panels by the overrides' dpotrf_/dsyrk_ (process_overrides.cpp): the solution is right,
-// and a pivot that fails in a later panel is reported at its own column, as LAPACK would.
+// factored in panels by the overrides' dpotrf_/dsyrk_ (process_overrides.cpp): the solution is
+// right, and a pivot that fails in a later panel is reported at its own column, as LAPACK would.
 TEST(SparseCholeskyTest, LargeDenseSupernodesAreFactoredInPanels) {
   const int n = 5 * SparseCholesky::kDensePanel + 37;
   Eigen::SparseMatrix<double> a = DenseSpd(n, 5);
