@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
@@ -28,9 +29,24 @@ bool SameKind(const ArtLayer& a, const ArtLayer& b) {
   return a.fill.has_value() == b.fill.has_value() && a.stroke.has_value() == b.stroke.has_value();
 }
 
-// Same path count, and each path closed (and empty) in all members or in none.
+// Closed, non-empty paths only: layers of such paths morph even when their path counts differ
+// (a face that gains a mouth hole, one cell that becomes two), see Morph::Layer.
+bool AllClosedAndDrawn(const EmbeddedLayer& layer) {
+  if (layer.paths.empty()) return false;
+  for (const EmbeddedPath& path : layer.paths) {
+    if (!path.closed || path.points.empty()) return false;
+  }
+  return true;
+}
+
+// Same path count, and each path closed (and empty) in all members or in none; or closed,
+// non-empty paths in every member, in any count.
 bool SameGeometry(const std::vector<EmbeddedArt>& keys, const Group& group) {
   const EmbeddedLayer& first = keys[group[0].key].layers[group[0].layer];
+  const bool all_closed = std::all_of(group.begin(), group.end(), [&](const Member& m) {
+    return AllClosedAndDrawn(keys[m.key].layers[m.layer]);
+  });
+  if (all_closed) return true;
   for (const Member& m : group) {
     const EmbeddedLayer& layer = keys[m.key].layers[m.layer];
     if (layer.paths.size() != first.paths.size()) return false;
@@ -45,9 +61,11 @@ bool SameGeometry(const std::vector<EmbeddedArt>& keys, const Group& group) {
 }
 
 // Two layers that may morph into each other: the same kind of paint and the same path structure
-// (path count, each closed in both or neither).
+// (path count, each closed in both or neither), or closed non-empty paths in both.
 bool Compatible(const EmbeddedLayer& a, const EmbeddedLayer& b) {
-  if (!SameKind(a.paint, b.paint) || a.paths.size() != b.paths.size()) return false;
+  if (!SameKind(a.paint, b.paint)) return false;
+  if (AllClosedAndDrawn(a) && AllClosedAndDrawn(b)) return true;
+  if (a.paths.size() != b.paths.size()) return false;
   for (size_t j = 0; j < a.paths.size(); ++j) {
     if (a.paths[j].closed != b.paths[j].closed) return false;
   }
@@ -199,12 +217,31 @@ const Member* Heaviest(const Group& group, Has has) {
   return best;
 }
 
+// A key's layer cross-faded: its paint at `weight` times its opacity, placed in the frame.
+ArtLayer FadedLayer(const EmbeddedLayer& layer, double weight, const Points& frame) {
+  ArtLayer faded = layer.paint;
+  faded.opacity *= weight;
+  for (const EmbeddedPath& path : layer.paths) {
+    faded.paths.push_back({PlacePath(path, frame), path.closed});
+  }
+  return faded;
+}
+
+// The length of a closed polyline.
+double PathLength(const Points& path) {
+  double length = 0.0;
+  for (size_t i = 0; i < path.size(); ++i) length += (path[(i + 1) % path.size()] - path[i]).norm();
+  return length;
+}
+
 class Morph {
  public:
   Morph(const std::vector<EmbeddedArt>& keys, const Points& frame, const FrameArtOptions& options)
       : keys_(keys), frame_(frame), options_(options) {}
 
-  ArtLayer Layer(const Group& group) const {
+  // The group's morphed layer, or nullopt when its closed paths come in different counts and do
+  // not pair up closely (see MorphUnequalCounts): then its layers cross-fade.
+  std::optional<ArtLayer> Layer(const Group& group) const {
     const Member& top = *Heaviest(group, [](const Member&) { return true; });
     ArtLayer out = Paint(top).paint;
     out.opacity = 0.0;
@@ -213,16 +250,95 @@ class Morph {
     out.stroke = Stroke(group);
     std::vector<double> weights;
     for (const Member& m : group) weights.push_back(m.weight);
+    const size_t most = std::max_element(group.begin(), group.end(),
+                                         [&](const Member& a, const Member& b) {
+                                           return Paint(a).paths.size() < Paint(b).paths.size();
+                                         }) -
+                        group.begin();
+    if (std::any_of(group.begin(), group.end(), [&](const Member& m) {
+          return Paint(m).paths.size() != Paint(group[most]).paths.size();
+        })) {
+      std::optional<std::vector<ArtPath>> paths = MorphUnequalCounts(group, weights, most);
+      if (!paths) return std::nullopt;
+      out.paths = *std::move(paths);
+      return out;
+    }
     for (size_t j = 0; j < Paint(top).paths.size(); ++j) {
       std::vector<Points> placed;
       for (const Member& m : group) placed.push_back(PlacePath(Paint(m).paths[j], frame_));
       const bool closed = Paint(top).paths[j].closed;
+      // Closed paths drawn from other points or in the other direction in different keys: each
+      // runs from the point nearest the first member's start, in its direction, in this frame.
+      if (closed && !placed[0].empty()) {
+        for (size_t m = 1; m < placed.size(); ++m) placed[m] = AlignClosedPath(placed[0], placed[m]);
+      }
       out.paths.push_back({placed[0].empty()
                                ? Points{}
                                : BlendPaths(placed, closed, weights, options_.merge_fraction),
                            closed});
     }
     return out;
+  }
+
+
+  // Closed paths in different counts (a face that gains a mouth hole, one cell that becomes two):
+  // each path of the member with the most (group[most]) is morphed with the path of every other
+  // member that pairs with it, nearest first (mean squared distance of their placements in this
+  // frame, aligned), and a member without a partner for it lends that path's own placement: the
+  // mesh carries it (a hole opens as the mesh's opening does), instead of the layer fading.
+  // Pairs must lie close in the frame (root mean squared distance under kPairDistance of the
+  // path's length): a hole that opens pairs its face's outline with the face's outline, but one
+  // cell that becomes two would pair its outline with one of the cells, which then drags the
+  // other's half along; nullopt then (the layers cross-fade).
+  std::optional<std::vector<ArtPath>> MorphUnequalCounts(const Group& group,
+                                                         const std::vector<double>& weights,
+                                                         size_t most) const {
+    constexpr double kPairDistance = 0.02;
+    const auto place = [&](const Member& m) {
+      std::vector<Points> placed;
+      for (const EmbeddedPath& path : Paint(m).paths) placed.push_back(PlacePath(path, frame_));
+      return placed;
+    };
+    const std::vector<Points> full = place(group[most]);
+    // partner[m][j]: member m's path (aligned) that morphs with full[j], if any.
+    std::vector<std::vector<std::optional<Points>>> partner(group.size());
+    for (size_t m = 0; m < group.size(); ++m) {
+      partner[m].resize(full.size());
+      if (m == most) {
+        for (size_t j = 0; j < full.size(); ++j) partner[m][j] = full[j];
+        continue;
+      }
+      const std::vector<Points> own = place(group[m]);
+      struct Pair {
+        double cost;
+        size_t i, j;
+        Points aligned;
+      };
+      std::vector<Pair> pairs;
+      for (size_t i = 0; i < own.size(); ++i) {
+        for (size_t j = 0; j < full.size(); ++j) {
+          Points aligned = AlignClosedPath(full[j], own[i]);
+          pairs.push_back({MeanSquaredDistance(full[j], aligned), i, j, std::move(aligned)});
+        }
+      }
+      std::stable_sort(pairs.begin(), pairs.end(),
+                       [](const Pair& a, const Pair& b) { return a.cost < b.cost; });
+      std::vector<bool> used(own.size(), false);
+      for (Pair& pair : pairs) {
+        if (used[pair.i] || partner[m][pair.j]) continue;
+        const double length = PathLength(full[pair.j]);
+        if (!(pair.cost <= kPairDistance * kPairDistance * length * length)) return std::nullopt;
+        used[pair.i] = true;
+        partner[m][pair.j] = std::move(pair.aligned);
+      }
+    }
+    std::vector<ArtPath> paths;
+    for (size_t j = 0; j < full.size(); ++j) {
+      std::vector<Points> placed;
+      for (size_t m = 0; m < group.size(); ++m) placed.push_back(partner[m][j] ? *partner[m][j] : full[j]);
+      paths.push_back({BlendPaths(placed, true, weights, options_.merge_fraction), true});
+    }
+    return paths;
   }
 
  private:
@@ -336,31 +452,32 @@ absl::StatusOr<std::vector<ArtLayer>> ArtForFrame(const std::vector<EmbeddedArt>
         continue;
       }
       slot_sources[last + 1].push_back({a.key, static_cast<int>(l)});
-      ArtLayer& faded = slots[last + 1].emplace_back(layers[l].paint);
-      faded.opacity *= a.weight;
-      for (const EmbeddedPath& path : layers[l].paths) {
-        faded.paths.push_back({PlacePath(path, frame_vertices), path.closed});
-      }
+      slots[last + 1].push_back(FadedLayer(layers[l], a.weight, frame_vertices));
     }
   }
   const Morph morph(keys, frame_vertices, options);
   std::vector<ArtLayer> out = std::move(slots[0]);
+  std::vector<ArtLayerSource> out_sources;
+  const auto faded = [&](size_t slot) {
+    for (const ArtLayerRef& ref : slot_sources[slot]) out_sources.push_back({{ref}});
+  };
+  faded(0);
   for (size_t g = 0; g < groups.size(); ++g) {
-    out.push_back(morph.Layer(groups[g]));
-    for (ArtLayer& layer : slots[g + 1]) out.push_back(std::move(layer));
-  }
-  if (sources != nullptr) {
-    sources->clear();
-    const auto faded = [&](size_t slot) {
-      for (const ArtLayerRef& ref : slot_sources[slot]) sources->push_back({{ref}});
-    };
-    faded(0);
-    for (size_t g = 0; g < groups.size(); ++g) {
-      ArtLayerSource& morphed = sources->emplace_back();
-      for (const Member& m : groups[g]) morphed.members.push_back({m.key, m.layer});
-      faded(g + 1);
+    if (std::optional<ArtLayer> morphed = morph.Layer(groups[g])) {
+      out.push_back(*std::move(morphed));
+      ArtLayerSource& source = out_sources.emplace_back();
+      for (const Member& m : groups[g]) source.members.push_back({m.key, m.layer});
+    } else {
+      // Not morphable in this frame: its members cross-fade where the group stands.
+      for (const Member& m : groups[g]) {
+        out.push_back(FadedLayer(keys[m.key].layers[m.layer], m.weight, frame_vertices));
+        out_sources.push_back({{{m.key, m.layer}}});
+      }
     }
+    for (ArtLayer& layer : slots[g + 1]) out.push_back(std::move(layer));
+    faded(g + 1);
   }
+  if (sources != nullptr) *sources = std::move(out_sources);
   return out;
 }
 

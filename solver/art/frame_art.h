@@ -15,17 +15,29 @@
 //    to 1 for lying close together in the frame). Keys drawn with the same layers align index to
 //    index; a key that adds or drops layers (other eyes) keeps its other layers (the face, its
 //    outline, the mouth) morphing instead of fading.
-//  A group of corresponding layers morphs only if its members have the same number of paths and
-//  each path is closed in all or none of them; otherwise its layers cross-fade.
+//  A group of corresponding layers morphs if its members have the same number of paths and each
+//  path is closed in all or none of them, or if every path of every member is closed and the
+//  paths pair up closely in the frame (a face that gains a mouth hole: see Morph); otherwise its
+//  layers cross-fade.
 //
 // Morph: each path is placed in the frame from every member's own embedding, the placements are
 // resampled to one point count by arc length (at the union of every placement's own vertex
 // parameters, so that each placement is kept exactly, corners included, and the morph tends to a
-// key's drawn path as its weight tends to 1), then positions are blended by the weights. Closed
-// paths start at their drawn first point and keep their drawn direction (no cyclic alignment).
+// key's drawn path as its weight tends to 1), then positions are blended by the weights. A
+// closed path drawn from another point or in the other direction than the first member's is
+// first restarted and turned to run along it in the frame (AlignClosedPath), so a square drawn
+// from one corner and a hexagon drawn from another morph in place instead of turning and
+// shrinking through the middle frames.
 // Colours (per 8-bit channel), opacities, stroke widths, miter limits and dashes (when every
 // member has as many) blend by the weights; discrete properties (cap, join, fill rule, id) are
 // the heaviest member's (ties: the lower key).
+//
+// Closed paths in different counts: each path of the member with the most paths morphs with
+// the nearest path of every other member (root mean squared distance of their aligned
+// placements under 2% of the path's length, nearest pairs first); a member without a partner
+// for it lends that path's own placement, so a hole one key lacks is carried by the mesh (it
+// opens as the mesh's opening does). When some path finds no partner that close (one cell that
+// becomes two), the group's layers cross-fade.
 //
 // Cross-fade: a layer without a morphing group is drawn with its opacity times its key's weight.
 //

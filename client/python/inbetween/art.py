@@ -229,6 +229,128 @@ def _blend_paths(paths: List[List[XY]], closed: bool, weights: List[float],
     return out
 
 
+_ALIGN_SAMPLES = 64
+
+
+def _polygon_signed_area2(path: List[XY]) -> float:
+    n = len(path)
+    total = 0.0
+    for i in range(n):
+        (ax, ay), (bx, by) = path[i], path[(i + 1) % n]
+        total += ax * by - ay * bx
+    return total
+
+
+def _uniform_samples(path: List[XY], params: List[float], shift: float) -> List[XY]:
+    out = []
+    for i in range(_ALIGN_SAMPLES):
+        u = i / _ALIGN_SAMPLES + shift
+        u -= math.floor(u)
+        out.append(_point_at_parameter(path, True, params, u))
+    return out
+
+
+def _squared_distances(a: List[XY], b: List[XY]) -> float:
+    total = 0.0
+    for (ax, ay), (bx, by) in zip(a, b):
+        dx, dy = ax - bx, ay - by
+        total += dx * dx + dy * dy
+    return total
+
+
+def _restart_at(path: List[XY], params: List[float], u: float) -> List[XY]:
+    n = len(path)
+    lo, hi = 0, n  # std::upper_bound
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if params[mid] > u:
+            hi = mid
+        else:
+            lo = mid + 1
+    a = lo - 1
+    start = _point_at_parameter(path, True, params, u)
+    out = [start]
+    for k in range(1, n + 1):
+        p = path[(a + k) % n]
+        if k == n and p == start:
+            break  # the offset fell on vertex a
+        if k == 1 and p == start:
+            continue  # or on vertex a + 1
+        out.append(p)
+    return out
+
+
+def _align_closed_path(reference: List[XY], path: List[XY]) -> List[XY]:
+    """blend_paths.h AlignClosedPath: ``path`` restarted (and reversed when its direction
+    differs) to run along ``reference``."""
+    if len(reference) < 3 or len(path) < 3:
+        return path
+    p = list(path)
+    if _polygon_signed_area2(reference) * _polygon_signed_area2(p) < 0.0:
+        p = [p[0]] + p[:0:-1]  # the other direction, from the same first point
+    ref_params = _arc_length_parameters(reference, True)
+    params = _arc_length_parameters(p, True)
+    if ref_params[-1] == 0.0 or params[-1] == 0.0:
+        return p
+    ref = _uniform_samples(reference, ref_params, 0.0)
+    grid = _uniform_samples(p, params, 0.0)
+    best, best_cost = 0, 0.0
+    for k in range(_ALIGN_SAMPLES):
+        cost = 0.0
+        for i in range(_ALIGN_SAMPLES):
+            (ax, ay), (bx, by) = ref[i], grid[(i + k) % _ALIGN_SAMPLES]
+            dx, dy = ax - bx, ay - by
+            cost += dx * dx + dy * dy
+        if k == 0 or cost < best_cost:
+            best, best_cost = k, cost
+
+    def cost_at(shift: float) -> float:
+        return _squared_distances(ref, _uniform_samples(p, params, shift))
+
+    step = 1.0 / _ALIGN_SAMPLES
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    lo, hi = (best - 1) * step, (best + 1) * step
+    x1, x2 = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+    f1, f2 = cost_at(x1), cost_at(x2)
+    for _ in range(40):
+        if f1 <= f2:
+            hi, x2, f2 = x2, x1, f1
+            x1 = hi - ratio * (hi - lo)
+            f1 = cost_at(x1)
+        else:
+            lo, x1, f1 = x1, x2, f2
+            x2 = lo + ratio * (hi - lo)
+            f2 = cost_at(x2)
+    shift = x1 if f1 <= f2 else x2
+    if min(f1, f2) >= cost_at(0.0):
+        return p  # the drawn start is as good
+    shift -= math.floor(shift)
+    for v in params:
+        if abs(v - shift) < 1e-9:
+            shift = v
+    if shift >= 1.0 - 1e-9 or shift == 0.0:
+        return p
+    return _restart_at(p, params, shift)
+
+
+def _mean_squared_distance(a: List[XY], b: List[XY]) -> float:
+    if len(a) < 3 or len(b) < 3:
+        return math.inf
+    pa, pb = _arc_length_parameters(a, True), _arc_length_parameters(b, True)
+    if pa[-1] == 0.0 or pb[-1] == 0.0:
+        return math.inf
+    return _squared_distances(_uniform_samples(a, pa, 0.0),
+                              _uniform_samples(b, pb, 0.0)) / _ALIGN_SAMPLES
+
+
+def _path_length(path: List[XY]) -> float:
+    length = 0.0
+    n = len(path)
+    for i in range(n):
+        length += _norm(path[i], path[(i + 1) % n])
+    return length
+
+
 # ------------------------------------------------------------------------------------------
 # Which layers correspond (frame_art.cpp). A group member is (key, layer, weight), the weight
 # normalized over the active keys; a group has one member per active key, in key order.
@@ -238,7 +360,13 @@ def _same_kind(a: Layer, b: Layer) -> bool:
         (a.stroke is not None) == (b.stroke is not None)
 
 
+def _all_closed_and_drawn(layer: _KeyLayer) -> bool:
+    return bool(layer.paths) and all(closed and corners for closed, corners in layer.paths)
+
+
 def _same_geometry(keys: List[List[_KeyLayer]], group: List[Member]) -> bool:
+    if all(_all_closed_and_drawn(keys[key][l]) for key, l, _ in group):
+        return True
     first = keys[group[0][0]][group[0][1]].paths
     for key, l, _ in group:
         paths = keys[key][l].paths
@@ -251,7 +379,11 @@ def _same_geometry(keys: List[List[_KeyLayer]], group: List[Member]) -> bool:
 
 
 def _compatible(a: _KeyLayer, b: _KeyLayer) -> bool:
-    if not _same_kind(a.paint, b.paint) or len(a.paths) != len(b.paths):
+    if not _same_kind(a.paint, b.paint):
+        return False
+    if _all_closed_and_drawn(a) and _all_closed_and_drawn(b):
+        return True
+    if len(a.paths) != len(b.paths):
         return False
     return all(p[0] == q[0] for p, q in zip(a.paths, b.paths))
 
@@ -394,8 +526,50 @@ def _heaviest(group: List[Member], has: Callable[[Member], bool]) -> Optional[Me
     return best
 
 
+_PAIR_DISTANCE = 0.02
+
+
+def _morph_unequal_counts(paths_of: List[List[Tuple[bool, List[Corner]]]], xy: Sequence[XY],
+                          weights: List[float], most: int,
+                          merge_fraction: float) -> Optional[List[Path]]:
+    """frame_art.cpp MorphUnequalCounts: closed paths in different counts pair nearest first; a
+    member without a partner lends the fullest member's placement; None when a pair is far."""
+    full = [_place(corners, xy) for _, corners in paths_of[most]]
+    partner: List[List[Optional[List[XY]]]] = []
+    for m, paths in enumerate(paths_of):
+        row: List[Optional[List[XY]]] = [None] * len(full)
+        partner.append(row)
+        if m == most:
+            for j in range(len(full)):
+                row[j] = full[j]
+            continue
+        own = [_place(corners, xy) for _, corners in paths]
+        pairs = []
+        for i, path in enumerate(own):
+            for j, target in enumerate(full):
+                aligned = _align_closed_path(target, path)
+                pairs.append((_mean_squared_distance(target, aligned), i, j, aligned))
+        pairs.sort(key=lambda pair: pair[0])  # stable, as std::stable_sort
+        used = [False] * len(own)
+        for cost, i, j, aligned in pairs:
+            if used[i] or row[j] is not None:
+                continue
+            length = _path_length(full[j])
+            if not cost <= _PAIR_DISTANCE * _PAIR_DISTANCE * length * length:
+                return None
+            used[i] = True
+            row[j] = aligned
+    out = []
+    for j in range(len(full)):
+        placed = [row[j] if row[j] is not None else full[j] for row in partner]
+        out.append(Path(True, _blend_paths(placed, True, weights, merge_fraction)))
+    return out
+
+
 def _morph_layer(keys: List[List[_KeyLayer]], group: List[Member], xy: Sequence[XY],
-                 options: FrameArtOptions) -> Layer:
+                 options: FrameArtOptions) -> Optional[Layer]:
+    """The group's morphed layer, or None when its closed paths come in different counts and
+    do not pair up closely (then its layers cross-fade)."""
     def layer_of(m: Member) -> _KeyLayer:
         return keys[m[0]][m[1]]
 
@@ -407,8 +581,22 @@ def _morph_layer(keys: List[List[_KeyLayer]], group: List[Member], xy: Sequence[
     out.fill = _morph_fill(group, layer_of)
     out.stroke = _morph_stroke(group, layer_of)
     weights = [m[2] for m in group]
+    counts = [len(layer_of(m).paths) for m in group]
+    most = 0
+    for m, count in enumerate(counts):
+        if count > counts[most]:
+            most = m
+    if any(count != counts[most] for count in counts):
+        paths = _morph_unequal_counts([layer_of(m).paths for m in group], xy, weights, most,
+                                      options.merge_fraction)
+        if paths is None:
+            return None
+        out.paths = paths
+        return out
     for j, (closed, _) in enumerate(layer_of(top).paths):
         placed = [_place(layer_of(m).paths[j][1], xy) for m in group]
+        if closed and placed[0]:
+            placed = [placed[0]] + [_align_closed_path(placed[0], p) for p in placed[1:]]
         points = _blend_paths(placed, closed, weights, options.merge_fraction) if placed[0] else []
         out.paths.append(Path(closed, points))
     return out
@@ -537,15 +725,23 @@ def _art_for_frame(keys: List[List[_KeyLayer]], xy: Sequence[XY], weights: List[
             if (key, l) in group_of:
                 last = group_of[(key, l)]
                 continue
-            faded = _copy_paint(layer.paint)
-            faded.opacity *= weight
-            faded.paths = [Path(closed, _place(corners, xy)) for closed, corners in layer.paths]
-            slots[last + 1].append(faded)
+            slots[last + 1].append(_faded_layer(layer, weight, xy))
     out = slots[0]
     for g, group in enumerate(groups):
-        out.append(_morph_layer(keys, group, xy, options))
+        morphed = _morph_layer(keys, group, xy, options)
+        if morphed is not None:
+            out.append(morphed)
+        else:  # not morphable in this frame: its members cross-fade where the group stands
+            out.extend(_faded_layer(keys[key][l], weight, xy) for key, l, weight in group)
         out.extend(slots[g + 1])
     return out
+
+
+def _faded_layer(layer: _KeyLayer, weight: float, xy: Sequence[XY]) -> Layer:
+    faded = _copy_paint(layer.paint)
+    faded.opacity *= weight
+    faded.paths = [Path(closed, _place(corners, xy)) for closed, corners in layer.paths]
+    return faded
 
 
 def frame_art(header: Any, frame: Any, options: Optional[FrameArtOptions] = None

@@ -107,6 +107,29 @@ class FrameArtTest(unittest.TestCase):
         by_order = inbetween.frame_art(h, frame([0.5, 0.5]), options)
         self.assertEqual([l.fill.rgb for l in by_order], [0x800080, 0x800080])
 
+    def test_closed_paths_drawn_from_other_corners_morph_in_place(self):
+        # The square drawn v0 v1 v2 v3 in key 0, from v2 and the other way round in key 1: midway
+        # it is the square, not a turned and shrunk one.
+        h = header([layer([V0, V1, V2, V3], fill=0x204060)],
+                   [layer([V2, V1, V0, V3], fill=0x204060)])
+        layers = inbetween.frame_art(h, frame([0.5, 0.5]))
+        self.assertEqual(len(layers), 1)
+        closed, points = layers[0].paths[0]
+        self.assertTrue(closed)
+        self.assertEqual(sorted(points), sorted(SQUARE))
+
+    def test_a_fill_that_gains_a_hole_morphs(self):
+        # Key 1 adds a closed path (a hole); key 0's outline pairs with key 1's, and the hole is
+        # placed as key 1 draws it: one layer at full opacity, not two fading ones.
+        outline = layer([V0, V1, V2, V3], fill=0x204060)
+        holed = layer([V0, V1, V2, V3], fill=0x204060)
+        holed.paths.add(triangles=[0, 0, 1], barycentric=[0.6, 0.3, 0.1, 0.3, 0.6, 0.1,
+                                                          0.3, 0.1, 0.6], closed=True)
+        layers = inbetween.frame_art(header([outline], [holed]), frame([0.5, 0.5]))
+        self.assertEqual(len(layers), 1)
+        self.assertEqual(layers[0].opacity, 1.0)
+        self.assertEqual(len(layers[0].paths), 2)
+
     def test_errors_and_no_art(self):
         h = header([layer([V0, V3], fill=0)], [layer([V0, V1, V2], fill=0)])
         with self.assertRaisesRegex(ValueError, "3 weights for the art of 2 keys"):

@@ -50,5 +50,25 @@ TEST(ArtBlendPathsTest, ClosedSquaresMorphToTheMiddleSquare) {
   EXPECT_EQ(m, expected);
 }
 
+TEST(ArtBlendPathsTest, ClosedPathsAreAlignedToTheReferencesStartAndDirection) {
+  const Points square = {{0, 0}, {4, 0}, {4, 4}, {0, 4}};
+  // Started at the third corner; drawn the other way; started half-way along a side.
+  EXPECT_EQ(AlignClosedPath(square, {{4, 4}, {0, 4}, {0, 0}, {4, 0}}), square);
+  EXPECT_EQ(AlignClosedPath(square, {{0, 0}, {0, 4}, {4, 4}, {4, 0}}), square);
+  const Points octagon_like = {{2, 0}, {4, 0}, {4, 4}, {0, 4}, {0, 0}};
+  EXPECT_EQ(AlignClosedPath(square, octagon_like), (Points{{0, 0}, {2, 0}, {4, 0}, {4, 4}, {0, 4}}));
+  // A start between the path's own vertices gets a vertex there: same point set.
+  const Points shifted = {{1, 1}, {5, 1}, {5, 5}, {1, 5}};
+  const Points diamond = {{3, 0}, {6, 3}, {3, 6}, {0, 3}};
+  const Points aligned = AlignClosedPath(shifted, diamond);
+  EXPECT_EQ(aligned.size(), 5u);
+  for (const Point& p : diamond) {
+    EXPECT_NE(std::find(aligned.begin(), aligned.end(), p), aligned.end()) << p.transpose();
+  }
+  EXPECT_LT((aligned[0] - Point(1.5, 1.5)).norm(), 0.2) << aligned[0].transpose();
+  // Too short to align: as given.
+  EXPECT_EQ(AlignClosedPath(square, {{0, 0}, {1, 1}}), (Points{{0, 0}, {1, 1}}));
+}
+
 }  // namespace
 }  // namespace inbetween::solver

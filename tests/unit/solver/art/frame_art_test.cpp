@@ -108,7 +108,7 @@ TEST(FrameArtTest, CorrespondingLayersBlendMidway) {
 
 TEST(FrameArtTest, NonCorrespondingLayersCrossFadeInKeyOrder) {
   const Multimesh mesh = TwoShapes();
-  // Key 0's fill has two paths, key 1's one: no layer of one may morph into one of the other.
+  // Key 0's fill has two paths, key 1's one, far apart: no layer of one morphs into the other.
   std::vector<ArtLayer> a = {FillLayer({{1, 1}, {5, 1}, {5, 4}}, 0x111111, 0.8)};
   a[0].paths.push_back({{{5.5, 1}, {6.5, 1}, {6.5, 2}}, true});
   std::vector<ArtLayer> b = Head({0, 0}, 0x222222, 2.0);
@@ -217,6 +217,64 @@ TEST(FrameArtTest, StrokesPairWithTheNearestOfTheirKind) {
     EXPECT_LT((layer.paths[0].points.front() - mouths).norm(), 1e-9);  // mouth to mouth
   }
   EXPECT_EQ(morphed, 1);
+}
+
+// A closed path drawn from another corner, or the other way round, in the other key still
+// morphs in place: the same square in both keys (one geometry) stays that square midway, where
+// blending from each key's drawn first point turned and shrank it (to half its area).
+TEST(FrameArtTest, ClosedPathsDrawnFromOtherStartsMorphInPlace) {
+  Multimesh mesh = JitteredGrid(8, 6, 0.25);
+  mesh.shapes.push_back(mesh.shapes[0]);
+  const Points square = {{1, 1}, {6, 1}, {6, 5}, {1, 5}};
+  const Points from_third = {{6, 5}, {1, 5}, {1, 1}, {6, 1}};
+  const Points reversed = {{6, 1}, {1, 1}, {1, 5}, {6, 5}};
+  for (const Points& other : {from_third, reversed}) {
+    const std::vector<EmbeddedArt> keys =
+        Embed(mesh, {FillLayer(square, 0x204060)}, {FillLayer(other, 0x204060)});
+    for (double s : {0.25, 0.5, 0.75}) {
+      const std::vector<ArtLayer> out = Frame(keys, mesh.shapes[0], {1 - s, s});
+      ASSERT_EQ(out.size(), 1u);
+      const Points& got = out[0].paths[0].points;
+      for (const Point& p : got) EXPECT_LT(DistanceToPolyline(square, true, p), 1e-9) << s;
+      for (const Point& corner : square) {
+        EXPECT_LT(DistanceToPolyline(got, true, corner), 1e-9) << s;
+      }
+    }
+  }
+}
+
+// A fill that gains a hole (a mouth that opens) morphs instead of fading: its outline pairs with
+// the other key's outline, and the hole, which the other key lacks, is carried by the mesh. A
+// fill whose outline would pair only with a far path (one cell that becomes two) cross-fades.
+TEST(FrameArtTest, FillsThatGainAHoleMorphAndCellsThatSplitCrossFade) {
+  Multimesh mesh = JitteredGrid(8, 6, 0.25);
+  mesh.shapes.push_back(mesh.shapes[0]);
+  const Points face = {{1, 1}, {7, 1}, {7, 5}, {1, 5}};
+  ArtLayer open = FillLayer(face, 0x204060);
+  open.paths.push_back({{{3, 2}, {5, 2}, {5, 3}, {3, 3}}, true});
+  const std::vector<EmbeddedArt> keys = Embed(mesh, {FillLayer(face, 0x204060)}, {open});
+  std::vector<ArtLayerSource> sources;
+  absl::StatusOr<std::vector<ArtLayer>> out =
+      ArtForFrame(keys, mesh.shapes[0], {0.5, 0.5}, {}, &sources);
+  ASSERT_TRUE(out.ok()) << out.status();
+  ASSERT_EQ(out->size(), 1u);
+  EXPECT_DOUBLE_EQ((*out)[0].opacity, 1.0);
+  ASSERT_EQ((*out)[0].paths.size(), 2u);
+  for (const Point& p : (*out)[0].paths[0].points) {
+    EXPECT_LT(DistanceToPolyline(face, true, p), 1e-9);
+  }
+  EXPECT_EQ((*out)[0].paths[1].points, PlacePath(keys[1].layers[0].paths[1], mesh.shapes[0]));
+  ASSERT_EQ(sources.size(), 1u);
+  EXPECT_EQ(sources[0].members.size(), 2u);
+
+  ArtLayer two = FillLayer({{0.5, 1}, {3, 1}, {3, 5}, {0.5, 5}}, 0x204060);
+  two.paths.push_back({{{5, 1}, {7.5, 1}, {7.5, 5}, {5, 5}}, true});
+  const std::vector<EmbeddedArt> split = Embed(mesh, {FillLayer(face, 0x204060)}, {two});
+  const std::vector<ArtLayer> faded = Frame(split, mesh.shapes[0], {0.25, 0.75});
+  ASSERT_EQ(faded.size(), 2u);
+  EXPECT_DOUBLE_EQ(faded[0].opacity, 0.25);
+  EXPECT_DOUBLE_EQ(faded[1].opacity, 0.75);
+  EXPECT_EQ(faded[1].paths.size(), 2u);
 }
 
 TEST(FrameArtTest, MorphTendsToEachKeyAsItsWeightTendsToOne) {
