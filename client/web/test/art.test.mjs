@@ -12,15 +12,19 @@ import { test } from "node:test";
 import { create } from "@bufbuild/protobuf";
 
 import {
+  alignClosedPath,
   appendArtChunk,
   arcLengthParameters,
   artForFrame,
   blendPaths,
   blendRgb,
   keysFromProto,
+  meanSquaredDistance,
   paintArt,
   placeArt,
+  placePath,
   pointAtParameter,
+  polygonSignedArea2,
 } from "../src/page/art.js";
 import { KeyArtSchema, LineCap, LineJoin } from "../src/gen/inbetween/v1/inbetween_pb.js";
 
@@ -124,6 +128,24 @@ function nearAll(actual, expected, tol, what) {
   }
 }
 
+// The distance from (x, y) to the packed polyline `path` (closed: with its closing segment).
+function distanceToPolyline(path, closed, [x, y]) {
+  const n = path.length / 2;
+  let best = Math.hypot(path[0] - x, path[1] - y);
+  const segments = closed ? n : n - 1;
+  for (let i = 0; i < segments; i++) {
+    const j = (i + 1) % n;
+    const [ax, ay, bx, by] = [path[2 * i], path[2 * i + 1], path[2 * j], path[2 * j + 1]];
+    const dx = bx - ax;
+    const dy = by - ay;
+    const d2 = dx * dx + dy * dy;
+    const t = d2 === 0 ? 0 : Math.min(Math.max(((x - ax) * dx + (y - ay) * dy) / d2, 0), 1);
+    best = Math.min(best, Math.hypot(ax + t * dx - x, ay + t * dy - y));
+  }
+  return best;
+}
+const pairsOf = (flat) => Array.from({ length: flat.length / 2 }, (_, i) => [flat[2 * i], flat[2 * i + 1]]);
+
 function twoShapes() {
   const mesh = grid(8, 6, 0.25);
   return { mesh, shapes: [mesh.xy, mapped(mesh.xy, rotatedStretched)] };
@@ -213,7 +235,7 @@ test("layers without a counterpart cross-fade with opacity × weight, outgoing u
   const other = artForFrame(keys, xy, [0.9, 0.1]);
   assert.deepEqual(other.map((l) => l.opacity), [0.1, 1, 0.8 * 0.9, 0.1]);
 
-  // Same name but another path structure (one path vs two): both cross-fade.
+  // Same name, one closed path vs two far from it: no pairing, both cross-fade.
   const one = fillLayer(triangleAt([3, 3]), 0xff0000, { name: "eyes" });
   const two = fillLayer(triangleAt([2, 3]), 0x00ff00, { name: "eyes" });
   two.paths.push({ points: triangleAt([4, 3]), closed: true });
@@ -357,6 +379,84 @@ test("blend_paths: arc-length parameters, corners kept, ends kept", () => {
   // Rounding: per channel, half away from zero.
   assert.equal(blendRgb([[0x000001, 0.5], [0x000002, 0.5]]), 0x000002);
   assert.equal(blendRgb([[0xffffff, 1]]), 0xffffff);
+});
+
+test("blend_paths: closed paths are aligned to the reference's start and direction", () => {
+  const flat = (points) => Float64Array.from(points.flat());
+  const square = flat([[0, 0], [4, 0], [4, 4], [0, 4]]);
+  // Started at the third corner; drawn the other way; started half-way along a side.
+  assert.deepEqual([...alignClosedPath(square, flat([[4, 4], [0, 4], [0, 0], [4, 0]]))], [...square]);
+  assert.deepEqual([...alignClosedPath(square, flat([[0, 0], [0, 4], [4, 4], [4, 0]]))], [...square]);
+  const octagonLike = flat([[2, 0], [4, 0], [4, 4], [0, 4], [0, 0]]);
+  assert.deepEqual([...alignClosedPath(square, octagonLike)], [0, 0, 2, 0, 4, 0, 4, 4, 0, 4]);
+  // A start between the path's own vertices gets a vertex there: same point set.
+  const shiftedSquare = flat([[1, 1], [5, 1], [5, 5], [1, 5]]);
+  const diamond = [[3, 0], [6, 3], [3, 6], [0, 3]];
+  const aligned = pairsOf(alignClosedPath(shiftedSquare, flat(diamond)));
+  assert.equal(aligned.length, 5);
+  for (const p of diamond) assert.ok(aligned.some((q) => q[0] === p[0] && q[1] === p[1]), `${p} kept`);
+  assert.ok(Math.hypot(aligned[0][0] - 1.5, aligned[0][1] - 1.5) < 0.2, `starts at ${aligned[0]}`);
+  // Too short to align: as given.
+  assert.deepEqual([...alignClosedPath(square, flat([[0, 0], [1, 1]]))], [0, 0, 1, 1]);
+  // Twice the signed area, positive counter-clockwise in y-up axes; the mean squared distance of
+  // aligned samples.
+  assert.equal(polygonSignedArea2(square), 32);
+  assert.equal(polygonSignedArea2(flat([[0, 0], [0, 4], [4, 4], [4, 0]])), -32);
+  assert.equal(meanSquaredDistance(square, square), 0);
+  assert.ok(Math.abs(meanSquaredDistance(square, flat([[1, 0], [5, 0], [5, 4], [1, 4]])) - 1) < 1e-12);
+  assert.equal(meanSquaredDistance(square, flat([[0, 0], [1, 1]])), Infinity);
+});
+
+// A closed path drawn from another corner, or the other way round, in the other key still morphs
+// in place: the same square in both keys (one geometry) stays that square midway.
+test("closed paths drawn from other starts morph in place", () => {
+  const mesh = grid(8, 6, 0.25);
+  const xy = mesh.xy;
+  const square = [[1, 1], [6, 1], [6, 5], [1, 5]];
+  const fromThird = [[6, 5], [1, 5], [1, 1], [6, 1]];
+  const reversed = [[6, 1], [1, 1], [1, 5], [6, 5]];
+  const flatSquare = square.flat();
+  for (const other of [fromThird, reversed]) {
+    const keys = keysFromProto([keyArt(mesh, 0, [fillLayer(square, 0x204060)]), keyArt(mesh, 1, [fillLayer(other, 0x204060)])],
+      mesh.triangles);
+    for (const s of [0.25, 0.5, 0.75]) {
+      const out = artForFrame(keys, xy, [1 - s, s]);
+      assert.equal(out.length, 1);
+      const got = out[0].paths[0].points;
+      for (const p of pairsOf(got)) assert.ok(distanceToPolyline(flatSquare, true, p) < 1e-9, `${s}: ${p} on the square`);
+      for (const corner of square) assert.ok(distanceToPolyline(got, true, corner) < 1e-9, `${s}: corner ${corner} kept`);
+    }
+  }
+});
+
+// A fill that gains a hole (a mouth that opens) morphs instead of fading: its outline pairs with
+// the other key's outline, and the hole, which the other key lacks, is carried by the mesh. A
+// fill whose outline would pair only with a far path (one cell that becomes two) cross-fades.
+test("fills that gain a hole morph; cells that split cross-fade", () => {
+  const mesh = grid(8, 6, 0.25);
+  const xy = mesh.xy;
+  const face = [[1, 1], [7, 1], [7, 5], [1, 5]];
+  const open = fillLayer(face, 0x204060);
+  open.paths.push({ points: [[3, 2], [5, 2], [5, 3], [3, 3]], closed: true });
+  const keys = keysFromProto([keyArt(mesh, 0, [fillLayer(face, 0x204060)]), keyArt(mesh, 1, [open])], mesh.triangles);
+  const out = artForFrame(keys, xy, [0.5, 0.5]);
+  assert.equal(out.length, 1);
+  assert.equal(out[0].opacity, 1);
+  assert.equal(out[0].paths.length, 2);
+  for (const p of pairsOf(out[0].paths[0].points)) assert.ok(distanceToPolyline(face.flat(), true, p) < 1e-9, `${p} on the face`);
+  assert.deepEqual(out[0].paths[1], { points: placePath(keys[1].layers[0].paths[1], xy), closed: true });
+
+  const two = fillLayer([[0.5, 1], [3, 1], [3, 5], [0.5, 5]], 0x204060);
+  two.paths.push({ points: [[5, 1], [7.5, 1], [7.5, 5], [5, 5]], closed: true });
+  const split = keysFromProto([keyArt(mesh, 0, [fillLayer(face, 0x204060)]), keyArt(mesh, 1, [two])], mesh.triangles);
+  const faded = artForFrame(split, xy, [0.25, 0.75]);
+  assert.equal(faded.length, 2);
+  assert.equal(faded[0].opacity, 0.25);
+  assert.equal(faded[1].opacity, 0.75);
+  assert.equal(faded[1].paths.length, 2);
+  // Each is its key's layer placed in the frame.
+  assert.deepEqual(faded[0].paths, placeArt(split[0], xy)[0].paths);
+  assert.deepEqual(faded[1].paths, placeArt(split[1], xy)[0].paths);
 });
 
 // ------------------------------------------------------------------------------------------

@@ -3,7 +3,8 @@
 // combined by the frame's example weights, and painted on a canvas. A port of the C++ rule, kept
 // to the same arithmetic and tie-breaks so that the page draws what the CLI's renderers draw:
 //  - placement: solver/art/art_embedding.h (PlacePath, PlaceArt);
-//  - resampling and blending of corresponding paths: solver/art/blend_paths.h;
+//  - resampling, alignment of closed paths and blending of corresponding paths:
+//    solver/art/blend_paths.h;
 //  - which layers morph and which cross-fade, paint blending, draw order: solver/art/frame_art.h
 //    (ArtForFrame), whose header states the rule this file follows line by line;
 //  - painting: client/render/art_painter.h (cairo), here with the canvas 2D context.
@@ -213,6 +214,153 @@ export function pointAtParameter(path, closed, params, u) {
   return [path[2 * a] + t * (path[2 * b] - path[2 * a]), path[2 * a + 1] + t * (path[2 * b + 1] - path[2 * a + 1])];
 }
 
+// Twice the signed area of the closed packed polygon: the sum of cross(p_i, p_{i+1}) in index
+// order, cross(a, b) = a.x * b.y - a.y * b.x (solver/geometry/primitives.h PolygonSignedArea2).
+export function polygonSignedArea2(path) {
+  const n = path.length / 2;
+  let sum = 0;
+  for (let i = 0; i < n; i++) {
+    const j = (i + 1) % n;
+    sum += path[2 * i] * path[2 * j + 1] - path[2 * i + 1] * path[2 * j];
+  }
+  return sum;
+}
+
+const ALIGN_SAMPLES = 64;
+
+// Samples of the closed packed `path` at arc-length offsets (i / ALIGN_SAMPLES + shift) mod 1,
+// packed.
+function uniformSamples(path, params, shift) {
+  const out = new Float64Array(2 * ALIGN_SAMPLES);
+  for (let i = 0; i < ALIGN_SAMPLES; i++) {
+    let u = i / ALIGN_SAMPLES + shift;
+    u -= Math.floor(u);
+    const [x, y] = pointAtParameter(path, true, params, u);
+    out[2 * i] = x;
+    out[2 * i + 1] = y;
+  }
+  return out;
+}
+
+// The sum over points of |a_i - b_i|^2 (packed, same length).
+function squaredDistances(a, b) {
+  let sum = 0;
+  for (let i = 0; i < a.length; i += 2) {
+    const dx = a[i] - b[i];
+    const dy = a[i + 1] - b[i + 1];
+    sum += dx * dx + dy * dy;
+  }
+  return sum;
+}
+
+// Closed packed `path` started at arc-length offset u in (0, 1) (params from
+// arcLengthParameters): a first vertex there unless u falls on a vertex.
+function restartAt(path, params, u) {
+  const n = path.length / 2;
+  const a = upperBound(params, u) - 1;
+  const [sx, sy] = pointAtParameter(path, true, params, u);
+  const out = [sx, sy];
+  for (let k = 1; k <= n; k++) {
+    const q = (a + k) % n;
+    const px = path[2 * q];
+    const py = path[2 * q + 1];
+    const atStart = px === sx && py === sy;
+    if (k === n && atStart) break; // the offset fell on vertex a
+    if (k === 1 && atStart) continue; // or on vertex a + 1
+    out.push(px, py);
+  }
+  return Float64Array.from(out);
+}
+
+// Closed packed `path` restarted and, when needed, reversed so that it runs along `reference`
+// (closed, packed, in the same space): the same direction (the sign of the enclosed area), and
+// the start at the arc-length offset whose 64 uniform samples lie closest to the reference's
+// (every offset of the sample grid, then a golden-section search between its neighbours). A new
+// first vertex is inserted at that offset unless it falls on a vertex. Returned as is when either
+// path has fewer than 3 points or no length (blend_paths.h AlignClosedPath).
+export function alignClosedPath(reference, path) {
+  if (reference.length / 2 < 3 || path.length / 2 < 3) return path;
+  let p = path;
+  if (polygonSignedArea2(reference) * polygonSignedArea2(p) < 0) {
+    // The other direction, from the same first point.
+    const n = path.length / 2;
+    p = new Float64Array(path.length);
+    p[0] = path[0];
+    p[1] = path[1];
+    for (let k = 1; k < n; k++) {
+      p[2 * k] = path[2 * (n - k)];
+      p[2 * k + 1] = path[2 * (n - k) + 1];
+    }
+  }
+  const refParams = arcLengthParameters(reference, true);
+  const params = arcLengthParameters(p, true);
+  if (refParams[refParams.length - 1] === 0 || params[params.length - 1] === 0) return p;
+  const ref = uniformSamples(reference, refParams, 0);
+  const grid = uniformSamples(p, params, 0);
+  // Every offset of the sample grid: sample i of the reference against sample i + k of the path.
+  let best = 0;
+  let bestCost = 0;
+  for (let k = 0; k < ALIGN_SAMPLES; k++) {
+    let cost = 0;
+    for (let i = 0; i < ALIGN_SAMPLES; i++) {
+      const j = (i + k) % ALIGN_SAMPLES;
+      const dx = ref[2 * i] - grid[2 * j];
+      const dy = ref[2 * i + 1] - grid[2 * j + 1];
+      cost += dx * dx + dy * dy;
+    }
+    if (k === 0 || cost < bestCost) {
+      best = k;
+      bestCost = cost;
+    }
+  }
+  // Refined between the neighbouring grid offsets (golden-section search on the sampled cost).
+  const costAt = (shift) => squaredDistances(ref, uniformSamples(p, params, shift));
+  const step = 1 / ALIGN_SAMPLES;
+  const ratio = (Math.sqrt(5) - 1) / 2;
+  let lo = (best - 1) * step;
+  let hi = (best + 1) * step;
+  let x1 = hi - ratio * (hi - lo);
+  let x2 = lo + ratio * (hi - lo);
+  let f1 = costAt(x1);
+  let f2 = costAt(x2);
+  for (let it = 0; it < 40; it++) {
+    if (f1 <= f2) {
+      hi = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = hi - ratio * (hi - lo);
+      f1 = costAt(x1);
+    } else {
+      lo = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = lo + ratio * (hi - lo);
+      f2 = costAt(x2);
+    }
+  }
+  let shift = f1 <= f2 ? x1 : x2;
+  const least = f2 < f1 ? f2 : f1; // std::min(f1, f2)
+  if (least >= costAt(0)) return p; // the drawn start is as good
+  shift -= Math.floor(shift);
+  // An offset within a hair of a vertex is that vertex (no near-duplicate first point).
+  for (const v of params) {
+    if (Math.abs(v - shift) < 1e-9) shift = v;
+  }
+  if (shift >= 1 - 1e-9 || shift === 0) return p;
+  return restartAt(p, params, shift);
+}
+
+// Mean squared distance between 64 uniform arc-length samples of two closed packed paths, sample
+// i of one against sample i of the other (so: after alignClosedPath). Infinity when either has
+// fewer than 3 points or no length (blend_paths.h MeanSquaredDistance).
+export function meanSquaredDistance(a, b) {
+  if (a.length / 2 < 3 || b.length / 2 < 3) return Infinity;
+  const pa = arcLengthParameters(a, true);
+  const pb = arcLengthParameters(b, true);
+  if (pa[pa.length - 1] === 0 || pb[pb.length - 1] === 0) return Infinity;
+  return squaredDistances(uniformSamples(a, pa, 0), uniformSamples(b, pb, 0)) / ALIGN_SAMPLES;
+}
+
 // sum_k weights[k] paths[k](u) / sum_k weights[k], sampled at the union of every path's own
 // vertex parameters (those within `mergeFraction` of a kept one merged into it). Every path has
 // at least one point; one path is returned as is.
@@ -255,9 +403,19 @@ export function blendPaths(paths, closed, weights, mergeFraction) {
 
 const sameKind = (a, b) => (a.fill !== null) === (b.fill !== null) && (a.stroke !== null) === (b.stroke !== null);
 
-// Same path count, and each path closed (and empty) in all members or in none.
+// Closed, non-empty paths only: layers of such paths morph even when their path counts differ
+// (a face that gains a mouth hole, one cell that becomes two), see morphLayer.
+function allClosedAndDrawn(layer) {
+  if (layer.paths.length === 0) return false;
+  for (const path of layer.paths) if (!path.closed || path.corners.length === 0) return false;
+  return true;
+}
+
+// Same path count, and each path closed (and empty) in all members or in none; or closed,
+// non-empty paths in every member, in any count.
 function sameGeometry(keys, group) {
   const first = keys[group[0].key].layers[group[0].layer];
+  if (group.every((m) => allClosedAndDrawn(keys[m.key].layers[m.layer]))) return true;
   for (const m of group) {
     const layer = keys[m.key].layers[m.layer];
     if (layer.paths.length !== first.paths.length) return false;
@@ -271,9 +429,12 @@ function sameGeometry(keys, group) {
   return true;
 }
 
-// Same kind of paint and the same path structure (path count, each closed in both or neither).
+// Same kind of paint and the same path structure (path count, each closed in both or neither),
+// or closed non-empty paths in both.
 function compatible(a, b) {
-  if (!sameKind(a.paint, b.paint) || a.paths.length !== b.paths.length) return false;
+  if (!sameKind(a.paint, b.paint)) return false;
+  if (allClosedAndDrawn(a) && allClosedAndDrawn(b)) return true;
+  if (a.paths.length !== b.paths.length) return false;
   for (let j = 0; j < a.paths.length; j++) if (a.paths[j].closed !== b.paths[j].closed) return false;
   return true;
 }
@@ -425,6 +586,29 @@ function heaviest(group, has) {
   return best;
 }
 
+// A key's layer cross-faded: its paint at `weight` times its opacity, placed in the frame.
+function fadedLayer(layer, weight, xy) {
+  const faded = copyPaint(layer.paint);
+  faded.opacity *= weight;
+  faded.paths = layer.paths.map((path) => ({ points: placePath(path, xy), closed: path.closed }));
+  return faded;
+}
+
+// The length of a closed packed polyline.
+function pathLength(path) {
+  const n = path.length / 2;
+  let length = 0;
+  for (let i = 0; i < n; i++) {
+    const j = (i + 1) % n;
+    const dx = path[2 * j] - path[2 * i];
+    const dy = path[2 * j + 1] - path[2 * i + 1];
+    length += Math.sqrt(dx * dx + dy * dy);
+  }
+  return length;
+}
+
+// The group's morphed layer, or null when its closed paths come in different counts and do not
+// pair up closely (see morphUnequalCounts): then its layers cross-fade.
 function morphLayer(keys, group, xy, options) {
   const layerOf = (m) => keys[m.key].layers[m.layer];
   const top = heaviest(group, () => true);
@@ -434,15 +618,74 @@ function morphLayer(keys, group, xy, options) {
   out.fill = morphFill(group, layerOf);
   out.stroke = morphStroke(group, layerOf);
   const weights = group.map((m) => m.weight);
+  // The first member with the most paths (std::max_element).
+  let most = 0;
+  for (let m = 1; m < group.length; m++) {
+    if (layerOf(group[most]).paths.length < layerOf(group[m]).paths.length) most = m;
+  }
+  if (group.some((m) => layerOf(m).paths.length !== layerOf(group[most]).paths.length)) {
+    const paths = morphUnequalCounts(group, layerOf, xy, weights, most, options);
+    if (paths === null) return null;
+    out.paths = paths;
+    return out;
+  }
   out.paths = layerOf(top).paths.map((path, j) => {
     const placed = group.map((m) => placePath(layerOf(m).paths[j], xy));
     const closed = path.closed;
+    // Closed paths drawn from other points or in the other direction in different keys: each
+    // runs from the point nearest the first member's start, in its direction, in this frame.
+    if (closed && placed[0].length > 0) {
+      for (let m = 1; m < placed.length; m++) placed[m] = alignClosedPath(placed[0], placed[m]);
+    }
     return {
       points: placed[0].length === 0 ? new Float64Array(0) : blendPaths(placed, closed, weights, options.mergeFraction),
       closed,
     };
   });
   return out;
+}
+
+// Closed paths in different counts (a face that gains a mouth hole, one cell that becomes two):
+// each path of the member with the most (group[most]) morphs with the path of every other member
+// that pairs with it, nearest first (mean squared distance of their aligned placements in this
+// frame), and a member without a partner for it lends that path's own placement (the mesh
+// carries it). Pairs must lie close (root mean squared distance under PAIR_DISTANCE of the
+// path's length), else null: the layers cross-fade (frame_art.cpp's MorphUnequalCounts).
+function morphUnequalCounts(group, layerOf, xy, weights, most, options) {
+  const PAIR_DISTANCE = 0.02;
+  const place = (m) => layerOf(m).paths.map((path) => placePath(path, xy));
+  const full = place(group[most]);
+  // partner[m][j]: member m's path (aligned) that morphs with full[j], or null.
+  const partner = [];
+  for (let m = 0; m < group.length; m++) {
+    partner.push(new Array(full.length).fill(null));
+    if (m === most) {
+      for (let j = 0; j < full.length; j++) partner[m][j] = full[j];
+      continue;
+    }
+    const own = place(group[m]);
+    const pairs = [];
+    for (let i = 0; i < own.length; i++) {
+      for (let j = 0; j < full.length; j++) {
+        const aligned = alignClosedPath(full[j], own[i]);
+        pairs.push({ cost: meanSquaredDistance(full[j], aligned), i, j, aligned });
+      }
+    }
+    // Stable (as std::stable_sort with a.cost < b.cost).
+    pairs.sort((a, b) => (a.cost < b.cost ? -1 : b.cost < a.cost ? 1 : 0));
+    const used = new Array(own.length).fill(false);
+    for (const pair of pairs) {
+      if (used[pair.i] || partner[m][pair.j] !== null) continue;
+      const length = pathLength(full[pair.j]);
+      if (!(pair.cost <= PAIR_DISTANCE * PAIR_DISTANCE * length * length)) return null;
+      used[pair.i] = true;
+      partner[m][pair.j] = pair.aligned;
+    }
+  }
+  return full.map((path, j) => ({
+    points: blendPaths(group.map((_, m) => partner[m][j] ?? path), true, weights, options.mergeFraction),
+    closed: true,
+  }));
 }
 
 // Present in some member: colour blended among those that have it, opacity among all (a member
@@ -539,15 +782,18 @@ export function artForFrame(keys, xy, weights, options = {}) {
         last = groupOf[a.key][l];
         return;
       }
-      const faded = copyPaint(layer.paint);
-      faded.opacity *= a.weight;
-      faded.paths = layer.paths.map((path) => ({ points: placePath(path, xy), closed: path.closed }));
-      slots[last + 1].push(faded);
+      slots[last + 1].push(fadedLayer(layer, a.weight, xy));
     });
   }
   const out = slots[0];
   groups.forEach((group, g) => {
-    out.push(morphLayer(keys, group, xy, opts));
+    const morphed = morphLayer(keys, group, xy, opts);
+    if (morphed !== null) {
+      out.push(morphed);
+    } else {
+      // Not morphable in this frame: its members cross-fade where the group stands.
+      for (const m of group) out.push(fadedLayer(keys[m.key].layers[m.layer], m.weight, xy));
+    }
     out.push(...slots[g + 1]);
   });
   return out;
