@@ -13,6 +13,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
 #include "solver/art/blend_paths.h"
+#include "solver/geometry/polygon.h"
 
 namespace inbetween::solver {
 namespace {
@@ -289,7 +290,8 @@ class Morph {
   // Pairs must lie close in the frame (root mean squared distance under kPairDistance of the
   // path's length): a hole that opens pairs its face's outline with the face's outline, but one
   // cell that becomes two would pair its outline with one of the cells, which then drags the
-  // other's half along; nullopt then (the layers cross-fade).
+  // other's half along; nullopt then (the layers cross-fade), as when a path some member lacks
+  // is not a hole in one it has.
   std::optional<std::vector<ArtPath>> MorphUnequalCounts(const Group& group,
                                                          const std::vector<double>& weights,
                                                          size_t most) const {
@@ -330,6 +332,17 @@ class Morph {
         if (!(pair.cost <= kPairDistance * kPairDistance * length * length)) return std::nullopt;
         used[pair.i] = true;
         partner[m][pair.j] = std::move(pair.aligned);
+      }
+      // A path this member lacks is carried only if it lies inside one it has (a hole, which
+      // the mesh keeps shut where this member's drawing is closed); a separate region it lacks
+      // (a second eye) would appear at once, so the layers cross-fade instead.
+      for (size_t j = 0; j < full.size(); ++j) {
+        if (partner[m][j]) continue;
+        bool inside = false;
+        for (size_t k = 0; k < full.size() && !inside; ++k) {
+          inside = k != j && partner[m][k] && PolygonContains(full[k], full[j][0]);
+        }
+        if (!inside) return std::nullopt;
       }
     }
     std::vector<ArtPath> paths;

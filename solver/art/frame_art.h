@@ -37,7 +37,8 @@
 // placements under 2% of the path's length, nearest pairs first); a member without a partner
 // for it lends that path's own placement, so a hole one key lacks is carried by the mesh (it
 // opens as the mesh's opening does). When some path finds no partner that close (one cell that
-// becomes two), the group's layers cross-fade.
+// becomes two), or a path a member lacks is not inside one of its paired paths (a second eye,
+// which would appear at once), the group's layers cross-fade.
 //
 // Cross-fade: a layer without a morphing group is drawn with its opacity times its key's weight.
 //

@@ -526,6 +526,21 @@ def _heaviest(group: List[Member], has: Callable[[Member], bool]) -> Optional[Me
     return best
 
 
+def _polygon_contains(polygon: List[XY], q: XY) -> bool:
+    """polygon.h PolygonContains: even-odd crossing test."""
+    inside = False
+    n = len(polygon)
+    j = n - 1
+    for i in range(n):
+        (ax, ay), (bx, by) = polygon[i], polygon[j]
+        if (ay > q[1]) != (by > q[1]):
+            x = ax + (q[1] - ay) * (bx - ax) / (by - ay)
+            if q[0] < x:
+                inside = not inside
+        j = i
+    return inside
+
+
 _PAIR_DISTANCE = 0.02
 
 
@@ -559,6 +574,12 @@ def _morph_unequal_counts(paths_of: List[List[Tuple[bool, List[Corner]]]], xy: S
                 return None
             used[i] = True
             row[j] = aligned
+        # A path this member lacks is carried only if it lies inside one it has (a hole).
+        for j in range(len(full)):
+            if row[j] is None and not any(
+                    k != j and row[k] is not None and _polygon_contains(full[k], full[j][0])
+                    for k in range(len(full))):
+                return None
     out = []
     for j in range(len(full)):
         placed = [row[j] if row[j] is not None else full[j] for row in partner]

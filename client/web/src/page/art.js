@@ -645,6 +645,21 @@ function morphLayer(keys, group, xy, options) {
   return out;
 }
 
+// polygon.h PolygonContains: even-odd crossing test of (qx, qy) against a flat polygon.
+function polygonContains(polygon, qx, qy) {
+  let inside = false;
+  const n = polygon.length / 2;
+  for (let i = 0, j = n - 1; i < n; j = i++) {
+    const ax = polygon[2 * i], ay = polygon[2 * i + 1];
+    const bx = polygon[2 * j], by = polygon[2 * j + 1];
+    if ((ay > qy) !== (by > qy)) {
+      const x = ax + ((qy - ay) * (bx - ax)) / (by - ay);
+      if (qx < x) inside = !inside;
+    }
+  }
+  return inside;
+}
+
 // Closed paths in different counts (a face that gains a mouth hole, one cell that becomes two):
 // each path of the member with the most (group[most]) morphs with the path of every other member
 // that pairs with it, nearest first (mean squared distance of their aligned placements in this
@@ -680,6 +695,16 @@ function morphUnequalCounts(group, layerOf, xy, weights, most, options) {
       if (!(pair.cost <= PAIR_DISTANCE * PAIR_DISTANCE * length * length)) return null;
       used[pair.i] = true;
       partner[m][pair.j] = pair.aligned;
+    }
+    // A path this member lacks is carried only if it lies inside one it has (a hole); a separate
+    // region it lacks (a second eye) would appear at once, so the layers cross-fade instead.
+    for (let j = 0; j < full.length; j++) {
+      if (partner[m][j] !== null) continue;
+      let inside = false;
+      for (let k = 0; k < full.length && !inside; k++) {
+        inside = k !== j && partner[m][k] !== null && polygonContains(full[k], full[j][0], full[j][1]);
+      }
+      if (!inside) return null;
     }
   }
   return full.map((path, j) => ({
