@@ -364,19 +364,13 @@ absl::string_view KindName(v1::ElementKind kind) {
   }
 }
 
-// Applies one TopologyEdit to `state` (elements, solver drawing, multimesh dropped) and returns
-// the reply without its version. A bad edit is INVALID_ARGUMENT naming the edit, the drawing and
+// Applies the add, move or delete of `edit` (number n of the stream) to the elements of
+// `drawing` (number index + 1 of the session) and returns what was done, for messages ("edit 0
+// (move cut 3) in drawing 2 'mouth.svg'"); a bad edit is INVALID_ARGUMENT naming the edit and
 // the element.
-absl::StatusOr<v1::TopologyState> ApplyTopologyEdit(const v1::TopologyEdit& edit, int n,
-                                                    int max_points, SessionState& state) {
-  v1::Session& session = state.session;
-  const int index = edit.drawing_id() == 0 ? -1 : FindDrawing(session, edit.drawing_id());
-  if (index < 0) {
-    return absl::NotFoundError(absl::StrCat("edit ", n, ": drawing ", edit.drawing_id(),
-                                            " not found in session ", session.id()));
-  }
-  v1::Drawing& drawing = *session.mutable_drawings(index);
-  std::string what;  // "edit 0 (move cut 3) in drawing 2 'mouth.svg'"
+absl::StatusOr<std::string> EditElements(const v1::TopologyEdit& edit, int n, int index,
+                                         v1::Drawing& drawing) {
+  std::string what;
   auto named = [&](absl::string_view verb, v1::ElementKind kind, uint32_t id) {
     return absl::StrCat("edit ", n, " (", verb, " ", KindName(kind), " ", id, ") in drawing ",
                         index + 1, drawing.name().empty() ? "" : " '", drawing.name(),
@@ -431,19 +425,20 @@ absl::StatusOr<v1::TopologyState> ApplyTopologyEdit(const v1::TopologyEdit& edit
       return absl::InvalidArgumentError(
           absl::StrCat("edit ", n, ": set one of add, move or delete_element"));
   }
-  absl::StatusOr<ImportedDrawing> imported =
-      ImportDrawingElements(drawing, absl::StrCat("drawing ", index + 1), index + 1, max_points);
-  if (!imported.ok()) {
-    return absl::Status(imported.status().code(),
-                        absl::StrCat(what, ": ", imported.status().message()));
-  }
-  state.parsed[index] = std::move(imported->parsed);
-  InvalidateMultimesh(state);
+  return what;
+}
 
+// The TopologyState reply after an edit of drawing number index + 1, without its version: the
+// drawing's elements, boundaries and cohesive edges, every drawing's class (`imported`'s for the
+// edited one), and a warning for each drawing whose class differs from the edited one's.
+v1::TopologyState TopologyReply(const SessionState& state, int index,
+                                const ImportedDrawing& imported) {
+  const v1::Session& session = state.session;
+  const v1::Drawing& drawing = session.drawings(index);
   v1::TopologyState reply;
   reply.set_drawing_id(drawing.id());
   *reply.mutable_elements() = drawing.elements();
-  const solver::BoundaryGraph& graph = imported->boundaries;
+  const solver::BoundaryGraph& graph = imported.boundaries;
   for (size_t l = 0; l < graph.loops.size(); ++l) {
     const solver::BoundaryLoop& loop = graph.loops[l];
     ToProto(loop.points, reply.add_boundaries()->mutable_points());
@@ -461,7 +456,7 @@ absl::StatusOr<v1::TopologyState> ApplyTopologyEdit(const v1::TopologyEdit& edit
   }
   for (int j = 0; j < session.drawings_size(); ++j) {
     if (j == index) {
-      *reply.add_classes() = imported->equivalence_class;
+      *reply.add_classes() = imported.equivalence_class;
       continue;
     }
     absl::StatusOr<solver::BoundaryGraph> other = solver::BuildBoundaries(state.parsed[j], j + 1);
@@ -483,6 +478,104 @@ absl::StatusOr<v1::TopologyState> ApplyTopologyEdit(const v1::TopologyEdit& edit
     }
   }
   return reply;
+}
+
+// Applies one TopologyEdit to `state` (elements, solver drawing, multimesh dropped) and returns
+// the reply without its version. A bad edit is INVALID_ARGUMENT naming the edit, the drawing and
+// the element.
+absl::StatusOr<v1::TopologyState> ApplyTopologyEdit(const v1::TopologyEdit& edit, int n,
+                                                    int max_points, SessionState& state) {
+  v1::Session& session = state.session;
+  const int index = edit.drawing_id() == 0 ? -1 : FindDrawing(session, edit.drawing_id());
+  if (index < 0) {
+    return absl::NotFoundError(absl::StrCat("edit ", n, ": drawing ", edit.drawing_id(),
+                                            " not found in session ", session.id()));
+  }
+  v1::Drawing& drawing = *session.mutable_drawings(index);
+  absl::StatusOr<std::string> what = EditElements(edit, n, index, drawing);
+  if (!what.ok()) return what.status();
+  absl::StatusOr<ImportedDrawing> imported =
+      ImportDrawingElements(drawing, absl::StrCat("drawing ", index + 1), index + 1, max_points);
+  if (!imported.ok()) {
+    return absl::Status(imported.status().code(),
+                        absl::StrCat(*what, ": ", imported.status().message()));
+  }
+  state.parsed[index] = std::move(imported->parsed);
+  InvalidateMultimesh(state);
+  return TopologyReply(state, index, *imported);
+}
+
+// Comesh options for optimizing `state`'s multimesh with `comesh`. The outline guard holds the
+// keys to the session's outline tolerance, measured against the drawings the multimesh was built
+// from (without them, e.g. a session whose drawings do not match the mesh's shapes, against the
+// mesh's own outline).
+solver::ComeshOptions ComeshOptionsFor(const SessionState& state,
+                                       const v1::ComeshParameters& comesh) {
+  solver::ComeshOptions options = ToComeshOptions(comesh);
+  options.outline_tolerance = ComeshOutlineTolerance(state.session.parameters().meshing());
+  if (static_cast<int>(state.parsed.size()) == state.multimesh->num_shapes()) {
+    for (const solver::Drawing& drawing : state.parsed) {
+      std::vector<solver::Points>& loops = options.outline_reference.emplace_back();
+      for (const solver::Outline& outline : drawing.outlines) loops.push_back(outline.points);
+    }
+  }
+  return options;
+}
+
+// The progress message that opens a resumed optimization.
+v1::OptimizeComeshResponse ResumedNotice(const solver::ComeshCheckpoint& from,
+                                         uint64_t stored_version) {
+  v1::OptimizeComeshResponse message;
+  v1::Progress* p = message.mutable_progress();
+  p->set_stage("comesh");
+  p->set_detail(
+      absl::StrFormat("resumed after outer %d at iteration %d (checkpoint of session version %d)",
+                      from.outer, from.inner, stored_version));
+  return message;
+}
+
+// The optimized mesh has new triangles: the drawings' art is embedded in it again, and the mesh
+// is checked before it is stored (INTERNAL if the optimizer broke its promise).
+absl::Status EmbedArtAndValidate(const std::vector<solver::Drawing>& drawings,
+                                 solver::Multimesh* mesh) {
+  absl::StatusOr<std::vector<solver::EmbeddedArt>> art = solver::EmbedDrawingsArt(*mesh, drawings);
+  if (!art.ok()) return art.status();
+  mesh->art = *std::move(art);
+  if (absl::Status s = solver::ValidateMultimesh(*mesh); !s.ok()) {
+    return absl::InternalError(
+        absl::StrCat("the comesh optimizer returned an invalid mesh: ", s.message()));
+  }
+  return absl::OkStatus();
+}
+
+// The checkpoint a resumed OptimizeComesh continues from, or null to start over. Checkpoints are
+// written without moving the version (docs/api.md "Resuming OptimizeComesh"): one stored at this
+// version is of a run on this multimesh, and it is continued only for the same parameters.
+const solver::ComeshCheckpoint* CheckpointToResume(const v1::OptimizeComeshRequest& request,
+                                                   const SessionState& state,
+                                                   const std::string& parameters_key) {
+  const std::shared_ptr<const StoredComeshCheckpoint>& checkpoint = state.comesh_checkpoint;
+  const bool own_checkpoint = request.resume() && checkpoint &&
+                              checkpoint->input_version == request.expected_version() &&
+                              checkpoint->stored_version == state.session.version();
+  return own_checkpoint && checkpoint->parameters == parameters_key ? &checkpoint->checkpoint
+                                                                    : nullptr;
+}
+
+// The result of an optimization, without the stored session and stats.
+v1::OptimizeComeshResult OptimizeResult(const solver::Multimesh& mesh,
+                                        const solver::ComeshReport& report,
+                                        const solver::ComeshCheckpoint* resumed_from) {
+  v1::OptimizeComeshResult result;
+  *result.mutable_multimesh() = ToProto(mesh);
+  result.set_inner_iterations(report.inner);
+  result.set_outer_iterations(report.outer);
+  result.set_seconds(report.seconds);
+  if (resumed_from != nullptr) {
+    result.set_resumed_outer(resumed_from->outer);
+    result.set_resumed_inner(resumed_from->inner);
+  }
+  return result;
 }
 
 int MaxDrawings(const ServiceOptions& options) {
@@ -992,12 +1085,7 @@ grpc::Status InbetweenService::OptimizeComesh(
             LoadForUpdate(*store_, request->session_id(), request->expected_version(), caller,
                           /*latest=*/request->resume());
         if (!state.ok()) return state.status();
-        // Checkpoints are written without moving the version (docs/api.md "Resuming
-        // OptimizeComesh"): one stored at this version is of a run on this multimesh.
         const std::shared_ptr<const StoredComeshCheckpoint> checkpoint = state->comesh_checkpoint;
-        const bool own_checkpoint = request->resume() && checkpoint &&
-                                    checkpoint->input_version == request->expected_version() &&
-                                    checkpoint->stored_version == state->session.version();
         if (state->session.stage() < v1::STAGE_MULTIMESH || !state->multimesh) {
           return absl::FailedPreconditionError(
               absl::StrCat("session ", request->session_id(),
@@ -1011,22 +1099,10 @@ grpc::Status InbetweenService::OptimizeComesh(
           return s;
         }
         const std::string parameters_key = comesh.SerializeAsString();
-        // Continue from the checkpoint only for the same parameters; else start over.
         const solver::ComeshCheckpoint* resume_from =
-            own_checkpoint && checkpoint->parameters == parameters_key ? &checkpoint->checkpoint
-                                                                       : nullptr;
-        solver::ComeshOptions options = ToComeshOptions(comesh);
+            CheckpointToResume(*request, *state, parameters_key);
+        solver::ComeshOptions options = ComeshOptionsFor(*state, comesh);
         options.threads = options_.solver_threads;
-        // The outline guard holds the keys to the session's outline tolerance, measured against
-        // the drawings the multimesh was built from (without them, e.g. a session whose drawings
-        // do not match the mesh's shapes, against the mesh's own outline).
-        options.outline_tolerance = ComeshOutlineTolerance(state->session.parameters().meshing());
-        if (static_cast<int>(state->parsed.size()) == state->multimesh->num_shapes()) {
-          for (const solver::Drawing& drawing : state->parsed) {
-            std::vector<solver::Points>& loops = options.outline_reference.emplace_back();
-            for (const solver::Outline& outline : drawing.outlines) loops.push_back(outline.points);
-          }
-        }
         absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
         if (!slot.ok()) return slot.status();
 
@@ -1037,15 +1113,7 @@ grpc::Status InbetweenService::OptimizeComesh(
           std::lock_guard lock(write_mutex);
           if (!writer->Write(message)) token.Cancel();
         };
-        if (resume_from != nullptr) {
-          v1::OptimizeComeshResponse message;
-          v1::Progress* p = message.mutable_progress();
-          p->set_stage("comesh");
-          p->set_detail(absl::StrFormat(
-              "resumed after outer %d at iteration %d (checkpoint of session version %d)",
-              resume_from->outer, resume_from->inner, checkpoint->stored_version));
-          write(message);
-        }
+        if (resume_from != nullptr) write(ResumedNotice(*resume_from, checkpoint->stored_version));
         // One ComeshIteration per accepted iterate: on_iterate opens it (iteration number, vertex
         // count), the progress call that follows in the same iteration adds the energies.
         ComeshIterationStream iterations(
@@ -1094,15 +1162,7 @@ grpc::Status InbetweenService::OptimizeComesh(
           return StoppedStatus(*context, "OptimizeComesh");
         }
         if (!mesh.ok()) return mesh.status();
-        // The optimized mesh has new triangles: the drawings' art is embedded in it again.
-        absl::StatusOr<std::vector<solver::EmbeddedArt>> art =
-            solver::EmbedDrawingsArt(*mesh, state->parsed);
-        if (!art.ok()) return art.status();
-        mesh->art = *std::move(art);
-        if (absl::Status s = solver::ValidateMultimesh(*mesh); !s.ok()) {
-          return absl::InternalError(
-              absl::StrCat("the comesh optimizer returned an invalid mesh: ", s.message()));
-        }
+        if (absl::Status s = EmbedArtAndValidate(state->parsed, &*mesh); !s.ok()) return s;
         v1::MultimeshStats stats = StatsOf(*mesh);
         stats.set_map_energy(report.map_energy);
         stats.set_mesh_energy(report.mesh_energy);
@@ -1110,14 +1170,7 @@ grpc::Status InbetweenService::OptimizeComesh(
 
         v1::OptimizeComeshResponse message;
         v1::OptimizeComeshResult* result = message.mutable_result();
-        *result->mutable_multimesh() = ToProto(*mesh);
-        result->set_inner_iterations(report.inner);
-        result->set_outer_iterations(report.outer);
-        result->set_seconds(report.seconds);
-        if (resume_from != nullptr) {
-          result->set_resumed_outer(resume_from->outer);
-          result->set_resumed_inner(resume_from->inner);
-        }
+        *result = OptimizeResult(*mesh, report, resume_from);
         state->multimesh = std::make_shared<const solver::Multimesh>(*std::move(mesh));
         state->comesh_checkpoint.reset();  // done: nothing to resume
         state->session.set_stage(v1::STAGE_OPTIMIZED);
