@@ -385,8 +385,7 @@ absl::StatusOr<Points> OverlayComponent(Component* c, int root, int ref, int d,
                                                : absl::StatusOr<Points>(over->shapes.back()));
 }
 
-// Drawings whose mesh BuildMultimesh tries to map into the others (see `references` in
-// BuildOnce).
+// Drawings whose mesh BuildMultimesh tries to map into the others (see ReferenceOrder).
 constexpr int kMaxReferences = 3;
 
 // The component maps one attempt made, (drawing, component) -> MapComponent's answer. The
@@ -401,20 +400,32 @@ struct MapMemo {
   std::map<std::pair<int, int>, Entry> entries;
 };
 
-// One attempt of BuildMultimesh, corners matched or not, meshing the drawing of the given rank
-// in the order of `references` below (0: the preferred one; *meshed: which drawing that is).
-// Returns ABORTED (not an answer: the caller keeps its first error) with require_match when no
-// loop's corners matched, and when there is no drawing of that rank, before any meshing. With
-// `memo`, an attempt without overlay records its maps there, one with overlay replays them.
-absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
-                                    const MultimeshOptions& options, bool match_corners,
-                                    bool require_match, int rank, bool overlay, MapMemo* memo,
-                                    const CancelToken* cancel, const ProgressFn& progress,
-                                    MultimeshReport* report, int* meshed) {
-  const auto start = std::chrono::steady_clock::now();
-  auto notify = [&](const std::string& stage, double fraction, const std::string& detail) {
-    if (progress) progress(stage, fraction, detail);
-  };
+// How one attempt of BuildMultimesh differs from the others.
+struct AttemptMode {
+  bool match_corners = false;  // the correspondence matches corners to corners
+  bool require_match = false;  // ABORTED (no answer) unless some loop's corners matched
+  bool overlay = false;        // overlay the mesh where a component cannot be mapped
+};
+
+// One attempt's parameters besides the drawings and the caller's options.
+struct AttemptOptions {
+  AttemptMode mode;
+  // Which drawing is meshed, in ReferenceOrder (0: the preferred one).
+  int rank = 0;
+  // Without overlay the attempt records its component maps here, with overlay it replays them.
+  MapMemo* memo = nullptr;
+  const CancelToken* cancel = nullptr;
+  ProgressFn progress = nullptr;
+};
+
+// Progress for the caller, when it asked for it.
+void Notify(const ProgressFn& progress, const std::string& stage, double fraction,
+            const std::string& detail) {
+  if (progress) progress(stage, fraction, detail);
+}
+
+// At least two drawings, every outline point finite: what the stages below assume.
+absl::Status CheckDrawings(const std::vector<Drawing>& drawings) {
   const int num_shapes = static_cast<int>(drawings.size());
   if (num_shapes < 2) {
     return absl::InvalidArgumentError(
@@ -431,18 +442,27 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
       }
     }
   }
+  return absl::OkStatus();
+}
 
-  if (Cancelled(cancel)) return absl::CancelledError("BuildMultimesh cancelled");
-  notify("boundaries", 0.0, absl::StrCat(num_shapes, " drawings"));
+// S-Alg.1 boundaries of every drawing, which must all be of one equivalence class.
+absl::StatusOr<std::vector<BoundaryGraph>> DrawingBoundaries(const std::vector<Drawing>& drawings) {
   std::vector<BoundaryGraph> graphs;
-  for (int d = 0; d < num_shapes; ++d) {
+  for (int d = 0; d < static_cast<int>(drawings.size()); ++d) {
     absl::StatusOr<BoundaryGraph> g = BuildBoundaries(drawings[d], d + 1);
     if (!g.ok()) return g.status();
     graphs.push_back(*std::move(g));
   }
   if (absl::Status same = CheckSameEquivalence(graphs); !same.ok()) return same;
+  return graphs;
+}
 
-  notify("correspondence", 0.05, absl::StrCat(graphs[0].loops.size(), " boundary loops"));
+// The boundary correspondence the options ask for, with the drawings' own marks when the options
+// give none.
+absl::StatusOr<BoundaryCorrespondence> Correspond(const std::vector<Drawing>& drawings,
+                                                  const std::vector<BoundaryGraph>& graphs,
+                                                  const MultimeshOptions& options,
+                                                  bool match_corners) {
   BoundaryCorrespondenceOptions correspondence_options;
   correspondence_options.vertices = options.boundary_vertices;
   correspondence_options.corner_angle_degrees = options.corner_angle_degrees;
@@ -458,15 +478,15 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
     if (!drawn.ok()) return drawn.status();
     correspondence_options.marks = *std::move(drawn);
   }
-  absl::StatusOr<BoundaryCorrespondence> bc =
-      ComputeBoundaryCorrespondence(graphs, correspondence_options);
-  if (!bc.ok()) return bc.status();
-  if (require_match && bc->corner_matched_loops == 0) {
-    return absl::AbortedError("no loop has corners to match");
-  }
+  return ComputeBoundaryCorrespondence(graphs, correspondence_options);
+}
+
+// Two consecutive boundary vertices at one point would make a zero-length boundary edge in that
+// drawing: refused, naming where, since more boundary vertices separate them.
+absl::Status CheckDistinctSamples(const BoundaryCorrespondence& bc, int num_shapes) {
   for (int d = 0; d < num_shapes; ++d) {
-    for (int g = 0; g < bc->num_loops(); ++g) {
-      const Points& loop = bc->shapes[d][g];
+    for (int g = 0; g < bc.num_loops(); ++g) {
+      const Points& loop = bc.shapes[d][g];
       for (size_t k = 0; k < loop.size(); ++k) {
         if (loop[k] == loop[(k + 1) % loop.size()]) {
           return absl::InvalidArgumentError(
@@ -476,141 +496,202 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
       }
     }
   }
-  const int num_edges = bc->num_vertices();
-  std::vector<int> next_edge_start(num_edges);
-  for (int g = 0; g < bc->num_loops(); ++g) {
-    for (int e = bc->loop_start[g]; e < bc->loop_start[g + 1]; ++e) {
-      next_edge_start[e] = e + 1 < bc->loop_start[g + 1] ? e + 1 : bc->loop_start[g];
+  return absl::OkStatus();
+}
+
+// next[e]: the correspondence edge after e on its loop (the loop closes).
+std::vector<int> NextEdgeStarts(const BoundaryCorrespondence& bc) {
+  std::vector<int> next_edge_start(bc.num_vertices());
+  for (int g = 0; g < bc.num_loops(); ++g) {
+    for (int e = bc.loop_start[g]; e < bc.loop_start[g + 1]; ++e) {
+      next_edge_start[e] = e + 1 < bc.loop_start[g + 1] ? e + 1 : bc.loop_start[g];
     }
   }
-  auto sample = [&](int d, int e) -> const Point& {
-    const int g =
-        static_cast<int>(std::upper_bound(bc->loop_start.begin(), bc->loop_start.end(), e) -
-                         bc->loop_start.begin()) -
-        1;
-    return bc->shapes[d][g][e - bc->loop_start[g]];
-  };
+  return next_edge_start;
+}
 
-  // The drawing meshed first: the one with the most closed cut/opening sides. Opening a slit
-  // (mapping out of the closed drawing) only widens angles, while closing a hole onto a slit
-  // asks the mesh for 2*pi at the slit tips; RefineBoundaryFans covers what remains. The next
-  // ranks (when the first drawing's mesh cannot be mapped into some drawing) follow in that
-  // order, ties in key order, up to kMaxReferences: a mesh of a concave drawing often maps onto
-  // a convex one when the other way round a chord of the convex drawing's mesh has nowhere to go.
+// Correspondence vertex e (the start of edge e) in drawing d.
+const Point& Sample(const BoundaryCorrespondence& bc, int d, int e) {
+  const int g = static_cast<int>(std::upper_bound(bc.loop_start.begin(), bc.loop_start.end(), e) -
+                                 bc.loop_start.begin()) -
+                1;
+  return bc.shapes[d][g][e - bc.loop_start[g]];
+}
+
+// The drawings in the order they are meshed, by rank. First the one with the most closed
+// cut/opening sides: opening a slit (mapping out of the closed drawing) only widens angles, while
+// closing a hole onto a slit asks the mesh for 2*pi at the slit tips; RefineBoundaryFans covers
+// what remains. The next ranks (when the first drawing's mesh cannot be mapped into some drawing)
+// follow in that order, ties in key order, up to kMaxReferences: a mesh of a concave drawing
+// often maps onto a convex one when the other way round a chord of the convex drawing's mesh has
+// nowhere to go.
+std::vector<int> ReferenceOrder(const BoundaryCorrespondence& bc, int num_shapes) {
   std::vector<int> references(num_shapes);
   std::iota(references.begin(), references.end(), 0);
-  {
-    std::vector<int> closed(num_shapes);
-    for (int d = 0; d < num_shapes; ++d) {
-      closed[d] = static_cast<int>(std::count_if(bc->edge_twin[d].begin(), bc->edge_twin[d].end(),
-                                                 [](int f) { return f >= 0; }));
-    }
-    std::stable_sort(references.begin(), references.end(),
-                     [&](int a, int b) { return closed[a] > closed[b]; });
+  std::vector<int> closed(num_shapes);
+  for (int d = 0; d < num_shapes; ++d) {
+    closed[d] = static_cast<int>(std::count_if(bc.edge_twin[d].begin(), bc.edge_twin[d].end(),
+                                               [](int f) { return f >= 0; }));
   }
-  if (rank >= std::min(num_shapes, kMaxReferences)) {
-    return absl::AbortedError("no other drawing to mesh");
-  }
-  const int ref = references[rank];
-  if (meshed != nullptr) *meshed = ref;
+  std::stable_sort(references.begin(), references.end(),
+                   [&](int a, int b) { return closed[a] > closed[b]; });
+  return references;
+}
 
-  if (Cancelled(cancel)) return absl::CancelledError("BuildMultimesh cancelled");
-  notify("triangulate", 0.1,
-         absl::StrCat("drawing ", ref + 1, ", ", num_edges, " boundary vertices"));
-  TriangulateOptions triangulate_options;
-  triangulate_options.shape_bound = options.shape_bound;
-  triangulate_options.max_vertices = options.max_mesh_vertices;
-  {
-    Point lo = bc->shapes[ref][0][0], hi = lo;
+// One attempt's construction once the reference drawing is chosen: its mesh cut open along the
+// seams, boundary vertices made to pair up across every cohesive zone and fans widened, then an
+// injective map of each component into every other drawing (overlaid where the attempt allows
+// it), and the cohesive edges. A class because every phase reads and grows the same mesh; Build
+// runs the phases in order.
+class AttemptBuilder {
+ public:
+  AttemptBuilder(const BoundaryCorrespondence& bc, int ref, int num_shapes,
+                 const MultimeshOptions& options, const AttemptOptions& attempt)
+      : bc_(bc),
+        ref_(ref),
+        num_shapes_(num_shapes),
+        num_edges_(bc.num_vertices()),
+        options_(options),
+        attempt_(attempt),
+        next_edge_start_(NextEdgeStarts(bc)) {}
+
+  absl::StatusOr<Multimesh> Build() {
+    if (Cancelled(attempt_.cancel)) return absl::CancelledError("BuildMultimesh cancelled");
+    Notify(attempt_.progress, "triangulate", 0.1,
+           absl::StrCat("drawing ", ref_ + 1, ", ", num_edges_, " boundary vertices"));
+    if (absl::Status s = MeshReference(); !s.ok()) return s;
+    MirrorSteinerPoints();
+    CollectBoundaryLoops();
+    SplitBoundaryChords(&cut_.vertices, &cut_.triangles, &is_boundary_);
+    WidenFans();
+    mesh_.triangles = cut_.triangles;
+    num_vertices_ = static_cast<int>(cut_.vertices.size());
+    FindComponents();
+    mesh_.shapes.assign(num_shapes_, {});
+    mesh_.shapes[ref_] = TargetsOf(ref_);
+    int done = 0;
+    for (const int d : MapOrder()) {
+      if (absl::Status s = MapDrawing(d, done++); !s.ok()) return s;
+    }
+    if (absl::Status s = PairCohesiveEdges(); !s.ok()) return s;
+    for (int e : bc_.mark_vertices) mesh_.pinned.push_back(cut_.entries[e][0].vertex);
+    return std::move(mesh_);
+  }
+
+  // Components reached by the overlay (MultimeshReport::overlays).
+  int overlays() const { return overlays_; }
+
+ private:
+  // Mesh size for the reference drawing: max_edge from the options' relative length, else about
+  // the even sampling's spacing (the refinement to the outline tolerance adds vertices at tips
+  // only).
+  TriangulateOptions ReferenceMeshOptions() const {
+    TriangulateOptions triangulate_options;
+    triangulate_options.shape_bound = options_.shape_bound;
+    triangulate_options.max_vertices = options_.max_mesh_vertices;
+    Point lo = bc_.shapes[ref_][0][0], hi = lo;
     double perimeter = 0.0;
-    for (const Points& loop : bc->shapes[ref]) {
+    for (const Points& loop : bc_.shapes[ref_]) {
       for (size_t i = 0; i < loop.size(); ++i) {
         lo = lo.cwiseMin(loop[i]), hi = hi.cwiseMax(loop[i]);
         perimeter += (loop[(i + 1) % loop.size()] - loop[i]).norm();
       }
     }
     triangulate_options.max_edge =
-        options.max_edge_relative > 0
-            ? options.max_edge_relative * (hi - lo).norm()
-            // about the even sampling's spacing (the refinement
-            // to the outline tolerance adds vertices at tips only)
-            : 1.5 * perimeter / std::max(1, bc->base_vertices > 0 ? bc->base_vertices : num_edges);
+        options_.max_edge_relative > 0
+            ? options_.max_edge_relative * (hi - lo).norm()
+            : 1.5 * perimeter / std::max(1, bc_.base_vertices > 0 ? bc_.base_vertices : num_edges_);
+    return triangulate_options;
   }
-  absl::StatusOr<DomainTriangulation> triangulation =
-      CgalTriangulateDomain(bc->shapes[ref], triangulate_options);
-  if (!triangulation.ok()) {
-    return absl::Status(triangulation.status().code(),
-                        absl::StrCat("drawing ", ref + 1, ": ", triangulation.status().message()));
-  }
-  absl::StatusOr<CutMesh> cut_or = CutAlongSeams(*triangulation, *bc);
-  if (!cut_or.ok()) {
-    return absl::Status(cut_or.status().code(),
-                        absl::StrCat("drawing ", ref + 1, ": ", cut_or.status().message()));
-  }
-  CutMesh cut = *std::move(cut_or);
 
-  // Mirror boundary Steiner points across every pair of twin edges of every drawing.
-  for (int round = 0; round < 8; ++round) {
-    bool split = false;
-    for (int d = 0; d < num_shapes; ++d) {
-      for (int e = 0; e < num_edges; ++e) {
-        const int f = bc->edge_twin[d][e];
-        if (f < 0) continue;
-        for (const BoundaryEntry& entry : std::vector<BoundaryEntry>(cut.entries[e])) {
-          if (entry.t == 0.0) continue;
-          const double want = 1.0 - entry.t;
-          bool present = false;
-          for (const BoundaryEntry& other : cut.entries[f])
-            present |= std::abs(other.t - want) < 1e-9;
-          if (!present) SplitBoundaryEdge(&cut, next_edge_start, f, want), split = true;
+  // The reference drawing's CGAL mesh, cut open along its seams (CutAlongSeams); errors name
+  // the drawing.
+  absl::Status MeshReference() {
+    absl::StatusOr<DomainTriangulation> triangulation =
+        CgalTriangulateDomain(bc_.shapes[ref_], ReferenceMeshOptions());
+    if (!triangulation.ok()) {
+      return absl::Status(
+          triangulation.status().code(),
+          absl::StrCat("drawing ", ref_ + 1, ": ", triangulation.status().message()));
+    }
+    absl::StatusOr<CutMesh> cut = CutAlongSeams(*triangulation, bc_);
+    if (!cut.ok()) {
+      return absl::Status(cut.status().code(),
+                          absl::StrCat("drawing ", ref_ + 1, ": ", cut.status().message()));
+    }
+    cut_ = *std::move(cut);
+    return absl::OkStatus();
+  }
+
+  // Mirror boundary Steiner points across every pair of twin edges of every drawing, so that
+  // every cohesive edge pairs up in every drawing; a split can call for another on a third
+  // edge, hence rounds (at most 8).
+  void MirrorSteinerPoints() {
+    for (int round = 0; round < 8; ++round) {
+      bool split = false;
+      for (int d = 0; d < num_shapes_; ++d) {
+        for (int e = 0; e < num_edges_; ++e) {
+          const int f = bc_.edge_twin[d][e];
+          if (f < 0) continue;
+          for (const BoundaryEntry& entry : std::vector<BoundaryEntry>(cut_.entries[e])) {
+            if (entry.t == 0.0) continue;
+            const double want = 1.0 - entry.t;
+            bool present = false;
+            for (const BoundaryEntry& other : cut_.entries[f])
+              present |= std::abs(other.t - want) < 1e-9;
+            if (!present) SplitBoundaryEdge(&cut_, next_edge_start_, f, want), split = true;
+          }
         }
       }
+      if (!split) break;
     }
-    if (!split) break;
   }
 
-  Multimesh mesh;
-  std::vector<bool> is_boundary(cut.vertices.size(), false);
-  for (int g = 0; g < bc->num_loops(); ++g) {
-    std::vector<int> loop;
-    for (int e = bc->loop_start[g]; e < bc->loop_start[g + 1]; ++e) {
-      for (const BoundaryEntry& entry : cut.entries[e]) loop.push_back(entry.vertex);
+  // The mesh's boundary loops, edge by edge in correspondence order, and which vertices are on
+  // the boundary.
+  void CollectBoundaryLoops() {
+    is_boundary_.assign(cut_.vertices.size(), false);
+    for (int g = 0; g < bc_.num_loops(); ++g) {
+      std::vector<int> loop;
+      for (int e = bc_.loop_start[g]; e < bc_.loop_start[g + 1]; ++e) {
+        for (const BoundaryEntry& entry : cut_.entries[e]) loop.push_back(entry.vertex);
+      }
+      for (int v : loop) is_boundary_[v] = true;
+      mesh_.boundary.insert(mesh_.boundary.end(), loop.begin(), loop.end());
+      mesh_.boundary_loops.push_back(std::move(loop));
     }
-    for (int v : loop) is_boundary[v] = true;
-    mesh.boundary.insert(mesh.boundary.end(), loop.begin(), loop.end());
-    mesh.boundary_loops.push_back(std::move(loop));
   }
-  SplitBoundaryChords(&cut.vertices, &cut.triangles, &is_boundary);
 
-  // Targets per drawing: boundary vertices at their edge parameter, twins made exactly equal.
-  auto targets_of = [&](int d) {
-    Points target = cut.vertices;
-    for (int e = 0; e < num_edges; ++e) {
-      const Point& a = sample(d, e);
-      const Point& b = sample(d, next_edge_start[e]);
-      for (const BoundaryEntry& entry : cut.entries[e]) {
+  // Targets in drawing d: boundary vertices at their edge parameter, twins made exactly equal;
+  // other vertices at their current place in the reference drawing.
+  Points TargetsOf(int d) const {
+    Points target = cut_.vertices;
+    for (int e = 0; e < num_edges_; ++e) {
+      const Point& a = Sample(bc_, d, e);
+      const Point& b = Sample(bc_, d, next_edge_start_[e]);
+      for (const BoundaryEntry& entry : cut_.entries[e]) {
         target[entry.vertex] = entry.t == 0.0 ? a : Point((1 - entry.t) * a + entry.t * b);
       }
     }
-    for (int e = 0; e < num_edges; ++e) {
-      const int f = bc->edge_twin[d][e];
+    for (int e = 0; e < num_edges_; ++e) {
+      const int f = bc_.edge_twin[d][e];
       if (f < 0 || f < e) continue;
-      const auto& le = cut.entries[e];
-      const auto& lf = cut.entries[f];
+      const auto& le = cut_.entries[e];
+      const auto& lf = cut_.entries[f];
       for (size_t j = 1; j < le.size() && j < lf.size(); ++j) {
         target[lf[lf.size() - j].vertex] = target[le[j].vertex];
       }
     }
     return target;
-  };
+  }
 
-  // Widest interior angle each boundary vertex must take in any drawing; fans too small for it
-  // get more triangles.
-  {
-    std::vector<double> demand(cut.vertices.size(), 0.0);
-    for (int d = 0; d < num_shapes; ++d) {
-      const Points target = targets_of(d);
-      for (const std::vector<int>& loop : mesh.boundary_loops) {
+  // The widest interior angle each boundary vertex must take in any drawing; fans too small for
+  // it get more triangles (refine_boundary_fans.h).
+  void WidenFans() {
+    std::vector<double> demand(cut_.vertices.size(), 0.0);
+    for (int d = 0; d < num_shapes_; ++d) {
+      const Points target = TargetsOf(d);
+      for (const std::vector<int>& loop : mesh_.boundary_loops) {
         for (size_t k = 0; k < loop.size(); ++k) {
           const int prev = loop[(k + loop.size() - 1) % loop.size()];
           const int next = loop[(k + 1) % loop.size()];
@@ -619,150 +700,242 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
         }
       }
     }
-    RefineBoundaryFans(demand, &cut.vertices, &cut.triangles, &is_boundary);
+    RefineBoundaryFans(demand, &cut_.vertices, &cut_.triangles, &is_boundary_);
   }
-  mesh.triangles = cut.triangles;
-  int num_vertices = static_cast<int>(cut.vertices.size());
 
-  // Connected components, each mapped on its own.
-  std::vector<int> component_of(num_vertices);
-  {
-    UnionFind components(num_vertices);
-    for (const Triangle& t : mesh.triangles)
+  // Connected components, each mapped on its own, and the boundary loops of each.
+  void FindComponents() {
+    component_of_.resize(num_vertices_);
+    UnionFind components(num_vertices_);
+    for (const Triangle& t : mesh_.triangles)
       components.Unite(t[0], t[1]), components.Unite(t[0], t[2]);
-    for (int v = 0; v < num_vertices; ++v) component_of[v] = components.Find(v);
-  }
-  std::map<int, std::vector<int>> loops_of_component;
-  for (int g = 0; g < bc->num_loops(); ++g) {
-    loops_of_component[component_of[mesh.boundary_loops[g][0]]].push_back(g);
-  }
-  int overlays = 0;
-  mesh.shapes.assign(num_shapes, {});
-  mesh.shapes[ref] = targets_of(ref);
-  // Drawings are mapped outward from the reference in key order (ref - 1, ref + 1, ref - 2, ...),
-  // so that a pose the reference's mesh cannot reach directly finds a mapped neighbour to start
-  // from (below).
-  std::vector<int> order;
-  for (int d = 0; d < num_shapes; ++d) {
-    if (d != ref) order.push_back(d);
-  }
-  std::stable_sort(order.begin(), order.end(),
-                   [ref](int a, int b) { return std::abs(a - ref) < std::abs(b - ref); });
-  int done = 0;
-  for (const int d : order) {
-    if (Cancelled(cancel)) return absl::CancelledError("BuildMultimesh cancelled");
-    notify("map", 0.2 + 0.75 * done++ / (num_shapes - 1), absl::StrCat("drawing ", d + 1));
-    Points shape = targets_of(d);
-    const Points target = shape;
-    for (const auto& [root, loops] : loops_of_component) {
-      Component c = ExtractComponent(mesh, component_of, root, loops, target);
-      std::optional<Points> flat_map;
-      absl::StatusOr<Points> mapped = absl::UnknownError("not mapped");
-      const std::pair<int, int> key(d, root);
-      const MapMemo::Entry* replay = nullptr;
-      if (memo != nullptr && overlay && overlays == 0) {
-        if (auto it = memo->entries.find(key); it != memo->entries.end()) replay = &it->second;
-      }
-      if (replay != nullptr) {
-        mapped = replay->mapped;
-        flat_map = replay->flat_map;
-      } else {
-        mapped = MapComponent(c, mesh, ref, d, options, cancel, &flat_map);
-        if (memo != nullptr && !overlay && !absl::IsCancelled(mapped.status())) {
-          memo->entries[key] = {mapped, flat_map};
-        }
-      }
-      if (!mapped.ok() && overlay && absl::IsFailedPrecondition(mapped.status())) {
-        notify("map", 0.2 + 0.75 * (done - 1) / (num_shapes - 1),
-               absl::StrCat("drawing ", d + 1, ": ", mapped.status().message(),
-                            "; overlaying the mesh with a triangulation of drawing ", d + 1));
-        const Growing growing{&mesh, &component_of, &cut.vertices, &num_vertices};
-        mapped = OverlayComponent(&c, root, ref, d, options, growing, cancel);
-        if (absl::IsCancelled(mapped.status())) return mapped.status();
-        if (mapped.ok()) ++overlays;
-        shape.resize(num_vertices);
-      }
-      if (!mapped.ok() && overlay && flat_map.has_value() && !absl::IsCancelled(mapped.status())) {
-        mapped = *std::move(flat_map);  // the overlay did not build: the flat map is all there is
-      }
-      if (!mapped.ok()) {
-        if (absl::IsCancelled(mapped.status())) return mapped.status();
-        if (absl::IsResourceExhausted(mapped.status())) {
-          return absl::ResourceExhaustedError(absl::StrCat("mapping drawing ", ref + 1,
-                                                           "'s mesh into drawing ", d + 1, ": ",
-                                                           mapped.status().message()));
-        }
-        return absl::FailedPreconditionError(absl::StrCat("cannot map drawing ", ref + 1,
-                                                          "'s mesh into drawing ", d + 1, ": ",
-                                                          mapped.status().message()));
-      }
-      for (size_t i = 0; i < c.global.size(); ++i) shape[c.global[i]] = (*mapped)[i];
+    for (int v = 0; v < num_vertices_; ++v) component_of_[v] = components.Find(v);
+    for (int g = 0; g < bc_.num_loops(); ++g) {
+      loops_of_component_[component_of_[mesh_.boundary_loops[g][0]]].push_back(g);
     }
-    mesh.shapes[d] = std::move(shape);
+  }
+
+  // Drawings are mapped outward from the reference in key order (ref - 1, ref + 1, ref - 2,
+  // ...), so that a pose the reference's mesh cannot reach directly finds a mapped neighbour to
+  // start from (MapComponent).
+  std::vector<int> MapOrder() const {
+    std::vector<int> order;
+    for (int d = 0; d < num_shapes_; ++d) {
+      if (d != ref_) order.push_back(d);
+    }
+    const int ref = ref_;
+    std::stable_sort(order.begin(), order.end(),
+                     [ref](int a, int b) { return std::abs(a - ref) < std::abs(b - ref); });
+    return order;
+  }
+
+  // Drawing d's shape, component by component; `k` drawings were mapped before it (progress).
+  absl::Status MapDrawing(int d, int k) {
+    if (Cancelled(attempt_.cancel)) return absl::CancelledError("BuildMultimesh cancelled");
+    const double fraction = 0.2 + 0.75 * k / (num_shapes_ - 1);
+    Notify(attempt_.progress, "map", fraction, absl::StrCat("drawing ", d + 1));
+    Points shape = TargetsOf(d);
+    const Points target = shape;
+    for (const auto& [root, loops] : loops_of_component_) {
+      if (absl::Status s = MapComponentInto(d, root, loops, target, fraction, &shape); !s.ok()) {
+        return s;
+      }
+    }
+    mesh_.shapes[d] = std::move(shape);
+    return absl::OkStatus();
+  }
+
+  // One component's map into drawing d written into *shape: found directly (MapOrReplay), else
+  // with the attempt's overlay (which grows the mesh, and *shape with it), else the nearly flat
+  // map the overlay was to improve on. Errors name both drawings.
+  absl::Status MapComponentInto(int d, int root, const std::vector<int>& loops,
+                                const Points& target, double fraction, Points* shape) {
+    const bool overlay = attempt_.mode.overlay;
+    Component c = ExtractComponent(mesh_, component_of_, root, loops, target);
+    std::optional<Points> flat_map;
+    absl::StatusOr<Points> mapped = MapOrReplay(c, d, root, &flat_map);
+    if (!mapped.ok() && overlay && absl::IsFailedPrecondition(mapped.status())) {
+      Notify(attempt_.progress, "map", fraction,
+             absl::StrCat("drawing ", d + 1, ": ", mapped.status().message(),
+                          "; overlaying the mesh with a triangulation of drawing ", d + 1));
+      const Growing growing{&mesh_, &component_of_, &cut_.vertices, &num_vertices_};
+      mapped = OverlayComponent(&c, root, ref_, d, options_, growing, attempt_.cancel);
+      if (absl::IsCancelled(mapped.status())) return mapped.status();
+      if (mapped.ok()) ++overlays_;
+      shape->resize(num_vertices_);
+    }
+    if (!mapped.ok() && overlay && flat_map.has_value() && !absl::IsCancelled(mapped.status())) {
+      mapped = *std::move(flat_map);  // the overlay did not build: the flat map is all there is
+    }
+    if (!mapped.ok()) return MapError(mapped.status(), d);
+    for (size_t i = 0; i < c.global.size(); ++i) (*shape)[c.global[i]] = (*mapped)[i];
+    return absl::OkStatus();
+  }
+
+  // MapComponent's answer for component `root` in drawing d. With the memo, an attempt without
+  // overlay records it; one with overlay replays it until its first overlay, since up to there
+  // it asks for exactly the maps the first attempt made (the construction is deterministic).
+  absl::StatusOr<Points> MapOrReplay(const Component& c, int d, int root,
+                                     std::optional<Points>* flat_map) {
+    MapMemo* memo = attempt_.memo;
+    const bool overlay = attempt_.mode.overlay;
+    const std::pair<int, int> key(d, root);
+    if (memo != nullptr && overlay && overlays_ == 0) {
+      if (auto it = memo->entries.find(key); it != memo->entries.end()) {
+        *flat_map = it->second.flat_map;
+        return it->second.mapped;
+      }
+    }
+    absl::StatusOr<Points> mapped =
+        MapComponent(c, mesh_, ref_, d, options_, attempt_.cancel, flat_map);
+    if (memo != nullptr && !overlay && !absl::IsCancelled(mapped.status())) {
+      memo->entries[key] = {mapped, *flat_map};
+    }
+    return mapped;
+  }
+
+  // A map not found, as the attempt's answer: out of memory and cancellation kept as such,
+  // anything else FAILED_PRECONDITION (the caller may try another drawing's mesh).
+  absl::Status MapError(const absl::Status& status, int d) const {
+    if (absl::IsCancelled(status)) return status;
+    if (absl::IsResourceExhausted(status)) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "mapping drawing ", ref_ + 1, "'s mesh into drawing ", d + 1, ": ", status.message()));
+    }
+    return absl::FailedPreconditionError(absl::StrCat(
+        "cannot map drawing ", ref_ + 1, "'s mesh into drawing ", d + 1, ": ", status.message()));
   }
 
   // Cohesive edges: sub-edges of twin edges, closed in the drawings where they are collocated.
-  std::map<std::array<int, 4>, int> cohesive_index;
-  mesh.cohesive_closed.assign(num_shapes, {});
-  for (int d = 0; d < num_shapes; ++d) {
-    for (int e = 0; e < num_edges; ++e) {
-      const int f = bc->edge_twin[d][e];
-      if (f < 0 || f < e) continue;
-      std::vector<int> le, lf;
-      for (const BoundaryEntry& x : cut.entries[e]) le.push_back(x.vertex);
-      le.push_back(cut.entries[next_edge_start[e]][0].vertex);
-      for (const BoundaryEntry& x : cut.entries[f]) lf.push_back(x.vertex);
-      lf.push_back(cut.entries[next_edge_start[f]][0].vertex);
-      if (le.size() != lf.size()) {
-        return absl::InternalError("cohesive sides have different vertex counts");
-      }
-      const size_t m = le.size() - 1;
-      for (size_t j = 0; j < m; ++j) {
-        const std::array<int, 4> c = {le[j], le[j + 1], lf[m - j], lf[m - j - 1]};
-        auto [it, inserted] =
-            cohesive_index.emplace(c, static_cast<int>(mesh.cohesive_edges.size()));
-        if (inserted) mesh.cohesive_edges.push_back(c);
-        mesh.cohesive_closed[d].push_back(it->second);
+  absl::Status PairCohesiveEdges() {
+    std::map<std::array<int, 4>, int> cohesive_index;
+    mesh_.cohesive_closed.assign(num_shapes_, {});
+    for (int d = 0; d < num_shapes_; ++d) {
+      for (int e = 0; e < num_edges_; ++e) {
+        const int f = bc_.edge_twin[d][e];
+        if (f < 0 || f < e) continue;
+        std::vector<int> le, lf;
+        for (const BoundaryEntry& x : cut_.entries[e]) le.push_back(x.vertex);
+        le.push_back(cut_.entries[next_edge_start_[e]][0].vertex);
+        for (const BoundaryEntry& x : cut_.entries[f]) lf.push_back(x.vertex);
+        lf.push_back(cut_.entries[next_edge_start_[f]][0].vertex);
+        if (le.size() != lf.size()) {
+          return absl::InternalError("cohesive sides have different vertex counts");
+        }
+        const size_t m = le.size() - 1;
+        for (size_t j = 0; j < m; ++j) {
+          const std::array<int, 4> c = {le[j], le[j + 1], lf[m - j], lf[m - j - 1]};
+          auto [it, inserted] =
+              cohesive_index.emplace(c, static_cast<int>(mesh_.cohesive_edges.size()));
+          if (inserted) mesh_.cohesive_edges.push_back(c);
+          mesh_.cohesive_closed[d].push_back(it->second);
+        }
       }
     }
+    if (mesh_.cohesive_edges.empty()) mesh_.cohesive_closed.clear();
+    return absl::OkStatus();
   }
-  if (mesh.cohesive_edges.empty()) mesh.cohesive_closed.clear();
-  for (int e : bc->mark_vertices) mesh.pinned.push_back(cut.entries[e][0].vertex);
 
-  // Vertices along a Hilbert curve of the first shape: every later stage loops over triangles
-  // and gathers their corners (vertex_order.h).
-  RenumberSpatially(&mesh);
+  const BoundaryCorrespondence& bc_;
+  const int ref_;         // the drawing meshed
+  const int num_shapes_;  // drawings
+  const int num_edges_;   // correspondence edges (= correspondence vertices)
+  const MultimeshOptions& options_;
+  const AttemptOptions& attempt_;
+  const std::vector<int> next_edge_start_;  // NextEdgeStarts
+  CutMesh cut_;                             // the reference drawing's mesh, cut open
+  std::vector<bool> is_boundary_;           // per vertex of cut_
+  Multimesh mesh_;
+  int num_vertices_ = 0;                                // grows with the overlay
+  std::vector<int> component_of_;                       // per mesh vertex: its component's root
+  std::map<int, std::vector<int>> loops_of_component_;  // component root -> its boundary loops
+  int overlays_ = 0;
+};
 
-  notify("validate", 0.95, absl::StrCat(mesh.num_vertices(), " vertices"));
-  if (absl::Status valid = ValidateMultimesh(mesh); !valid.ok()) {
+// The built mesh checked (ValidateMultimesh), then the drawings' art embedded in it
+// (art_embedding.h), which rides the mesh from here on; *art_seconds: how long that took.
+absl::Status ValidateAndEmbedArt(const std::vector<Drawing>& drawings, const ProgressFn& progress,
+                                 Multimesh* mesh, double* art_seconds) {
+  Notify(progress, "validate", 0.95, absl::StrCat(mesh->num_vertices(), " vertices"));
+  if (absl::Status valid = ValidateMultimesh(*mesh); !valid.ok()) {
     return absl::InternalError(absl::StrCat("built multimesh is invalid: ", valid.message()));
   }
-  // The drawings' art rides the mesh from here on (art_embedding.h).
   const auto art_start = std::chrono::steady_clock::now();
-  absl::StatusOr<std::vector<EmbeddedArt>> art = EmbedDrawingsArt(mesh, drawings);
+  absl::StatusOr<std::vector<EmbeddedArt>> art = EmbedDrawingsArt(*mesh, drawings);
   if (!art.ok()) return art.status();
-  mesh.art = *std::move(art);
-  if (report != nullptr) {
-    report->art_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - art_start).count();
-    report->vertices = mesh.num_vertices();
-    report->triangles = static_cast<int>(mesh.triangles.size());
-    report->boundary_loops = static_cast<int>(mesh.boundary_loops.size());
-    report->cohesive_edges = static_cast<int>(mesh.cohesive_edges.size());
-    report->corner_matched_loops = bc->corner_matched_loops;
-    report->loop_vertices.clear();
-    for (const std::vector<int>& loop : mesh.boundary_loops) {
-      report->loop_vertices.push_back(static_cast<int>(loop.size()));
-    }
-    report->achieved_tolerance = bc->achieved_tolerance;
-    report->overlays = overlays;
-    report->equivalence.clear();
-    for (const BoundaryGraph& g : graphs) report->equivalence.push_back(g.equivalence.ToString());
-    report->seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  mesh->art = *std::move(art);
+  *art_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - art_start).count();
+  return absl::OkStatus();
+}
+
+// A successful attempt's numbers (MultimeshReport); `start`: when the attempt began.
+void FillReport(const Multimesh& mesh, const BoundaryCorrespondence& bc,
+                const std::vector<BoundaryGraph>& graphs, int overlays, double art_seconds,
+                std::chrono::steady_clock::time_point start, MultimeshReport* report) {
+  report->art_seconds = art_seconds;
+  report->vertices = mesh.num_vertices();
+  report->triangles = static_cast<int>(mesh.triangles.size());
+  report->boundary_loops = static_cast<int>(mesh.boundary_loops.size());
+  report->cohesive_edges = static_cast<int>(mesh.cohesive_edges.size());
+  report->corner_matched_loops = bc.corner_matched_loops;
+  report->loop_vertices.clear();
+  for (const std::vector<int>& loop : mesh.boundary_loops) {
+    report->loop_vertices.push_back(static_cast<int>(loop.size()));
   }
-  notify("done", 1.0,
-         absl::StrCat(mesh.num_vertices(), " vertices, ", mesh.triangles.size(), " triangles"));
+  report->achieved_tolerance = bc.achieved_tolerance;
+  report->overlays = overlays;
+  report->equivalence.clear();
+  for (const BoundaryGraph& g : graphs) report->equivalence.push_back(g.equivalence.ToString());
+  report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// One attempt of BuildMultimesh: boundaries, correspondence (corners matched or not), then the
+// drawing of the given rank in ReferenceOrder meshed and mapped (*meshed: which drawing that
+// is). Returns ABORTED (not an answer: the caller keeps its first error) with require_match when
+// no loop's corners matched, and when there is no drawing of that rank, before any meshing.
+absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
+                                    const MultimeshOptions& options, const AttemptOptions& attempt,
+                                    MultimeshReport* report, int* meshed) {
+  const auto start = std::chrono::steady_clock::now();
+  if (absl::Status s = CheckDrawings(drawings); !s.ok()) return s;
+  const int num_shapes = static_cast<int>(drawings.size());
+  if (Cancelled(attempt.cancel)) return absl::CancelledError("BuildMultimesh cancelled");
+  Notify(attempt.progress, "boundaries", 0.0, absl::StrCat(num_shapes, " drawings"));
+  absl::StatusOr<std::vector<BoundaryGraph>> graphs = DrawingBoundaries(drawings);
+  if (!graphs.ok()) return graphs.status();
+
+  Notify(attempt.progress, "correspondence", 0.05,
+         absl::StrCat((*graphs)[0].loops.size(), " boundary loops"));
+  absl::StatusOr<BoundaryCorrespondence> bc =
+      Correspond(drawings, *graphs, options, attempt.mode.match_corners);
+  if (!bc.ok()) return bc.status();
+  if (attempt.mode.require_match && bc->corner_matched_loops == 0) {
+    return absl::AbortedError("no loop has corners to match");
+  }
+  if (absl::Status s = CheckDistinctSamples(*bc, num_shapes); !s.ok()) return s;
+  if (attempt.rank >= std::min(num_shapes, kMaxReferences)) {
+    return absl::AbortedError("no other drawing to mesh");
+  }
+  const int ref = ReferenceOrder(*bc, num_shapes)[attempt.rank];
+  if (meshed != nullptr) *meshed = ref;
+
+  AttemptBuilder builder(*bc, ref, num_shapes, options, attempt);
+  absl::StatusOr<Multimesh> mesh = builder.Build();
+  if (!mesh.ok()) return mesh.status();
+  // Vertices along a Hilbert curve of the first shape: every later stage loops over triangles
+  // and gathers their corners (vertex_order.h).
+  RenumberSpatially(&*mesh);
+  double art_seconds = 0.0;
+  if (absl::Status s = ValidateAndEmbedArt(drawings, attempt.progress, &*mesh, &art_seconds);
+      !s.ok()) {
+    return s;
+  }
+  if (report != nullptr) {
+    FillReport(*mesh, *bc, *graphs, builder.overlays(), art_seconds, start, report);
+  }
+  Notify(attempt.progress, "done", 1.0,
+         absl::StrCat(mesh->num_vertices(), " vertices, ", mesh->triangles.size(), " triangles"));
   return mesh;
 }
 
@@ -790,13 +963,17 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
   int num_others = 0;
   for (int rank = 0; rank < kMaxReferences; ++rank) {
     int meshed = -1;
-    auto attempt = [&](bool match_corners,
-                       bool require_match) -> std::optional<absl::StatusOr<Multimesh>> {
+    auto attempt = [&](AttemptMode mode) -> std::optional<absl::StatusOr<Multimesh>> {
       // The first attempt (rank 0, the first correspondence) is the one the overlay repeats.
-      const bool first_attempt = rank == 0 && match_corners == !arc_length && !require_match;
-      absl::StatusOr<Multimesh> m = BuildOnce(
-          drawings, options, match_corners, require_match, rank, /*overlay=*/false,
-          first_attempt && options.overlay ? &memo : nullptr, cancel, monotone, report, &meshed);
+      const bool first_attempt =
+          rank == 0 && mode.match_corners == !arc_length && !mode.require_match;
+      const AttemptOptions attempt_options{
+          .mode = mode,
+          .rank = rank,
+          .memo = first_attempt && options.overlay ? &memo : nullptr,
+          .cancel = cancel,
+          .progress = monotone};
+      absl::StatusOr<Multimesh> m = BuildOnce(drawings, options, attempt_options, report, &meshed);
       if (m.ok() || absl::IsCancelled(m.status())) return m;
       if (rank == 0 && first.ok()) first = m.status();
       return std::nullopt;
@@ -807,7 +984,7 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
                absl::StrCat(first.message(), "; again with another drawing's mesh"));
     }
     if (arc_length) {
-      if (auto built = attempt(false, false)) return *built;
+      if (auto built = attempt({.match_corners = false})) return *built;
       if (rank == 0 && !absl::IsInvalidArgument(first) && !absl::IsFailedPrecondition(first)) {
         return first;
       }
@@ -820,7 +997,9 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       }
     }
     if (corners) {
-      if (auto built = attempt(true, /*require_match=*/arc_length)) return *built;
+      if (auto built = attempt({.match_corners = true, .require_match = arc_length})) {
+        return *built;
+      }
     }
     if (meshed < 0) break;  // no drawing of this rank: nothing was tried
     if (rank > 0) absl::StrAppend(&others, num_others++ > 0 ? ", " : "", meshed + 1);
@@ -830,9 +1009,13 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     monotone(
         "map", reached,
         absl::StrCat(first.message(), "; again, overlaying the mesh where it cannot be mapped"));
-    absl::StatusOr<Multimesh> m =
-        BuildOnce(drawings, options, /*match_corners=*/!arc_length, /*require_match=*/false,
-                  /*rank=*/0, /*overlay=*/true, &memo, cancel, monotone, report, nullptr);
+    const AttemptOptions overlay_attempt{
+        .mode = {.match_corners = !arc_length, .require_match = false, .overlay = true},
+        .rank = 0,
+        .memo = &memo,
+        .cancel = cancel,
+        .progress = monotone};
+    absl::StatusOr<Multimesh> m = BuildOnce(drawings, options, overlay_attempt, report, nullptr);
     if (m.ok() || absl::IsCancelled(m.status())) return m;
     overlay_note = absl::StrCat("; overlaid: ", m.status().message());
   }

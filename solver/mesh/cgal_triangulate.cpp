@@ -177,6 +177,133 @@ double Diagonal(const std::vector<Points>& loops) {
   return (hi - lo).norm();
 }
 
+// The mesher's pass over a triangulation whose constraints are in place: with options.refine,
+// Delaunay refinement to the size and shape bounds (RefineBounded; `loops` give the scale of its
+// spacing bound), else only the set-up, which marks the enclosed faces and inserts nothing. Shared
+// by both entry points so that they refine alike.
+absl::Status MeshConstrained(Cdt& cdt, const TriangulateOptions& options,
+                             const std::vector<Points>& loops) {
+  const double size = options.max_edge > 0 ? options.max_edge : 0.0;
+  if (!options.refine) {
+    CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, Criteria(options.shape_bound, size));
+    mesher.init();
+    return absl::OkStatus();
+  }
+  return RefineBounded(cdt, Criteria(options.shape_bound, size), options.max_vertices,
+                       Diagonal(loops));
+}
+
+// The loops' points inserted once each (points repeated exactly, as a slit walked both ways,
+// share a vertex), then every loop edge as a constraint. Fails when two points merge (too close)
+// or constraints cross, since either would change the loops' vertex count.
+absl::Status InsertLoops(const std::vector<Points>& loops, Cdt& cdt,
+                         std::vector<VertexHandle>* handles,
+                         std::vector<std::vector<VertexHandle>>* loop_handles) {
+  std::map<std::pair<double, double>, VertexHandle> by_point;
+  loop_handles->resize(loops.size());
+  for (size_t l = 0; l < loops.size(); ++l) {
+    for (const Point& p : loops[l]) {
+      auto [it, inserted] = by_point.emplace(std::make_pair(p.x(), p.y()), VertexHandle());
+      if (inserted) {
+        it->second = cdt.insert(CgalPoint(p.x(), p.y()));
+        handles->push_back(it->second);
+      }
+      (*loop_handles)[l].push_back(it->second);
+    }
+  }
+  const size_t distinct = cdt.number_of_vertices();
+  if (distinct != handles->size()) {
+    return absl::InvalidArgumentError("triangulate: loop points are too close to each other");
+  }
+  for (const auto& lh : *loop_handles) {
+    for (size_t k = 0; k < lh.size(); ++k) {
+      if (lh[k] != lh[(k + 1) % lh.size()]) cdt.insert_constraint(lh[k], lh[(k + 1) % lh.size()]);
+    }
+  }
+  if (cdt.number_of_vertices() != distinct) {
+    return absl::InvalidArgumentError("triangulate: boundary loops cross each other");
+  }
+  return absl::OkStatus();
+}
+
+// Output numbering: the distinct loop points in insertion order, then the Steiner points in
+// CGAL's vertex order (insertion order), so that the numbering is deterministic.
+std::map<VertexHandle, int> NumberVertices(const Cdt& cdt, const std::vector<VertexHandle>& handles,
+                                           Points* vertices) {
+  std::map<VertexHandle, int> index;
+  for (VertexHandle h : handles) {
+    index[h] = static_cast<int>(vertices->size());
+    vertices->emplace_back(h->point().x(), h->point().y());
+  }
+  for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
+    if (index.count(v)) continue;
+    index[v] = static_cast<int>(vertices->size());
+    vertices->emplace_back(v->point().x(), v->point().y());
+  }
+  return index;
+}
+
+// The mesher's domain is every region enclosed by constraints (it also fills holes: marking the
+// domain ourselves made the 5.5 mesher loop on concave shapes), so faces are kept by the
+// even-odd rule over the loops at their centroid, positively oriented.
+void KeepEvenOddFaces(const Cdt& cdt, const std::vector<Points>& loops,
+                      const std::map<VertexHandle, int>& index, DomainTriangulation* out) {
+  // Each loop's bounding box first: a centroid outside it is outside the loop (a drawing of
+  // 900 holes spent 3.6 s here testing 218k centroids against every loop).
+  std::vector<Eigen::AlignedBox2d> boxes(loops.size());
+  for (size_t l = 0; l < loops.size(); ++l) {
+    for (const Point& p : loops[l]) boxes[l].extend(p);
+  }
+  auto in_domain = [&](const Point& q) {
+    bool in = false;
+    for (size_t l = 0; l < loops.size(); ++l) {
+      if (boxes[l].contains(q)) in ^= PolygonContains(loops[l], q);
+    }
+    return in;
+  };
+  for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+    if (!f->is_in_domain()) continue;
+    Triangle t = {index.at(f->vertex(0)), index.at(f->vertex(1)), index.at(f->vertex(2))};
+    if (!in_domain((out->vertices[t[0]] + out->vertices[t[1]] + out->vertices[t[2]]) / 3.0)) {
+      continue;
+    }
+    if (SignedArea2(t, out->vertices) < 0) std::swap(t[1], t[2]);
+    out->triangles.push_back(t);
+  }
+}
+
+// The Steiner vertices refinement put on the loop edge from `from` (at point a) to `to` (at
+// a + d), in order: walks constrained edges, each step to the nearest vertex further along the
+// edge's line (within 1e-9 of its length off it). INTERNAL when the walk cannot reach `to`.
+absl::Status SteinerChain(const Cdt& cdt, const std::map<VertexHandle, int>& index,
+                          VertexHandle from, VertexHandle to, const Point& a, const Point& d,
+                          std::vector<int>* chain) {
+  const double len2 = d.squaredNorm();
+  VertexHandle current = from;
+  double current_t = 0.0;
+  for (int guard = 0; current != to && guard < 1000000; ++guard) {
+    VertexHandle best;
+    double best_t = 2.0;
+    auto e = cdt.incident_edges(current), done = e;
+    do {
+      if (cdt.is_infinite(*e) || !cdt.is_constrained(*e)) continue;
+      VertexHandle w = e->first->vertex(Cdt::cw(e->second));
+      if (w == current) w = e->first->vertex(Cdt::ccw(e->second));
+      const Point q(w->point().x(), w->point().y());
+      const double t = (q - a).dot(d) / len2;
+      const double off = std::abs(Cross(d, q - a)) / std::sqrt(len2);
+      if (t > current_t && t < best_t && off <= 1e-9 * std::sqrt(len2)) best = w, best_t = t;
+    } while (++e != done);
+    if (best == VertexHandle()) {
+      return absl::InternalError("triangulate: lost a boundary edge during refinement");
+    }
+    if (best != to) chain->push_back(index.at(best));
+    current = best;
+    current_t = best_t;
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
@@ -206,16 +333,7 @@ absl::StatusOr<PolygonTriangulation> CgalTriangulate(const Points& boundary,
       return absl::InvalidArgumentError("triangulate: polygon boundary crosses itself");
     }
 
-    const double size = options.max_edge > 0 ? options.max_edge : 0.0;
-    if (!options.refine) {
-      // The mesher's set-up marks the faces inside the polygon and inserts nothing.
-      CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, Criteria(options.shape_bound, size));
-      mesher.init();
-    } else if (absl::Status s = RefineBounded(cdt, Criteria(options.shape_bound, size),
-                                              options.max_vertices, Diagonal({boundary}));
-               !s.ok()) {
-      return s;
-    }
+    if (absl::Status s = MeshConstrained(cdt, options, {boundary}); !s.ok()) return s;
 
     std::map<VertexHandle, int> index;
     for (int i = 0; i < n; ++i) index[handles[i]] = i;
@@ -281,108 +399,23 @@ absl::StatusOr<DomainTriangulation> CgalTriangulateDomain(const std::vector<Poin
   DomainTriangulation out;
   try {
     Cdt cdt;
-    std::map<std::pair<double, double>, VertexHandle> by_point;
     std::vector<VertexHandle> handles;
-    std::vector<std::vector<VertexHandle>> loop_handles(loops.size());
-    for (size_t l = 0; l < loops.size(); ++l) {
-      for (const Point& p : loops[l]) {
-        auto [it, inserted] = by_point.emplace(std::make_pair(p.x(), p.y()), VertexHandle());
-        if (inserted) {
-          it->second = cdt.insert(CgalPoint(p.x(), p.y()));
-          handles.push_back(it->second);
-        }
-        loop_handles[l].push_back(it->second);
-      }
-    }
-    const size_t distinct = cdt.number_of_vertices();
-    if (distinct != handles.size()) {
-      return absl::InvalidArgumentError("triangulate: loop points are too close to each other");
-    }
-    for (const auto& lh : loop_handles) {
-      for (size_t k = 0; k < lh.size(); ++k) {
-        if (lh[k] != lh[(k + 1) % lh.size()]) cdt.insert_constraint(lh[k], lh[(k + 1) % lh.size()]);
-      }
-    }
-    if (cdt.number_of_vertices() != distinct) {
-      return absl::InvalidArgumentError("triangulate: boundary loops cross each other");
-    }
-    // Refinement of every region enclosed by constraints (CGAL's default domain, which also
-    // fills holes: marking the domain ourselves made the 5.5 mesher loop on concave shapes),
-    // then faces kept by the even-odd rule at their centroid.
-    const double size = options.max_edge > 0 ? options.max_edge : 0.0;
-    if (!options.refine) {
-      // The mesher's set-up marks the enclosed faces and inserts nothing.
-      CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, Criteria(options.shape_bound, size));
-      mesher.init();
-    } else if (absl::Status s = RefineBounded(cdt, Criteria(options.shape_bound, size),
-                                              options.max_vertices, Diagonal(loops));
-               !s.ok()) {
-      return s;
-    }
-    // Each loop's bounding box first: a centroid outside it is outside the loop (a drawing of
-    // 900 holes spent 3.6 s here testing 218k centroids against every loop).
-    std::vector<Eigen::AlignedBox2d> boxes(loops.size());
-    for (size_t l = 0; l < loops.size(); ++l) {
-      for (const Point& p : loops[l]) boxes[l].extend(p);
-    }
-    auto in_domain = [&](const Point& q) {
-      bool in = false;
-      for (size_t l = 0; l < loops.size(); ++l) {
-        if (boxes[l].contains(q)) in ^= PolygonContains(loops[l], q);
-      }
-      return in;
-    };
-    std::map<VertexHandle, int> index;
-    for (VertexHandle h : handles) {
-      index[h] = static_cast<int>(out.vertices.size());
-      out.vertices.emplace_back(h->point().x(), h->point().y());
-    }
-    for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
-      if (index.count(v)) continue;
-      index[v] = static_cast<int>(out.vertices.size());
-      out.vertices.emplace_back(v->point().x(), v->point().y());
-    }
-    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-      if (!f->is_in_domain()) continue;
-      Triangle t = {index.at(f->vertex(0)), index.at(f->vertex(1)), index.at(f->vertex(2))};
-      if (!in_domain((out.vertices[t[0]] + out.vertices[t[1]] + out.vertices[t[2]]) / 3.0)) {
-        continue;
-      }
-      if (SignedArea2(t, out.vertices) < 0) std::swap(t[1], t[2]);
-      out.triangles.push_back(t);
-    }
-    // Steiner chains: walk constrained edges from each loop edge's start to its end.
+    std::vector<std::vector<VertexHandle>> loop_handles;
+    if (absl::Status s = InsertLoops(loops, cdt, &handles, &loop_handles); !s.ok()) return s;
+    if (absl::Status s = MeshConstrained(cdt, options, loops); !s.ok()) return s;
+    const std::map<VertexHandle, int> index = NumberVertices(cdt, handles, &out.vertices);
+    KeepEvenOddFaces(cdt, loops, index, &out);
     out.loop_vertex.resize(loops.size());
     out.edge_chain.resize(loops.size());
     for (size_t l = 0; l < loops.size(); ++l) {
       const auto& lh = loop_handles[l];
       for (size_t k = 0; k < lh.size(); ++k) {
         out.loop_vertex[l].push_back(index.at(lh[k]));
-        std::vector<int> chain;
-        const VertexHandle target = lh[(k + 1) % lh.size()];
         const Point a = loops[l][k], d = loops[l][(k + 1) % lh.size()] - a;
-        const double len2 = d.squaredNorm();
-        VertexHandle current = lh[k];
-        double current_t = 0.0;
-        for (int guard = 0; current != target && guard < 1000000; ++guard) {
-          VertexHandle best;
-          double best_t = 2.0;
-          auto e = cdt.incident_edges(current), done = e;
-          do {
-            if (cdt.is_infinite(*e) || !cdt.is_constrained(*e)) continue;
-            VertexHandle w = e->first->vertex(Cdt::cw(e->second));
-            if (w == current) w = e->first->vertex(Cdt::ccw(e->second));
-            const Point q(w->point().x(), w->point().y());
-            const double t = (q - a).dot(d) / len2;
-            const double off = std::abs(Cross(d, q - a)) / std::sqrt(len2);
-            if (t > current_t && t < best_t && off <= 1e-9 * std::sqrt(len2)) best = w, best_t = t;
-          } while (++e != done);
-          if (best == VertexHandle()) {
-            return absl::InternalError("triangulate: lost a boundary edge during refinement");
-          }
-          if (best != target) chain.push_back(index.at(best));
-          current = best;
-          current_t = best_t;
+        std::vector<int> chain;
+        if (absl::Status s = SteinerChain(cdt, index, lh[k], lh[(k + 1) % lh.size()], a, d, &chain);
+            !s.ok()) {
+          return s;
         }
         out.edge_chain[l].push_back(std::move(chain));
       }

@@ -421,12 +421,10 @@ bool AffineStart(const Points& source, const std::vector<Triangle>& triangles,
   return CountInverted(triangles, *out) == 0;
 }
 
-absl::StatusOr<Points> MapToBoundaryImpl(const Points& source,
-                                         const std::vector<Triangle>& triangles,
-                                         const std::vector<int>& boundary,
-                                         const Points& target_boundary,
-                                         const MapToBoundaryOptions& options,
-                                         const CancelToken* cancel, MapToBoundaryReport* report) {
+// The arguments' contract (map_to_boundary.h), checked before any work: sizes, boundary indices,
+// a finite target and a source without inverted triangles.
+absl::Status CheckMapInputs(const Points& source, const std::vector<Triangle>& triangles,
+                            const std::vector<int>& boundary, const Points& target_boundary) {
   const int n = static_cast<int>(source.size());
   if (boundary.size() != target_boundary.size() || boundary.size() < 3) {
     return absl::InvalidArgumentError(absl::StrCat("map: ", boundary.size(),
@@ -442,12 +440,15 @@ absl::StatusOr<Points> MapToBoundaryImpl(const Points& source,
   if (CountInverted(triangles, source) > 0) {
     return absl::InvalidArgumentError("map: the source mesh has inverted triangles");
   }
-  MapToBoundaryReport local_report;
-  MapToBoundaryReport& rep = report ? *report : local_report;
-  rep = MapToBoundaryReport();
+  return absl::OkStatus();
+}
 
-  Mapper mapper(source, triangles, boundary, target_boundary);
-  Constraints fixed;  // boundary pinned at the target
+// Every boundary vertex fixed at its target, the interior free: the constraints of the exact
+// placement and of the polish.
+Constraints PinnedBoundary(const Points& source, const std::vector<int>& boundary,
+                           const Points& target_boundary) {
+  const int n = static_cast<int>(source.size());
+  Constraints fixed;
   fixed.free_index.assign(n, 0);
   fixed.fixed_at = source;
   for (size_t k = 0; k < boundary.size(); ++k) {
@@ -457,117 +458,208 @@ absl::StatusOr<Points> MapToBoundaryImpl(const Points& source,
   for (int v = 0; v < n; ++v) {
     if (fixed.free_index[v] >= 0) fixed.free_index[v] = fixed.free_count++;
   }
+  return fixed;
+}
 
-  Points x;
-  bool placed = false;
-  const bool convex = IsConvexPositive(target_boundary);
-  absl::Status tutte = absl::FailedPreconditionError("not tried");
-  if ((options.tutte_when_convex && convex) || options.tutte_first_always) {
-    tutte = TutteEmbedding(source, triangles, boundary, target_boundary, &x);
-    if (absl::IsResourceExhausted(tutte)) return tutte;
-  }
-  if (tutte.ok()) {
-    // Non-convex targets: keep it only if no triangle is folded or nearly flat (relative to
-    // its source area), so the polish's barrier starts from a sound map.
-    bool sound = CountInverted(triangles, x) == 0;
-    for (size_t t = 0; sound && !convex && t < triangles.size(); ++t) {
-      sound = SignedArea2(triangles[t], x) > 1e-6 * SignedArea2(triangles[t], source);
+// One MapToBoundary call on checked arguments. The phases share the Mapper (whose factorization
+// patterns are cached per Constraints object, so `fixed_` lives as long as the mapper) and the
+// report, hence a class; Run calls them in order: a sound Tutte embedding, else the progressive
+// pull and the exact placement of the boundary; then the polish with the boundary pinned.
+class BoundaryMap {
+ public:
+  BoundaryMap(const Points& source, const std::vector<Triangle>& triangles,
+              const std::vector<int>& boundary, const Points& target_boundary,
+              const MapToBoundaryOptions& options, const CancelToken* cancel,
+              MapToBoundaryReport* report)
+      : source_(source),
+        triangles_(triangles),
+        boundary_(boundary),
+        target_(target_boundary),
+        options_(options),
+        cancel_(cancel),
+        rep_(*report),
+        n_(static_cast<int>(source.size())),
+        mapper_(source, triangles, boundary, target_boundary),
+        fixed_(PinnedBoundary(source, boundary, target_boundary)) {}
+
+  absl::StatusOr<Points> Run() {
+    Points x;
+    absl::StatusOr<bool> placed = TutteStart(&x);
+    if (!placed.ok()) return placed.status();
+    rep_.tutte = *placed;
+    if (!*placed) {
+      if (absl::Status s = CheckStart(); !s.ok()) return s;
+      x = PullStart();
+      if (absl::Status s = PullBoundary(&x); !s.ok()) return s;
+      if (absl::Status s = PlaceExactly(&x); !s.ok()) return s;
     }
-    rep.tutte = placed = sound;
+    for (size_t k = 0; k < boundary_.size(); ++k) x[boundary_[k]] = target_[k];
+    if (CountInverted(triangles_, x) > 0) {
+      return absl::FailedPreconditionError("the exactly placed boundary folds a triangle");
+    }
+    if (absl::Status s = Polish(&x); !s.ok()) return s;
+    for (size_t k = 0; k < boundary_.size(); ++k) x[boundary_[k]] = target_[k];
+    if (const int inverted = CountInverted(triangles_, x); inverted > 0) {
+      return absl::FailedPreconditionError(absl::StrCat(inverted, " triangles fold"));
+    }
+    rep_.energy = mapper_.Distortion(x) / mapper_.total_area();
+    return x;
   }
 
-  if (!placed && options.start != nullptr) {
-    if (options.start->size() != source.size()) {
-      return absl::InvalidArgumentError(absl::StrCat("start has ", options.start->size(),
-                                                     " points, the mesh has ", source.size()));
+ private:
+  // The Tutte embedding into *x, tried for a convex target (or always, per the options), and
+  // whether it is the map: true when it folds nothing and, for a non-convex target, leaves no
+  // triangle nearly flat relative to its source area, so the polish's barrier starts from a
+  // sound map. Only RESOURCE_EXHAUSTED is an error: any other failure leaves the pull to try.
+  absl::StatusOr<bool> TutteStart(Points* x) const {
+    const bool convex = IsConvexPositive(target_);
+    absl::Status tutte = absl::FailedPreconditionError("not tried");
+    if ((options_.tutte_when_convex && convex) || options_.tutte_first_always) {
+      tutte = TutteEmbedding(source_, triangles_, boundary_, target_, x);
+      if (absl::IsResourceExhausted(tutte)) return tutte;
     }
-    if (CountInverted(triangles, *options.start) != 0) {
+    if (!tutte.ok()) return false;
+    bool sound = CountInverted(triangles_, *x) == 0;
+    for (size_t t = 0; sound && !convex && t < triangles_.size(); ++t) {
+      sound = SignedArea2(triangles_[t], *x) > 1e-6 * SignedArea2(triangles_[t], source_);
+    }
+    return sound;
+  }
+
+  // options.start's contract (one point per vertex, nothing folded), checked only when the pull
+  // is going to start from it.
+  absl::Status CheckStart() const {
+    if (options_.start == nullptr) return absl::OkStatus();
+    if (options_.start->size() != source_.size()) {
+      return absl::InvalidArgumentError(absl::StrCat("start has ", options_.start->size(),
+                                                     " points, the mesh has ", source_.size()));
+    }
+    if (CountInverted(triangles_, *options_.start) != 0) {
       return absl::InvalidArgumentError("start folds a triangle");
     }
+    return absl::OkStatus();
   }
-  if (!placed) {
-    // Progressive boundary pull from the given start, else from the best-fitting affine image of
-    // the source (exact for a rotated, scaled or sheared copy), else from the identity.
+
+  // Where the pull starts: the given start, else the best-fitting affine image of the source
+  // (exact for a rotated, scaled or sheared copy), else the identity.
+  Points PullStart() const {
+    if (options_.start != nullptr) return *options_.start;
     Points affine;
-    if (options.start != nullptr) {
-      x = *options.start;
-    } else if (AffineStart(source, triangles, boundary, target_boundary, &affine)) {
-      x = std::move(affine);
-    } else {
-      x = source;
-    }
+    if (AffineStart(source_, triangles_, boundary_, target_, &affine)) return affine;
+    return source_;
+  }
+
+  // The progressive boundary pull: stages of SLIM iterations with every vertex free and a
+  // boundary penalty ten times the last stage's, until the boundary is within tolerance of the
+  // target (relative to its bounding-box diagonal) or the iterations, stages or penalty run out.
+  // FAILED_PRECONDITION (StuckError) when it does not get there.
+  absl::Status PullBoundary(Points* x) {
     Constraints pull;
-    pull.free_index.resize(n);
-    for (int v = 0; v < n; ++v) pull.free_index[v] = v;
-    pull.free_count = n;
-    Point lo = target_boundary[0], hi = lo;
-    for (const Point& p : target_boundary) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    pull.free_index.resize(n_);
+    for (int v = 0; v < n_; ++v) pull.free_index[v] = v;
+    pull.free_count = n_;
+    Point lo = target_[0], hi = lo;
+    for (const Point& p : target_) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     const double scale = (hi - lo).norm();
-    const double tolerance = options.boundary_tolerance * scale;
-    pull.penalty = mapper.total_area() / (boundary.size() * scale * scale);
-    while (mapper.MaxBoundaryDistance(x) > tolerance && rep.iterations < options.max_iterations) {
-      ++rep.stages;
+    const double tolerance = options_.boundary_tolerance * scale;
+    pull.penalty = mapper_.total_area() / (boundary_.size() * scale * scale);
+    while (mapper_.MaxBoundaryDistance(*x) > tolerance &&
+           rep_.iterations < options_.max_iterations) {
+      ++rep_.stages;
       pull.penalty *= 10;
-      for (int it = 0; it < options.iterations_per_stage && rep.iterations < options.max_iterations;
-           ++it) {
-        if (Cancelled(cancel)) return absl::CancelledError("map: cancelled");
-        ++rep.iterations;
-        const absl::StatusOr<double> iterated = mapper.Iterate(&x, pull);
+      for (int it = 0;
+           it < options_.iterations_per_stage && rep_.iterations < options_.max_iterations; ++it) {
+        if (Cancelled(cancel_)) return absl::CancelledError("map: cancelled");
+        ++rep_.iterations;
+        const absl::StatusOr<double> iterated = mapper_.Iterate(x, pull);
         if (!iterated.ok()) return iterated.status();
         const double progress = *iterated;
         if (progress < 0) break;  // the penalty outgrew the factorization: the pull is stuck
-        if (progress < options.stage_progress) break;
+        if (progress < options_.stage_progress) break;
       }
-      if (rep.stages > 40 || !(pull.penalty < 1e20)) break;
+      if (rep_.stages > 40 || !(pull.penalty < 1e20)) break;
     }
-    const double distance = mapper.MaxBoundaryDistance(x);
-    if (distance > tolerance) {
-      size_t worst = 0;  // the boundary vertex furthest from its target: where the map is stuck
-      for (size_t k = 0; k < boundary.size(); ++k) {
-        if ((x[boundary[k]] - target_boundary[k]).norm() >
-            (x[boundary[worst]] - target_boundary[worst]).norm()) {
-          worst = k;
-        }
+    const double distance = mapper_.MaxBoundaryDistance(*x);
+    if (distance > tolerance) return StuckError(*x, distance);
+    return absl::OkStatus();
+  }
+
+  // The pull's failure, named by the boundary vertex furthest from its target (where the map is
+  // stuck), in the target's and the reference drawing's coordinates, for the user to find it.
+  absl::Status StuckError(const Points& x, double distance) const {
+    size_t worst = 0;
+    for (size_t k = 0; k < boundary_.size(); ++k) {
+      if ((x[boundary_[k]] - target_[k]).norm() > (x[boundary_[worst]] - target_[worst]).norm()) {
+        worst = k;
       }
-      return absl::FailedPreconditionError(absl::StrCat(
-          "the boundary could not be pulled onto the target without folding triangles (the "
-          "boundary point that belongs at (",
-          target_boundary[worst].x(), ", ", target_boundary[worst].y(), ") stays ", distance,
-          " away, near (", source[boundary[worst]].x(), ", ", source[boundary[worst]].y(),
-          ") of the reference drawing, after ", rep.iterations, " iterations)"));
     }
-    // Exact placement: the proxy step with the boundary pinned; it must not fold anything.
+    return absl::FailedPreconditionError(absl::StrCat(
+        "the boundary could not be pulled onto the target without folding triangles (the "
+        "boundary point that belongs at (",
+        target_[worst].x(), ", ", target_[worst].y(), ") stays ", distance, " away, near (",
+        source_[boundary_[worst]].x(), ", ", source_[boundary_[worst]].y(),
+        ") of the reference drawing, after ", rep_.iterations, " iterations)"));
+  }
+
+  // Exact placement: the proxy step with the boundary pinned, else the boundary's move alone;
+  // whichever is taken must not fold anything (MaxStep beyond the full step).
+  absl::Status PlaceExactly(Points* x) const {
     Points proxy;
-    if (absl::Status s = mapper.ProxySolve(x, fixed, &proxy); !s.ok()) return s;
-    Points d(n);
-    for (int v = 0; v < n; ++v) d[v] = proxy[v] - x[v];
-    if (!(mapper.MaxStep(x, d) > 1.0)) {
-      // Move the boundary alone instead.
-      for (int v = 0; v < n; ++v) d[v] = fixed.free_index[v] < 0 ? proxy[v] - x[v] : Point(0, 0);
-      if (!(mapper.MaxStep(x, d) > 1.0)) {
+    if (absl::Status s = mapper_.ProxySolve(*x, fixed_, &proxy); !s.ok()) return s;
+    Points d(n_);
+    for (int v = 0; v < n_; ++v) d[v] = proxy[v] - (*x)[v];
+    if (!(mapper_.MaxStep(*x, d) > 1.0)) {
+      for (int v = 0; v < n_; ++v) {
+        d[v] = fixed_.free_index[v] < 0 ? proxy[v] - (*x)[v] : Point(0, 0);
+      }
+      if (!(mapper_.MaxStep(*x, d) > 1.0)) {
         return absl::FailedPreconditionError(
             "placing the boundary exactly on the target would fold a triangle");
       }
     }
-    for (int v = 0; v < n; ++v) x[v] += d[v];
+    for (int v = 0; v < n_; ++v) (*x)[v] += d[v];
+    return absl::OkStatus();
   }
-  for (size_t k = 0; k < boundary.size(); ++k) x[boundary[k]] = target_boundary[k];
-  if (CountInverted(triangles, x) > 0) {
-    return absl::FailedPreconditionError("the exactly placed boundary folds a triangle");
+
+  // Interior-only SLIM iterations with the boundary on target (quality polish), until
+  // options.polish_iterations or an iteration gaining less than 1e-6.
+  absl::Status Polish(Points* x) {
+    for (int it = 0; it < options_.polish_iterations; ++it) {
+      if (Cancelled(cancel_)) return absl::CancelledError("map: cancelled");
+      ++rep_.iterations;
+      const absl::StatusOr<double> progress = mapper_.Iterate(x, fixed_);
+      if (!progress.ok()) return progress.status();
+      if (*progress < 1e-6) break;
+    }
+    return absl::OkStatus();
   }
-  for (int it = 0; it < options.polish_iterations; ++it) {
-    if (Cancelled(cancel)) return absl::CancelledError("map: cancelled");
-    ++rep.iterations;
-    const absl::StatusOr<double> progress = mapper.Iterate(&x, fixed);
-    if (!progress.ok()) return progress.status();
-    if (*progress < 1e-6) break;
+
+  const Points& source_;
+  const std::vector<Triangle>& triangles_;
+  const std::vector<int>& boundary_;
+  const Points& target_;
+  const MapToBoundaryOptions& options_;
+  const CancelToken* cancel_;
+  MapToBoundaryReport& rep_;
+  const int n_;
+  const Mapper mapper_;
+  const Constraints fixed_;
+};
+
+absl::StatusOr<Points> MapToBoundaryImpl(const Points& source,
+                                         const std::vector<Triangle>& triangles,
+                                         const std::vector<int>& boundary,
+                                         const Points& target_boundary,
+                                         const MapToBoundaryOptions& options,
+                                         const CancelToken* cancel, MapToBoundaryReport* report) {
+  if (absl::Status s = CheckMapInputs(source, triangles, boundary, target_boundary); !s.ok()) {
+    return s;
   }
-  for (size_t k = 0; k < boundary.size(); ++k) x[boundary[k]] = target_boundary[k];
-  if (const int inverted = CountInverted(triangles, x); inverted > 0) {
-    return absl::FailedPreconditionError(absl::StrCat(inverted, " triangles fold"));
-  }
-  rep.energy = mapper.Distortion(x) / mapper.total_area();
-  return x;
+  // The report is reset only once the arguments are accepted.
+  MapToBoundaryReport local_report;
+  MapToBoundaryReport& rep = report ? *report : local_report;
+  rep = MapToBoundaryReport();
+  return BoundaryMap(source, triangles, boundary, target_boundary, options, cancel, &rep).Run();
 }
 
 }  // namespace

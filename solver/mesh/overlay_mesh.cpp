@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -458,11 +459,264 @@ absl::StatusOr<Opened> CutOpen(const std::vector<Triangle>& triangles, int n,
 constexpr long long kPreMergeFactor = 4;
 constexpr long long kMaxPreMergeVertices = 2'000'000;
 
+// Placements of the boundary on the circle, tried in turn: the share of the first shape's arc
+// length blended with even spacing. The spacing decides where chords pass close to mesh
+// vertices and cut thin pieces. Even spacing first: arc length crowds short boundary edges,
+// whose chords then graze the vertices between them.
+constexpr double kCircleBlends[] = {0.0, 0.5, 0.9, 0.25, 0.75, 0.6};
+// The first placement whose worst triangle is at least this good is kept, else the best.
+constexpr double kGoodQuality = 1e-3;
+
+// The bound on the refinement before the merges: the bound is on the result, after them (which
+// take about two in three crossings), so the refinement may have kPreMergeFactor times as many
+// vertices, up to kMaxPreMergeVertices (0: no bound).
+int RefineBound(int max_vertices) {
+  return max_vertices <= 0
+             ? 0
+             : static_cast<int>(std::max<long long>(
+                   max_vertices,
+                   std::min<long long>(kPreMergeFactor * static_cast<long long>(max_vertices),
+                                       kMaxPreMergeVertices)));
+}
+
+absl::Status TooManyVertices(int max_vertices) {
+  return absl::ResourceExhaustedError(
+      absl::StrCat("overlay: the refinement needs more than ", max_vertices, " vertices"));
+}
+
+// The worst triangle quality of the result over every drawing (4 sqrt(3) area / sum of squared
+// edges: 1 equilateral), or -1 when a triangle is not positive in doubles, as every later stage
+// judges a triangle (validate.h's CountInverted).
+double WorstQuality(const OverlayResult& result) {
+  double worst = std::numeric_limits<double>::infinity();
+  for (const Points& s : result.shapes) {
+    worst = std::min(worst, CountInverted(result.triangles, s) == 0
+                                ? WorstTriangleQuality(result.triangles, s)
+                                : -1.0);
+  }
+  return worst;
+}
+
+// The fan apex of a convex cell (vertices counter-clockwise) that keeps its smallest triangle
+// largest, relative to the cell's area, over every drawing; 0 for a triangle.
+int BestApex(const std::vector<int>& cell, const std::vector<Points>& shapes) {
+  const int m = static_cast<int>(cell.size());
+  int best = 0;
+  double best_worst = -std::numeric_limits<double>::infinity();
+  for (int apex = 0; apex < m && m > 3; ++apex) {
+    double worst = std::numeric_limits<double>::infinity();
+    for (const Points& s : shapes) {
+      double cell_area = 0.0;
+      for (int i = 1; i + 1 < m; ++i) {
+        cell_area += Cross(s[cell[i]] - s[cell[0]], s[cell[i + 1]] - s[cell[0]]);
+      }
+      const Point& o = s[cell[apex]];
+      for (int i = 1; i + 1 < m; ++i) {
+        const Point& p = s[cell[(apex + i) % m]];
+        const Point& q = s[cell[(apex + i + 1) % m]];
+        worst = std::min(worst, Cross(p - o, q - o) / std::abs(cell_area));
+      }
+    }
+    if (worst > best_worst) best_worst = worst, best = apex;
+  }
+  return best;
+}
+
+// OverlayDisk's inputs and its phases for one placement of the boundary on the circle (Try):
+// the circle, the convex (Tutte) embedding on it, the overlay, every vertex placed in every
+// drawing, the cells fanned, the cut's copies glued back and the crossings merged where they
+// may be. A class because every phase reads the same inputs.
+class DiskOverlay {
+ public:
+  // A placement's outcome: the refinement, or why it failed. A fatal failure (cancelled, out of
+  // memory, a broken overlay, an error merging) ends the search; the others leave it to the next
+  // placement.
+  struct Outcome {
+    absl::StatusOr<OverlayResult> result;
+    bool fatal = false;
+  };
+
+  DiskOverlay(const std::vector<Triangle>& triangles, const std::vector<Points>& shapes,
+              const std::vector<int>& boundary, const Points& target_boundary, const Chords& chords,
+              const std::vector<int>& original, int kept, int fixed, const CancelToken* cancel,
+              int max_vertices)
+      : triangles_(triangles),
+        shapes_(shapes),
+        boundary_(boundary),
+        target_(target_boundary),
+        chords_(chords),
+        original_(original),
+        kept_(kept),
+        fixed_(fixed),
+        cancel_(cancel),
+        max_vertices_(max_vertices),
+        refine_bound_(RefineBound(max_vertices)),
+        m_(static_cast<int>(shapes[0].size())),
+        nb_(static_cast<int>(boundary.size())),
+        arc_(nb_ + 1, 0.0) {
+    for (int k = 0; k < nb_; ++k) {
+      arc_[k + 1] = arc_[k] + (shapes[0][boundary[(k + 1) % nb_]] - shapes[0][boundary[k]]).norm();
+    }
+  }
+
+  // Placement `attempt` (an index into kCircleBlends), start to end.
+  Outcome Try(int attempt) const {
+    const Points circle = Circle(attempt);
+    if (!StrictlyConvex(circle)) {
+      return {absl::FailedPreconditionError("overlay: the circle's points are not convex")};
+    }
+    absl::StatusOr<Points> disk = Embed(circle);
+    if (!disk.ok()) {
+      return {disk.status(),
+              absl::IsCancelled(disk.status()) || absl::IsResourceExhausted(disk.status())};
+    }
+    Overlay overlay(triangles_, boundary_, *disk, circle, chords_);
+    if (absl::Status run = overlay.Run(cancel_, refine_bound_); !run.ok()) {
+      return {absl::IsResourceExhausted(run) ? TooManyVertices(max_vertices_) : run, true};
+    }
+    OverlayResult result = PlaceVertices(overlay, circle, *disk);
+    // Each convex cell fanned from its best apex (BestApex).
+    for (const Overlay::Cell& cell : overlay.cells()) {
+      const int m = static_cast<int>(cell.vertices.size());
+      const int apex = BestApex(cell.vertices, result.shapes);
+      for (int i = 1; i + 1 < m; ++i) {
+        result.triangles.push_back({cell.vertices[apex], cell.vertices[(apex + i) % m],
+                                    cell.vertices[(apex + i + 1) % m]});
+      }
+    }
+    GlueCopies(&result);
+    result.added_vertices = static_cast<int>(result.shapes[0].size()) - fixed_;
+    if (absl::Status merged = MergeCrossings(&result); !merged.ok()) return {merged, true};
+    if (max_vertices_ > 0 && fixed_ + result.added_vertices > max_vertices_) {
+      return {TooManyVertices(max_vertices_)};  // another placement may cut fewer pieces
+    }
+    return {std::move(result)};
+  }
+
+ private:
+  // The boundary's points on the unit circle for placement `attempt`, each also moved by a
+  // pseudo-random fraction of under a quarter of the even step (symmetric drawings put mesh
+  // vertices on chords otherwise); some even share keeps every step positive.
+  Points Circle(int attempt) const {
+    const double blend = arc_[nb_] > 0 ? kCircleBlends[attempt] : 0.0;
+    std::uint64_t state = 0x9E3779B97F4A7C15ull * (attempt + 1);
+    Points circle(nb_);
+    for (int k = 0; k < nb_; ++k) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      const double jitter = 0.2 * ((state >> 11) * 0x1.0p-53 - 0.5) * (1.0 - blend) / nb_;
+      const double share =
+          (arc_[nb_] > 0 ? blend * arc_[k] / arc_[nb_] : 0.0) + (1.0 - blend) * k / nb_ + jitter;
+      const double angle = 2.0 * std::numbers::pi * share;
+      circle[k] = Point(std::cos(angle), std::sin(angle));
+    }
+    return circle;
+  }
+
+  // The mesh's Tutte embedding with its boundary on the circle (no polish: the overlay needs the
+  // convex combination map), checked to leave every triangle positive by the exact predicate.
+  absl::StatusOr<Points> Embed(const Points& circle) const {
+    MapToBoundaryOptions tutte;
+    tutte.tutte_when_convex = true;
+    tutte.polish_iterations = 0;
+    absl::StatusOr<Points> disk =
+        MapToBoundary(shapes_[0], triangles_, boundary_, circle, tutte, cancel_);
+    if (!disk.ok()) return disk;
+    bool embedded = true;
+    for (const Triangle& t : triangles_) {
+      embedded &= ExactOrientation((*disk)[t[0]], (*disk)[t[1]], (*disk)[t[2]]) > 0;
+    }
+    if (!embedded) {
+      return absl::FailedPreconditionError("overlay: the convex embedding has a flat triangle");
+    }
+    return disk;
+  }
+
+  // Every vertex of the refinement in every drawing: the input's where they were, and in the
+  // new drawing (last shape) on their loop position or by their barycentric coordinates in the
+  // chord triangle holding them; the crossings on their mesh edge and on their chord.
+  OverlayResult PlaceVertices(Overlay& overlay, const Points& circle, const Points& disk) const {
+    OverlayResult result;
+    const int total = overlay.num_vertices();
+    result.shapes = shapes_;
+    for (Points& s : result.shapes) s.resize(total);
+    Points target(total);
+    for (int v = 0; v < m_; ++v) {
+      if (const int k = overlay.LoopPosition(v); k >= 0) {
+        target[v] = target_[k];
+        continue;
+      }
+      const auto& corners = chords_.corners[overlay.LocateVertex(v)];
+      const Point& a = circle[corners[0]];
+      const Point& b = circle[corners[1]];
+      const Point& c = circle[corners[2]];
+      const Point& p = disk[v];
+      const double area = Cross(b - a, c - a);
+      const double lb = Cross(p - a, c - a) / area, lc = Cross(b - a, p - a) / area;
+      target[v] = (1.0 - lb - lc) * target_[corners[0]] + lb * target_[corners[1]] +
+                  lc * target_[corners[2]];
+    }
+    for (size_t i = 0; i < overlay.crossings().size(); ++i) {
+      const Crossing& x = overlay.crossings()[i];
+      const int v = m_ + static_cast<int>(i);
+      for (Points& s : result.shapes) s[v] = (1.0 - x.t) * s[x.u] + x.t * s[x.v];
+      const auto& e = chords_.ends[x.chord];
+      target[v] = (1.0 - x.s) * target_[e[0]] + x.s * target_[e[1]];
+    }
+    result.shapes.push_back(std::move(target));
+    return result;
+  }
+
+  // With a cut (original_ not empty), its copies glued back to the vertices they stand for and
+  // the crossings renumbered after the kept vertices.
+  void GlueCopies(OverlayResult* result) const {
+    if (original_.empty()) return;
+    const auto glued = [&](int v) { return v < m_ ? original_[v] : kept_ + (v - m_); };
+    for (Triangle& t : result->triangles) {
+      for (int& v : t) v = glued(v);
+    }
+    for (Points& s : result->shapes) {
+      Points g(s.begin(), s.begin() + kept_);
+      g.insert(g.end(), s.begin() + m_, s.end());
+      s = std::move(g);
+    }
+  }
+
+  // Crossings that cut slivers off a mesh triangle (a chord passing near one of its vertices)
+  // merge into a neighbour where that leaves every drawing's thinnest triangle no thinner
+  // (collapse_vertices.h); the input's vertices stay.
+  absl::Status MergeCrossings(OverlayResult* result) const {
+    absl::StatusOr<CollapseResult> coarse =
+        CollapseVertices(result->triangles, result->shapes, fixed_, CollapseOptions{}, cancel_);
+    if (!coarse.ok()) return coarse.status();
+    result->triangles = std::move(coarse->triangles);
+    result->shapes = std::move(coarse->shapes);
+    result->added_vertices -= coarse->removed;
+    return absl::OkStatus();
+  }
+
+  const std::vector<Triangle>& triangles_;
+  const std::vector<Points>& shapes_;
+  const std::vector<int>& boundary_;
+  const Points& target_;
+  const Chords& chords_;
+  const std::vector<int>& original_;
+  const int kept_;
+  const int fixed_;
+  const CancelToken* cancel_;
+  const int max_vertices_;
+  const int refine_bound_;
+  const int m_;   // vertices of the disk mesh
+  const int nb_;  // boundary vertices
+  // arc_[k]: the first shape's arc length along the boundary up to loop position k (k <= nb_).
+  std::vector<double> arc_;
+};
+
 // The overlay proper: the disk mesh (vertices 0..m-1 in every shape, boundary loop `boundary`)
 // with the chord triangulation of the new drawing (target[k]: where loop position k lies).
 // original[v] (empty: v itself) is the vertex (< kept) disk vertex v stands for: copies made by
 // a cut are glued back to it, so the result's vertices are the kept ones, then the crossings.
 // Vertices from `fixed` on (the crossings, and vertices the caller added) may be merged away.
+// Placements are tried in the order of kCircleBlends until one is good (kGoodQuality).
 absl::StatusOr<OverlayResult> OverlayDisk(const std::vector<Triangle>& triangles,
                                           const std::vector<Points>& shapes,
                                           const std::vector<int>& boundary,
@@ -474,179 +728,28 @@ absl::StatusOr<OverlayResult> OverlayDisk(const std::vector<Triangle>& triangles
     return absl::Status(chords.status().code(),
                         absl::StrCat("overlay: ", chords.status().message()));
   }
-  const int m = static_cast<int>(shapes[0].size());
-  const int nb = static_cast<int>(boundary.size());
-  // The bound is on the result, after the merges (which take about two in three crossings); the
-  // refinement before them may have kPreMergeFactor times as many vertices.
-  const int refine_bound =
-      max_vertices <= 0
-          ? 0
-          : static_cast<int>(std::max<long long>(
-                max_vertices,
-                std::min<long long>(kPreMergeFactor * static_cast<long long>(max_vertices),
-                                    kMaxPreMergeVertices)));
-  const auto too_many = [max_vertices] {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("overlay: the refinement needs more than ", max_vertices, " vertices"));
-  };
-  // Loop positions on the circle: arc length of the first shape blended with even spacing (the
-  // blend changes between attempts; some even share keeps every step positive).
-  std::vector<double> arc(nb + 1, 0.0);
-  for (int k = 0; k < nb; ++k) {
-    arc[k + 1] = arc[k] + (shapes[0][boundary[(k + 1) % nb]] - shapes[0][boundary[k]]).norm();
-  }
+  const DiskOverlay overlay(triangles, shapes, boundary, target_boundary, *chords, original, kept,
+                            fixed, cancel, max_vertices);
   absl::Status last = absl::FailedPreconditionError("overlay: no attempt");
-  // Placements tried in turn, the first whose worst triangle is at least kGoodQuality kept, else
-  // the best: the spacing (even, or partly by arc length) decides where chords pass close to
-  // mesh vertices and cut thin pieces. Even spacing first: arc length crowds short boundary
-  // edges, whose chords then graze the vertices between them.
-  constexpr double kBlends[] = {0.0, 0.5, 0.9, 0.25, 0.75, 0.6};
-  constexpr double kGoodQuality = 1e-3;
   std::optional<OverlayResult> best;
   double best_quality = 0.0;
-  for (int attempt = 0; attempt < 6 && best_quality < kGoodQuality; ++attempt) {
+  for (int attempt = 0;
+       attempt < static_cast<int>(std::size(kCircleBlends)) && best_quality < kGoodQuality;
+       ++attempt) {
     if (Cancelled(cancel)) return absl::CancelledError("overlay cancelled");
-    // Each point also moves by a pseudo-random fraction of under a quarter of the even step
-    // (symmetric drawings put mesh vertices on chords otherwise).
-    const double blend = arc[nb] > 0 ? kBlends[attempt] : 0.0;
-    std::uint64_t state = 0x9E3779B97F4A7C15ull * (attempt + 1);
-    Points circle(nb);
-    for (int k = 0; k < nb; ++k) {
-      state = state * 6364136223846793005ull + 1442695040888963407ull;
-      const double jitter = 0.2 * ((state >> 11) * 0x1.0p-53 - 0.5) * (1.0 - blend) / nb;
-      const double share =
-          (arc[nb] > 0 ? blend * arc[k] / arc[nb] : 0.0) + (1.0 - blend) * k / nb + jitter;
-      const double angle = 2.0 * std::numbers::pi * share;
-      circle[k] = Point(std::cos(angle), std::sin(angle));
-    }
-    if (!StrictlyConvex(circle)) {
-      last = absl::FailedPreconditionError("overlay: the circle's points are not convex");
+    DiskOverlay::Outcome outcome = overlay.Try(attempt);
+    if (outcome.fatal) return outcome.result.status();
+    if (!outcome.result.ok()) {
+      last = outcome.result.status();
       continue;
     }
-    MapToBoundaryOptions tutte;
-    tutte.tutte_when_convex = true;
-    tutte.polish_iterations = 0;
-    absl::StatusOr<Points> disk =
-        MapToBoundary(shapes[0], triangles, boundary, circle, tutte, cancel);
-    if (!disk.ok()) {
-      if (absl::IsCancelled(disk.status()) || absl::IsResourceExhausted(disk.status())) {
-        return disk.status();
-      }
-      last = disk.status();
-      continue;
-    }
-    bool embedded = true;
-    for (const Triangle& t : triangles) {
-      embedded &= ExactOrientation((*disk)[t[0]], (*disk)[t[1]], (*disk)[t[2]]) > 0;
-    }
-    if (!embedded) {
-      last = absl::FailedPreconditionError("overlay: the convex embedding has a flat triangle");
-      continue;
-    }
-
-    Overlay overlay(triangles, boundary, *disk, circle, *chords);
-    if (absl::Status run = overlay.Run(cancel, refine_bound); !run.ok()) {
-      return absl::IsResourceExhausted(run) ? too_many() : run;
-    }
-
-    OverlayResult result;
-    const int total = overlay.num_vertices();
-    result.shapes = shapes;
-    for (Points& s : result.shapes) s.resize(total);
-    Points target(total);
-    for (int v = 0; v < m; ++v) {
-      if (const int k = overlay.LoopPosition(v); k >= 0) {
-        target[v] = target_boundary[k];
-        continue;
-      }
-      const auto& corners = chords->corners[overlay.LocateVertex(v)];
-      const Point& a = circle[corners[0]];
-      const Point& b = circle[corners[1]];
-      const Point& c = circle[corners[2]];
-      const Point& p = (*disk)[v];
-      const double area = Cross(b - a, c - a);
-      const double lb = Cross(p - a, c - a) / area, lc = Cross(b - a, p - a) / area;
-      target[v] = (1.0 - lb - lc) * target_boundary[corners[0]] + lb * target_boundary[corners[1]] +
-                  lc * target_boundary[corners[2]];
-    }
-    for (size_t i = 0; i < overlay.crossings().size(); ++i) {
-      const Crossing& x = overlay.crossings()[i];
-      const int v = m + static_cast<int>(i);
-      for (Points& s : result.shapes) s[v] = (1.0 - x.t) * s[x.u] + x.t * s[x.v];
-      const auto& e = chords->ends[x.chord];
-      target[v] = (1.0 - x.s) * target_boundary[e[0]] + x.s * target_boundary[e[1]];
-    }
-    result.shapes.push_back(std::move(target));
-
-    // Fan each cell from the corner that keeps its smallest triangle largest, relative to the
-    // cell, over every drawing.
-    for (const Overlay::Cell& cell : overlay.cells()) {
-      const int m = static_cast<int>(cell.vertices.size());
-      int best = 0;
-      double best_worst = -std::numeric_limits<double>::infinity();
-      for (int apex = 0; apex < m && m > 3; ++apex) {
-        double worst = std::numeric_limits<double>::infinity();
-        for (const Points& s : result.shapes) {
-          double cell_area = 0.0;
-          for (int i = 1; i + 1 < m; ++i) {
-            cell_area += Cross(s[cell.vertices[i]] - s[cell.vertices[0]],
-                               s[cell.vertices[i + 1]] - s[cell.vertices[0]]);
-          }
-          const Point& o = s[cell.vertices[apex]];
-          for (int i = 1; i + 1 < m; ++i) {
-            const Point& p = s[cell.vertices[(apex + i) % m]];
-            const Point& q = s[cell.vertices[(apex + i + 1) % m]];
-            worst = std::min(worst, Cross(p - o, q - o) / std::abs(cell_area));
-          }
-        }
-        if (worst > best_worst) best_worst = worst, best = apex;
-      }
-      for (int i = 1; i + 1 < m; ++i) {
-        result.triangles.push_back({cell.vertices[best], cell.vertices[(best + i) % m],
-                                    cell.vertices[(best + i + 1) % m]});
-      }
-    }
-    if (!original.empty()) {  // the cut's copies glued back, crossings renumbered after them
-      const auto glued = [&](int v) { return v < m ? original[v] : kept + (v - m); };
-      for (Triangle& t : result.triangles) {
-        for (int& v : t) v = glued(v);
-      }
-      for (Points& s : result.shapes) {
-        Points g(s.begin(), s.begin() + kept);
-        g.insert(g.end(), s.begin() + m, s.end());
-        s = std::move(g);
-      }
-    }
-    result.added_vertices = static_cast<int>(result.shapes[0].size()) - fixed;
-    // Crossings that cut slivers off a mesh triangle (a chord passing near one of its
-    // vertices) merge into a neighbour where that leaves every drawing's thinnest triangle no
-    // thinner (collapse_vertices.h); the input's vertices stay.
-    {
-      absl::StatusOr<CollapseResult> coarse =
-          CollapseVertices(result.triangles, result.shapes, fixed, CollapseOptions{}, cancel);
-      if (!coarse.ok()) return coarse.status();
-      result.triangles = std::move(coarse->triangles);
-      result.shapes = std::move(coarse->shapes);
-      result.added_vertices -= coarse->removed;
-    }
-    if (max_vertices > 0 && fixed + result.added_vertices > max_vertices) {
-      last = too_many();  // another placement may cut fewer pieces
-      continue;
-    }
-    // Positive in doubles, as every later stage judges a triangle (validate.h's CountInverted),
-    // and how thin the thinnest is (4 sqrt(3) area / sum of squared edges: 1 equilateral).
-    double worst = std::numeric_limits<double>::infinity();
-    for (const Points& s : result.shapes) {
-      worst = std::min(worst, CountInverted(result.triangles, s) == 0
-                                  ? WorstTriangleQuality(result.triangles, s)
-                                  : -1.0);
-    }
+    const double worst = WorstQuality(*outcome.result);
     if (!(worst > 0)) {
       last = absl::FailedPreconditionError(
           "overlay: a cell is too thin for double precision in some drawing");
       continue;
     }
-    if (worst > best_quality) best_quality = worst, best = std::move(result);
+    if (worst > best_quality) best_quality = worst, best = *std::move(outcome.result);
   }
   if (best.has_value()) return *std::move(best);
   return last;
