@@ -84,28 +84,51 @@ Sampled SampleLoop(const Points& loop, const LoopAlignmentOptions& options) {
   return out;
 }
 
-}  // namespace
-
-LoopAlignment AlignLoops(const Points& a_loop, const Points& b_loop, double hint,
-                         const LoopAlignmentOptions& options) {
-  const Sampled sa = SampleLoop(a_loop, options);
-  const Sampled sb = SampleLoop(b_loop, options);
-  const int m = static_cast<int>(sa.s.size()), n = static_cast<int>(sb.s.size());
-  // a's start: its most turning sample (the earliest of equals).
+// a's start: its most turning sample (the earliest of equals).
+int MostTurningSample(const Sampled& sa) {
   int a0 = 0;
-  for (int i = 1; i < m; ++i) {
+  for (int i = 1; i < static_cast<int>(sa.s.size()); ++i) {
     if (std::abs(sa.turn[i]) > std::abs(sa.turn[a0]) + 1e-12) a0 = i;
   }
-  auto ia = [&](int i) { return (a0 + i) % m; };
-  std::vector<double> ua(m + 1);  // a's arc fraction from its start
-  for (int i = 0; i < m; ++i) {
-    double s = sa.s[ia(i)] - sa.s[a0];
-    if (s < 0) s += sa.length;
-    ua[i] = s / sa.length;
-  }
-  ua[m] = 1.0;
+  return a0;
+}
 
-  // Starts on b.
+// Each sample's arc length from sample `start` (round the loop, in sample order) as a fraction
+// of the loop's length; one more entry, 1, closes the loop.
+std::vector<double> FractionsFrom(const Sampled& l, int start) {
+  const int n = static_cast<int>(l.s.size());
+  std::vector<double> u(n + 1);
+  for (int j = 0; j < n; ++j) {
+    double s = l.s[(start + j) % n] - l.s[start];
+    if (s < 0) s += l.length;
+    u[j] = s / l.length;
+  }
+  u[n] = 1.0;
+  return u;
+}
+
+// The sample of b nearest the fraction `hint` of its arc length.
+int NearestSample(const Sampled& sb, double hint) {
+  const int n = static_cast<int>(sb.s.size());
+  int hint_j = 0;
+  double h = std::fmod(hint * sb.length, sb.length);
+  if (h < 0) h += sb.length;
+  double best = kInf;
+  for (int j = 0; j < n; ++j) {
+    const double gap = std::abs(sb.s[j] - h);
+    const double d = std::min(gap, sb.length - gap);
+    if (d < best) best = d, hint_j = j;
+  }
+  return hint_j;
+}
+
+// The samples of b tried as the match of a's start a0, in the order tried, at most
+// options.max_starts: the hint's sample; where a's start is a corner, b's samples that turn the
+// same way by at least half as much (closest turn first, at most half the starts); the hint's
+// neighbours; then samples spread evenly round b from the hint.
+std::vector<int> StartsOnB(const Sampled& sa, int a0, const Sampled& sb, double hint,
+                           const LoopAlignmentOptions& options) {
+  const int n = static_cast<int>(sb.s.size());
   std::vector<int> starts;
   auto add_start = [&](int j) {
     j = ((j % n) + n) % n;
@@ -114,17 +137,7 @@ LoopAlignment AlignLoops(const Points& a_loop, const Points& b_loop, double hint
       starts.push_back(j);
     }
   };
-  int hint_j = 0;
-  {
-    double h = std::fmod(hint * sb.length, sb.length);
-    if (h < 0) h += sb.length;
-    double best = kInf;
-    for (int j = 0; j < n; ++j) {
-      const double gap = std::abs(sb.s[j] - h);
-      const double d = std::min(gap, sb.length - gap);
-      if (d < best) best = d, hint_j = j;
-    }
-  }
+  const int hint_j = NearestSample(sb, hint);
   add_start(hint_j);
   const double corner = options.corner_angle_degrees * M_PI / 180.0;
   if (std::abs(sa.turn[a0]) > corner) {
@@ -143,74 +156,209 @@ LoopAlignment AlignLoops(const Points& a_loop, const Points& b_loop, double hint
   const int spread = std::max(1, options.max_starts - static_cast<int>(starts.size()));
   for (int k = 1; k <= spread; ++k)
     add_start(hint_j + static_cast<int>(std::lround(1.0 * k * n / (spread + 1))));
+  return starts;
+}
 
-  const int step = std::max(1, options.max_step);
-  const int width = n + 1;
-  std::vector<double> cost((m + 1) * width);
-  std::vector<uint8_t> back((m + 1) * width);
+// (arc on a, arc on b), unwrapped from a's and b's starts.
+using ArcPath = std::vector<std::pair<double, double>>;
+
+// The banded DP of the module comment over cells (i, j): i samples of a and j of b past their
+// starts (a's start fixed, b's per Run). The cost and back-pointer tables are reused from start
+// to start; a back pointer packs a step's sample counts as di * 16 + dj.
+class BandedAlignment {
+ public:
+  BandedAlignment(const Sampled& sa, const Sampled& sb, int a0, const LoopAlignmentOptions& options)
+      : sa_(sa),
+        sb_(sb),
+        options_(options),
+        a0_(a0),
+        m_(static_cast<int>(sa.s.size())),
+        n_(static_cast<int>(sb.s.size())),
+        step_(std::max(1, options.max_step)),
+        width_(n_ + 1),
+        ua_(FractionsFrom(sa, a0)),
+        cost_((m_ + 1) * width_),
+        back_((m_ + 1) * width_) {}
+
+  // The cheapest path's cost from b's start j0, or a value not below `bound` once no path can
+  // cost less than `bound` (the best start's so far).
+  double Run(int j0, double bound);
+  // The back pointers of the last Run.
+  const std::vector<uint8_t>& back() const { return back_; }
+  // The path recorded in `back` (a Run's back pointers from b's start j0), from (a0, b0) to
+  // (a0 + length a, b0 + length b).
+  ArcPath Trace(int j0, const std::vector<uint8_t>& back) const;
+
+ private:
+  double RowsMin(int i) const;
+  void Relax(int i, int j, int j0, const std::vector<double>& ub);
+
+  const Sampled& sa_;
+  const Sampled& sb_;
+  const LoopAlignmentOptions& options_;
+  const int a0_, m_, n_, step_, width_;
+  const std::vector<double> ua_;  // a's arc fractions from its start
+  std::vector<double> cost_;
+  std::vector<uint8_t> back_;
+};
+
+// The least cost in rows i .. i + step - 1. Costs only grow along a path, and every path to the
+// end passes through one of these rows (whose cells rows before i have all reached): once none
+// holds a cell below the best start's total, this start cannot win (the result is the same; a
+// bad start is left after a few rows).
+double BandedAlignment::RowsMin(int i) const {
+  double row_min = kInf;
+  for (int r = i; r < std::min(m_ + 1, i + step_); ++r) {
+    for (int j = 0; j <= n_; ++j) row_min = std::min(row_min, cost_[r * width_ + j]);
+  }
+  return row_min;
+}
+
+// Every step of 1..step samples of both loops out of cell (i, j), priced as in the header;
+// samples a step skips add their squared turns.
+void BandedAlignment::Relax(int i, int j, int j0, const std::vector<double>& ub) {
+  auto ia = [&](int k) { return (a0_ + k) % m_; };
+  auto jb = [&](int k) { return (j0 + k) % n_; };
+  const double here = cost_[i * width_ + j];
+  double skipped_a = 0.0;
+  for (int di = 1; di <= step_ && i + di <= m_; ++di) {
+    const int i1 = i + di;
+    const double la = ua_[i1] - ua_[i];
+    const Point& pa = sa_.p[ia(i1)];
+    const double ta = sa_.turn[ia(i1)];
+    double skipped_b = 0.0;
+    for (int dj = 1; dj <= step_ && j + dj <= n_; ++dj) {
+      const int j1 = j + dj;
+      // Both ends of the loops are reached together (the path closes on the start pair).
+      if ((i1 == m_) != (j1 == n_)) {
+        skipped_b += sb_.turn[jb(j1)] * sb_.turn[jb(j1)];
+        continue;
+      }
+      if (std::abs(ub[j1] - ua_[i1]) > options_.band && j1 != n_) {
+        skipped_b += sb_.turn[jb(j1)] * sb_.turn[jb(j1)];
+        continue;
+      }
+      const double lb = ub[j1] - ub[j];
+      const double tb = sb_.turn[jb(j1)];
+      const double stretch = (la - lb) * (la - lb) / (la + lb);
+      const double turn = (ta - tb) * (ta - tb) + skipped_a + skipped_b;
+      const double position = (pa - sb_.p[jb(j1)]).squaredNorm() * 0.5 * (la + lb);
+      const double c = here + options_.stretch_weight * stretch + options_.turn_weight * turn +
+                       options_.position_weight * position;
+      double& there = cost_[i1 * width_ + j1];
+      if (c < there) there = c, back_[i1 * width_ + j1] = static_cast<uint8_t>(di * 16 + dj);
+      skipped_b += tb * tb;
+    }
+    skipped_a += ta * ta;
+  }
+}
+
+double BandedAlignment::Run(int j0, double bound) {
+  const std::vector<double> ub = FractionsFrom(sb_, j0);
+  std::fill(cost_.begin(), cost_.end(), kInf);
+  cost_[0] = 0.0;
+  for (int i = 0; i < m_; ++i) {
+    if (!(RowsMin(i) < bound)) break;
+    for (int j = 0; j < n_; ++j) {
+      if (cost_[i * width_ + j] == kInf) continue;
+      Relax(i, j, j0, ub);
+    }
+  }
+  return cost_[m_ * width_ + n_];
+}
+
+ArcPath BandedAlignment::Trace(int j0, const std::vector<uint8_t>& back) const {
+  ArcPath path;
+  const std::vector<double> ubest = FractionsFrom(sb_, j0);
+  int i = m_, j = n_;
+  while (i > 0 || j > 0) {
+    path.push_back({sa_.s[a0_] + ua_[i] * sa_.length, sb_.s[j0] + ubest[j] * sb_.length});
+    const uint8_t code = back[i * width_ + j];
+    i -= code / 16, j -= code % 16;
+  }
+  path.push_back({sa_.s[a0_], sb_.s[j0]});
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+// |turn| of the first sample of `s` at or after `arc` (wrapping to sample 0).
+double TurnAtOrAfter(const Sampled& s, double arc) {
+  const auto it = std::lower_bound(s.s.begin(), s.s.end(), arc - 1e-12 * s.length);
+  const size_t i = it == s.s.end() ? 0 : static_cast<size_t>(it - s.s.begin());
+  return std::abs(s.turn[i]);
+}
+
+// Only the pairs where either loop turns (kKnotDegrees in the sample's window) are kept as
+// knots, and the path's ends: between them the correspondence is linear in both arc lengths, so
+// the DP's staircase of 1..max_step steps on a straight side or a gentle curve does not show,
+// and a polygon and its affine copy correspond exactly (by arc length between matched corners).
+ArcPath KeepTurningKnots(const ArcPath& path, const Sampled& sa, const Sampled& sb) {
+  const double knot = kKnotDegrees * M_PI / 180.0;
+  ArcPath kept;
+  for (size_t k = 0; k < path.size(); ++k) {
+    const double arc_a = path[k].first, arc_b = path[k].second;
+    double fa = std::fmod(arc_a, sa.length), fb = std::fmod(arc_b, sb.length);
+    if (k == 0 || k + 1 == path.size() || TurnAtOrAfter(sa, fa) > knot ||
+        TurnAtOrAfter(sb, fb) > knot) {
+      kept.push_back(path[k]);
+    }
+  }
+  return kept;
+}
+
+// The knots re-based so that a starts at arc 0 (a's start sample at arc `start_a`): b at a's
+// arc length `length a` (unwrapped), then the pairs past it (a - length a), then those before
+// it (b + length b); as fractions of each loop's length, b shifted into [0, 1) at a's 0.
+void RebaseOntoA(const ArcPath& path, const Sampled& sa, const Sampled& sb, double start_a,
+                 LoopAlignment* out) {
+  const double la = sa.length;
+  double b_star = path.front().second;
+  if (start_a > 0.0) {
+    for (size_t k = 0; k + 1 < path.size(); ++k) {
+      if (path[k].first <= la && la <= path[k + 1].first) {
+        const double f = (la - path[k].first) / (path[k + 1].first - path[k].first);
+        b_star = path[k].second + f * (path[k + 1].second - path[k].second);
+        break;
+      }
+    }
+  }
+  out->a.push_back(0.0);
+  out->b.push_back(b_star);
+  if (start_a > 0.0) {
+    for (size_t k = 0; k + 1 < path.size(); ++k) {
+      if (path[k].first > la)
+        out->a.push_back(path[k].first - la), out->b.push_back(path[k].second);
+    }
+    for (size_t k = 0; k + 1 < path.size(); ++k) {
+      if (path[k].first < la) {
+        out->a.push_back(path[k].first), out->b.push_back(path[k].second + sb.length);
+      }
+    }
+  } else {
+    for (size_t k = 1; k + 1 < path.size(); ++k) {
+      out->a.push_back(path[k].first), out->b.push_back(path[k].second);
+    }
+  }
+  const double shift = std::floor(out->b[0] / sb.length) * sb.length;
+  for (double& a : out->a) a /= sa.length;
+  for (double& b : out->b) b = (b - shift) / sb.length;
+}
+
+}  // namespace
+
+LoopAlignment AlignLoops(const Points& a_loop, const Points& b_loop, double hint,
+                         const LoopAlignmentOptions& options) {
+  const Sampled sa = SampleLoop(a_loop, options);
+  const Sampled sb = SampleLoop(b_loop, options);
+  const int a0 = MostTurningSample(sa);
+  // Every start's DP; the cheapest wins (ties: the earliest tried).
+  BandedAlignment dp(sa, sb, a0, options);
   std::vector<uint8_t> best_back;
   int best_start = -1;
   double best_cost = kInf;
-  std::vector<double> ub(n + 1);
-  // Squared turns, for the samples a step skips.
-  for (const int j0 : starts) {
-    for (int j = 0; j < n; ++j) {
-      double s = sb.s[(j0 + j) % n] - sb.s[j0];
-      if (s < 0) s += sb.length;
-      ub[j] = s / sb.length;
-    }
-    ub[n] = 1.0;
-    auto jb = [&](int j) { return (j0 + j) % n; };
-    std::fill(cost.begin(), cost.end(), kInf);
-    cost[0] = 0.0;
-    for (int i = 0; i < m; ++i) {
-      // Costs only grow along a path, and every path to the end passes through one of rows
-      // i .. i + step - 1 (whose cells rows before i have all reached): once none of them holds
-      // a cell below the best start's total, this start cannot win (the result is the same; a
-      // bad start is left after a few rows).
-      double row_min = kInf;
-      for (int r = i; r < std::min(m + 1, i + step); ++r) {
-        for (int j = 0; j <= n; ++j) row_min = std::min(row_min, cost[r * width + j]);
-      }
-      if (!(row_min < best_cost)) break;
-      for (int j = 0; j < n; ++j) {
-        const double here = cost[i * width + j];
-        if (here == kInf) continue;
-        double skipped_a = 0.0;
-        for (int di = 1; di <= step && i + di <= m; ++di) {
-          const int i1 = i + di;
-          const double la = ua[i1] - ua[i];
-          const Point& pa = sa.p[ia(i1)];
-          const double ta = sa.turn[ia(i1)];
-          double skipped_b = 0.0;
-          for (int dj = 1; dj <= step && j + dj <= n; ++dj) {
-            const int j1 = j + dj;
-            // Both ends of the loops are reached together (the path closes on the start pair).
-            if ((i1 == m) != (j1 == n)) {
-              skipped_b += sb.turn[jb(j1)] * sb.turn[jb(j1)];
-              continue;
-            }
-            if (std::abs(ub[j1] - ua[i1]) > options.band && j1 != n) {
-              skipped_b += sb.turn[jb(j1)] * sb.turn[jb(j1)];
-              continue;
-            }
-            const double lb = ub[j1] - ub[j];
-            const double tb = sb.turn[jb(j1)];
-            const double stretch = (la - lb) * (la - lb) / (la + lb);
-            const double turn = (ta - tb) * (ta - tb) + skipped_a + skipped_b;
-            const double position = (pa - sb.p[jb(j1)]).squaredNorm() * 0.5 * (la + lb);
-            const double c = here + options.stretch_weight * stretch + options.turn_weight * turn +
-                             options.position_weight * position;
-            double& there = cost[i1 * width + j1];
-            if (c < there) there = c, back[i1 * width + j1] = static_cast<uint8_t>(di * 16 + dj);
-            skipped_b += tb * tb;
-          }
-          skipped_a += ta * ta;
-        }
-      }
-    }
-    const double total = cost[m * width + n];
-    if (total < best_cost) best_cost = total, best_start = j0, best_back = back;
+  for (const int j0 : StartsOnB(sa, a0, sb, hint, options)) {
+    const double total = dp.Run(j0, best_cost);
+    if (total < best_cost) best_cost = total, best_start = j0, best_back = dp.back();
   }
   LoopAlignment out;
   if (best_start < 0) {  // no path within the band (cannot happen with the hint's diagonal)
@@ -220,78 +368,7 @@ LoopAlignment AlignLoops(const Points& a_loop, const Points& b_loop, double hint
     return out;
   }
   out.cost = best_cost;
-  // The path, as unwrapped arcs from a's and b's starts.
-  std::vector<std::pair<double, double>> path;  // (arc on a, arc on b), unwrapped
-  {
-    std::vector<double> ubest(n + 1);
-    for (int j = 0; j < n; ++j) {
-      double s = sb.s[(best_start + j) % n] - sb.s[best_start];
-      if (s < 0) s += sb.length;
-      ubest[j] = s / sb.length;
-    }
-    ubest[n] = 1.0;
-    int i = m, j = n;
-    while (i > 0 || j > 0) {
-      path.push_back({sa.s[a0] + ua[i] * sa.length, sb.s[best_start] + ubest[j] * sb.length});
-      const uint8_t code = best_back[i * width + j];
-      i -= code / 16, j -= code % 16;
-    }
-    path.push_back({sa.s[a0], sb.s[best_start]});
-    std::reverse(path.begin(), path.end());  // from (a0, b0) to (a0 + length, b0 + length)
-  }
-  // Only the pairs where either loop turns (kKnotDegrees in the sample's window) are kept as
-  // knots: between them the correspondence is linear in both arc lengths, so the DP's staircase
-  // of 1..max_step steps on a straight side or a gentle curve does not show, and a polygon and
-  // its affine copy correspond exactly (by arc length between matched corners).
-  {
-    const double knot = kKnotDegrees * M_PI / 180.0;
-    std::vector<std::pair<double, double>> kept;
-    for (size_t k = 0; k < path.size(); ++k) {
-      const double arc_a = path[k].first, arc_b = path[k].second;
-      double fa = std::fmod(arc_a, sa.length), fb = std::fmod(arc_b, sb.length);
-      auto turn_at = [](const Sampled& s, double arc) {
-        const auto it = std::lower_bound(s.s.begin(), s.s.end(), arc - 1e-12 * s.length);
-        const size_t i = it == s.s.end() ? 0 : static_cast<size_t>(it - s.s.begin());
-        return std::abs(s.turn[i]);
-      };
-      if (k == 0 || k + 1 == path.size() || turn_at(sa, fa) > knot || turn_at(sb, fb) > knot) {
-        kept.push_back(path[k]);
-      }
-    }
-    path = std::move(kept);
-  }
-  // Re-based so that a starts at arc 0: b at a's arc length `length a` (unwrapped), then the
-  // pairs past it (a - length a), then those before it (b + length b).
-  const double la = sa.length;
-  double b_star = path.front().second;
-  if (sa.s[a0] > 0.0) {
-    for (size_t k = 0; k + 1 < path.size(); ++k) {
-      if (path[k].first <= la && la <= path[k + 1].first) {
-        const double f = (la - path[k].first) / (path[k + 1].first - path[k].first);
-        b_star = path[k].second + f * (path[k + 1].second - path[k].second);
-        break;
-      }
-    }
-  }
-  out.a.push_back(0.0);
-  out.b.push_back(b_star);
-  if (sa.s[a0] > 0.0) {
-    for (size_t k = 0; k + 1 < path.size(); ++k) {
-      if (path[k].first > la) out.a.push_back(path[k].first - la), out.b.push_back(path[k].second);
-    }
-    for (size_t k = 0; k + 1 < path.size(); ++k) {
-      if (path[k].first < la) {
-        out.a.push_back(path[k].first), out.b.push_back(path[k].second + sb.length);
-      }
-    }
-  } else {
-    for (size_t k = 1; k + 1 < path.size(); ++k) {
-      out.a.push_back(path[k].first), out.b.push_back(path[k].second);
-    }
-  }
-  const double shift = std::floor(out.b[0] / sb.length) * sb.length;
-  for (double& a : out.a) a /= sa.length;
-  for (double& b : out.b) b = (b - shift) / sb.length;
+  RebaseOntoA(KeepTurningKnots(dp.Trace(best_start, best_back), sa, sb), sa, sb, sa.s[a0], &out);
   return out;
 }
 

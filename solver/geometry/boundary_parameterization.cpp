@@ -1,0 +1,320 @@
+// The parameterization step of ComputeBoundaryCorrespondence: per loop group and drawing, the
+// map from the common parameter to arc length. Marks pin matching points (snapped onto nearby
+// corners) with arc length between them; without marks, corners matched to corners do the same
+// (BoundaryCorrespondenceOptions::match_corners), else the feature alignment (loop_alignment.h)
+// or arc length from the automatically aligned start.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <numeric>
+#include <optional>
+
+#include "absl/strings/str_cat.h"
+#include "solver/geometry/boundary_correspondence_internal.h"
+#include "solver/geometry/loop_alignment.h"
+#include "solver/geometry/primitives.h"
+#include "solver/geometry/resample_outline.h"
+
+namespace inbetween::solver::boundary_internal {
+namespace {
+
+// A mark computed by a program lands a hair off the drawn corner (an SVG written with four
+// decimals puts it 5e-5 units, 1e-7 of the diagonal, from an arrow's corner); pinned there it
+// splits the boundary next to the corner's own breakpoint into a sliver interval that every
+// drawing must repeat, and the mesher then fails on the sliver in another drawing. So a mark
+// within this fraction of its drawing's bounding-box diagonal of a corner of the loop
+// (FindCorners at corner_angle_degrees) snaps onto that corner, else onto the nearest vertex of
+// the loop within it (BoundaryCorrespondenceOptions::marks).
+constexpr double kMarkSnapRelative = 1e-5;
+
+// A corner of a loop: its arc length, the sign of its turn (+1 convex, -1 reflex, for a loop
+// with the drawing on its left) and the turn's angle (radians, unsigned).
+struct Corner {
+  double arc;
+  int turn;
+  double angle;
+};
+
+// The corners of `c` (FindCorners at corner_angle_degrees), by arc length.
+std::vector<Corner> CornersOf(const Curve& c, double corner_angle_degrees) {
+  std::vector<Corner> out;
+  const size_t n = c.p.size();
+  for (int k : FindCorners(c.p, corner_angle_degrees)) {
+    const Point in = c.p[k] - c.p[(k + n - 1) % n], next = c.p[(k + 1) % n] - c.p[k];
+    const double cross = Cross(in, next);
+    out.push_back({c.cum[k], cross > 0.0 ? 1 : -1, std::atan2(std::abs(cross), in.dot(next))});
+  }
+  std::sort(out.begin(), out.end(), [](const Corner& a, const Corner& b) { return a.arc < b.arc; });
+  return out;
+}
+
+// Automatic corner matching (BoundaryCorrespondenceOptions::match_corners): for one loop group
+// without marks, pairs of (arc in drawing 1, arcs in every drawing) of corners matched to
+// corners, or nothing. Every drawing must have as many corners on the loop as drawing 1; they are
+// matched in cyclic order, each pair turning the same way, at the shift that best agrees in the
+// pairs' turn angles and with the automatic alignment (`start`: drawing d's arc aligned with
+// drawing 1's arc 0). The turn angles weigh kTurnWeight times more: corners are matched when arc
+// length failed, often because the alignment is far off (a needle's tip aligned with its blunt
+// end, half the loop away), while the turn angles tell the tip from the other corners; the
+// alignment decides between corners that turn alike (a square's, a parallelogram's).
+// Corners are first every vertex turning by more than kFineCornerDegrees (a polygon and its
+// affine copy: vertex onto vertex); if their counts differ, every vertex that is not collinear
+// with its neighbours (turning by more than kCollinearDegrees: a shear can take a vertex's turn
+// across 1 degree, but an affine map keeps collinear points collinear); else those above
+// `corner_angle_degrees`.
+constexpr double kFineCornerDegrees = 1.0;
+constexpr double kCollinearDegrees = 1e-6;
+constexpr double kTurnWeight = 10.0;
+
+std::vector<ArcPin> MatchCornersAbove(const std::vector<const Curve*>& curves,
+                                      const std::vector<double>& start,
+                                      double corner_angle_degrees);
+
+std::vector<ArcPin> MatchCorners(const std::vector<const Curve*>& curves,
+                                 const std::vector<double>& start, double corner_angle_degrees) {
+  for (double degrees : {std::min(kFineCornerDegrees, corner_angle_degrees), kCollinearDegrees,
+                         corner_angle_degrees}) {
+    auto pairs = MatchCornersAbove(curves, start, degrees);
+    if (!pairs.empty()) return pairs;
+  }
+  return {};
+}
+
+std::vector<ArcPin> MatchCornersAbove(const std::vector<const Curve*>& curves,
+                                      const std::vector<double>& start,
+                                      double corner_angle_degrees) {
+  const int num_shapes = static_cast<int>(curves.size());
+  const std::vector<Corner> first = CornersOf(*curves[0], corner_angle_degrees);
+  const int n = static_cast<int>(first.size());
+  if (n == 0) return {};
+  std::vector<ArcPin> pairs(n);
+  for (int i = 0; i < n; ++i) {
+    pairs[i] = {first[i].arc, std::vector<double>(num_shapes)};
+    pairs[i].second[0] = first[i].arc;
+  }
+  for (int d = 1; d < num_shapes; ++d) {
+    const Curve& c = *curves[d];
+    std::vector<Corner> corners = CornersOf(c, corner_angle_degrees);
+    if (static_cast<int>(corners.size()) != n) return {};
+    // Corner fractions of the loop, counted from the aligned start, in increasing order.
+    std::vector<std::pair<double, int>> at;
+    for (int j = 0; j < n; ++j) at.push_back({Wrap01((corners[j].arc - start[d]) / c.length()), j});
+    std::sort(at.begin(), at.end());
+    int best = -1;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < n; ++r) {
+      double cost = 0.0;
+      for (int i = 0; i < n && cost < best_cost; ++i) {
+        const auto& [fraction, j] = at[(i + r) % n];
+        const double gap = std::abs(fraction - first[i].arc / curves[0]->length());
+        const double dist = std::min(gap, 1.0 - gap);
+        if (corners[j].turn != first[i].turn) {
+          cost = std::numeric_limits<double>::infinity();
+        }
+        const double turn = (corners[j].angle - first[i].angle) / std::numbers::pi;
+        cost += dist * dist + kTurnWeight * turn * turn;
+      }
+      if (cost < best_cost) best_cost = cost, best = r;
+    }
+    if (best < 0) return {};
+    // The matched corners' arcs, measured from the first pair's corner, must increase strictly
+    // (else no match).
+    const double first_arc = corners[at[best].second].arc;
+    double previous = -1.0;
+    for (int i = 0; i < n; ++i) {
+      const double arc = corners[at[(i + best) % n].second].arc;
+      const double from_first = std::fmod(arc - first_arc + c.length(), c.length());
+      if (!(from_first > previous)) return {};
+      previous = from_first;
+      pairs[i].second[d] = arc;
+    }
+  }
+  return pairs;
+}
+
+// Arc length `at` on `c` snapped onto the nearest corner within `tolerance`, else the nearest
+// vertex within it, else unchanged (kMarkSnapRelative). Distances are along the loop: a loop
+// that passes twice through one point (the two sides of a cut) must not send the mark to the
+// other pass.
+double SnapMark(const Curve& c, double at, double tolerance, double corner_angle_degrees) {
+  const double length = c.length();
+  auto nearest = [&](const std::vector<int>& indices) {
+    int best = -1;
+    double best_dist = tolerance;
+    for (int k : indices) {
+      const double gap = std::abs(c.cum[k] - at);
+      const double dist = std::min(gap, length - gap);
+      if (dist <= best_dist) best_dist = dist, best = k;
+    }
+    return best;
+  };
+  int k = nearest(FindCorners(c.p, corner_angle_degrees));
+  if (k < 0) {
+    std::vector<int> all(c.p.size());
+    std::iota(all.begin(), all.end(), 0);
+    k = nearest(all);
+  }
+  return k < 0 ? at : c.cum[k];
+}
+
+// A mark placed on its loop group: the group, and its arc on the group's loop in every drawing
+// (snapped, SnapMark).
+struct PlacedMark {
+  int group = -1;
+  std::vector<double> at;
+};
+
+// Mark m (`mark`: its point in every drawing) placed on the loop group nearest its point in
+// drawing 1. INVALID_ARGUMENT naming the mark when it has the wrong number of points or sits far
+// from that loop in some drawing: a mark far away is a mistake, not a pin.
+absl::StatusOr<PlacedMark> PlaceMark(const GroupedLoops& loops, const std::vector<Point>& mark,
+                                     size_t m, double corner_angle_degrees) {
+  const int num_shapes = loops.num_shapes();
+  if (static_cast<int>(mark.size()) != num_shapes) {
+    return absl::InvalidArgumentError(absl::StrCat("mark ", m + 1, " has ", mark.size(),
+                                                   " points for ", num_shapes, " drawings"));
+  }
+  PlacedMark out;
+  double best = std::numeric_limits<double>::infinity(), at0 = 0;
+  for (int g = 0; g < loops.num_groups(); ++g) {
+    double dist;
+    const double a = loops.curve(0, g).Project(mark[0], &dist);
+    if (dist < best) best = dist, out.group = g, at0 = a;
+  }
+  out.at.assign(num_shapes, at0);
+  for (int d = 0; d < num_shapes; ++d) {
+    const Curve& c = loops.curve(d, out.group);
+    double dist = best;
+    if (d > 0) out.at[d] = c.Project(mark[d], &dist);
+    out.at[d] =
+        SnapMark(c, out.at[d], kMarkSnapRelative * loops.normalised.scale[d], corner_angle_degrees);
+    if (!(dist <= kMarkRelativeTolerance * c.length())) {
+      const Point& p = mark[d];
+      return absl::InvalidArgumentError(
+          absl::StrCat("drawing ", d + 1, ": correspondence mark ", m + 1, " at (", p.x(), ", ",
+                       p.y(), ") is ", dist, " from the nearest boundary, more than ",
+                       kMarkRelativeTolerance * 100, "% of that boundary's length"));
+    }
+  }
+  return out;
+}
+
+// Group g's start in every drawing: the arc aligned with drawing 1's arc 0 (AlignStart, drawing
+// 1's loop carried by its component's map where one carried the holes).
+std::vector<double> AlignedStarts(const GroupedLoops& loops, int g) {
+  const NormalisedLoops& n = loops.normalised;
+  std::vector<double> start(loops.num_shapes(), 0.0);
+  for (int d = 1; d < loops.num_shapes(); ++d) {
+    const std::optional<Affine>& carry = loops.groups.carry[g][d];
+    start[d] = AlignStart(loops.curve(0, g), loops.curve(d, g), n.centre[0], n.scale[0],
+                          n.centre[d], n.scale[d], carry.has_value() ? &*carry : nullptr);
+  }
+  return start;
+}
+
+// Group g's loop in drawing d paired with drawing 1's by the feature alignment
+// (loop_alignment.h), the aligned start `start` one of the starts it tries; `p` holds the loop's
+// length and receives the knots.
+void AlignFeatures(const GroupedLoops& loops, int g, int d, double start,
+                   double corner_angle_degrees, Param* p) {
+  const NormalisedLoops& n = loops.normalised;
+  // Both loops in their drawings' normalised frames, for the alignment's position term.
+  Points a = loops.curve(0, g).p, b = loops.curve(d, g).p;
+  for (Point& q : a) q = (q - n.centre[0]) / n.scale[0];
+  for (Point& q : b) q = (q - n.centre[d]) / n.scale[d];
+  LoopAlignmentOptions align;
+  align.corner_angle_degrees = corner_angle_degrees;
+  const LoopAlignment al = AlignLoops(a, b, start / p->length, align);
+  for (size_t k = 0; k < al.a.size(); ++k) {
+    p->t.push_back(al.a[k]);
+    p->a.push_back(al.b[k] * p->length);
+  }
+}
+
+// Knots at the pins (marks or matched corners) of drawing d, arc length between them; `p` holds
+// the loop's length. INVALID_ARGUMENT when the pins are not in drawing 1's cyclic order.
+absl::Status KnotsAtPins(const std::vector<ArcPin>& pins, int d, double len0, Param* p) {
+  const double base0 = pins[0].first, based = pins[0].second[d];
+  for (size_t j = 0; j < pins.size(); ++j) {
+    double a = pins[j].second[d] - based;
+    a = std::fmod(a + p->length, p->length);
+    if (j > 0 && !(a > p->a.back() - based)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("drawing ", d + 1,
+                       ": correspondence marks on one boundary are not in the same "
+                       "order as in drawing 1 (or two marks coincide)"));
+    }
+    p->t.push_back((pins[j].first - base0) / len0);
+    p->a.push_back(based + a);
+  }
+  return absl::OkStatus();
+}
+
+// Group g's parameterization in every drawing (out->param[d][g]) and its pinned parameters.
+// Without marks: the automatic alignment, and corners matched to corners where every drawing
+// has as many on this loop (they then pin the parameterization as marks would, without being
+// marks: not pinned in the optimizer, not in mark_vertices).
+absl::Status ParameterizeGroup(const GroupedLoops& loops, int g,
+                               const BoundaryCorrespondenceOptions& options,
+                               Parameterization* out) {
+  const int num_shapes = loops.num_shapes();
+  std::sort(out->marks[g].begin(), out->marks[g].end());
+  std::vector<double> start(num_shapes, 0.0);
+  std::vector<ArcPin> corner_pairs;
+  if (out->marks[g].empty()) {
+    start = AlignedStarts(loops, g);
+    if (options.match_corners) {
+      std::vector<const Curve*> loop_curves;
+      for (int d = 0; d < num_shapes; ++d) loop_curves.push_back(&loops.curve(d, g));
+      corner_pairs = MatchCorners(loop_curves, start, options.corner_angle_degrees);
+    }
+  }
+  out->corner_matched_loops += corner_pairs.empty() ? 0 : 1;
+  const std::vector<ArcPin>& pins = out->marks[g].empty() ? corner_pairs : out->marks[g];
+  const double len0 = loops.curve(0, g).length();
+  for (const ArcPin& pin : pins) out->pinned_t[g].push_back((pin.first - pins[0].first) / len0);
+  for (int d = 0; d < num_shapes; ++d) {
+    Param& p = out->param[d][g];
+    p.length = loops.curve(d, g).length();
+    // A loop that its component's affine map carried (components with holes, MatchHoles)
+    // keeps arc length from the carried start: that map already pairs the loops point by
+    // point, and an affine map changes the turns the alignment weighs (a sheared flower's
+    // outline: arc length 0.5-0.7 units off the affine correspondence, the alignment
+    // 1.4-2.8).
+    if (pins.empty() && d > 0 && !loops.groups.carry[g][d].has_value() &&
+        options.alignment == BoundaryCorrespondenceOptions::Alignment::kFeatures) {
+      AlignFeatures(loops, g, d, start[d], options.corner_angle_degrees, &p);
+    } else if (pins.empty()) {
+      p.t = {0.0};
+      p.a = {start[d]};
+    } else if (absl::Status s = KnotsAtPins(pins, d, len0, &p); !s.ok()) {
+      return s;
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<Parameterization> ParameterizeGroups(const GroupedLoops& loops,
+                                                    const BoundaryCorrespondenceOptions& options) {
+  const int num_groups = loops.num_groups();
+  Parameterization out;
+  out.param.assign(loops.num_shapes(), std::vector<Param>(num_groups));
+  out.marks.resize(num_groups);
+  out.pinned_t.resize(num_groups);
+  for (size_t m = 0; m < options.marks.size(); ++m) {
+    absl::StatusOr<PlacedMark> placed =
+        PlaceMark(loops, options.marks[m], m, options.corner_angle_degrees);
+    if (!placed.ok()) return placed.status();
+    out.marks[placed->group].push_back({placed->at[0], placed->at});
+    out.mark_at.push_back({placed->group, placed->at[0]});
+  }
+  for (int g = 0; g < num_groups; ++g) {
+    if (absl::Status s = ParameterizeGroup(loops, g, options, &out); !s.ok()) return s;
+  }
+  return out;
+}
+
+}  // namespace inbetween::solver::boundary_internal
