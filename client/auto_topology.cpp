@@ -7,6 +7,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "solver/core/error_reason.h"
 #include "solver/geometry/auto_topology.h"
 #include "solver/io/svg_import.h"
 
@@ -90,7 +91,7 @@ absl::Status ApplyAutoTopology(Project* project, const std::filesystem::path& wr
 }
 
 absl::Status AdviseAutoTopology(const absl::Status& status) {
-  if (status.ok() || !absl::StrContains(status.message(), "must have the same topology")) {
+  if (solver::ErrorReason(status) != solver::kReasonTopologyDiffers) {
     return status;
   }
   return absl::Status(

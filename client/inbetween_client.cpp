@@ -8,6 +8,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "solver/core/error_reason.h"
 
 namespace inbetween::client {
 
@@ -43,7 +44,20 @@ absl::Status FromGrpcStatus(const grpc::Status& status) {
       return absl::ResourceExhaustedError(named);
     }
   }
-  return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+  absl::Status out(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+  // The service's reason, sent as a google.rpc.ErrorInfo in the status details.
+  v1::ErrorStatus details;
+  if (status.error_details().empty() || !details.ParseFromString(status.error_details())) {
+    return out;
+  }
+  for (const v1::ErrorDetail& detail : details.details()) {
+    v1::ErrorInfo info;
+    if (detail.type_url() == solver::kErrorInfoTypeUrl && info.ParseFromString(detail.value()) &&
+        info.domain() == solver::kErrorDomain && !info.reason().empty()) {
+      return solver::WithReason(out, info.reason());
+    }
+  }
+  return out;
 }
 
 std::shared_ptr<grpc::Channel> CreateChannelForServer(
@@ -64,8 +78,7 @@ bool IsTransient(const grpc::Status& status) {
 // The server's per-token heavy-job limit (server/heavy_jobs.cpp). After a transient failure it is
 // most likely our own broken attempt, whose job the server is still winding down: worth a retry.
 bool IsOwnHeavyJobLimit(const grpc::Status& status) {
-  return status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED &&
-         absl::StrContains(status.error_message(), "--max-heavy-jobs-per-token");
+  return solver::ErrorReason(FromGrpcStatus(status)) == solver::kReasonHeavyJobsPerToken;
 }
 
 // gRPC aborts the process on a metadata value outside printable ASCII (API misuse), so such a

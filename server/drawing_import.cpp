@@ -13,6 +13,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "server/proto_convert.h"
+#include "solver/core/error_reason.h"
 #include "solver/geometry/polygon.h"
 #include "solver/io/svg_import.h"
 
@@ -335,8 +336,7 @@ absl::StatusOr<ImportedDrawing> ImportDrawing(const v1::Drawing& drawing,
       }
       absl::StatusOr<solver::Drawing> parsed = solver::ImportSvg(drawing.svg(), options, &info);
       if (!parsed.ok()) {
-        const bool limit = absl::IsResourceExhausted(parsed.status()) &&
-                           absl::StrContains(parsed.status().message(), " points");
+        const bool limit = solver::ErrorReason(parsed.status()) == solver::kReasonDrawingPointLimit;
         return absl::Status(
             parsed.status().code(),
             absl::StrCat(field, ".svg: ", parsed.status().message(),

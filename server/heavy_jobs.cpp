@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "solver/core/error_reason.h"
 
 namespace inbetween::server {
 
@@ -29,11 +30,13 @@ absl::StatusOr<HeavyJobs::Slot> HeavyJobs::Acquire(const std::string& owner,
   int& mine = per_owner_[owner];
   if (mine >= max_per_owner_) {
     if (mine == 0) per_owner_.erase(owner);
-    return absl::ResourceExhaustedError(
-        absl::StrCat("this token already has ", max_per_owner_,
-                     " heavy jobs (build, optimize, inbetween) running or queued, the limit "
-                     "(--max-heavy-jobs-per-token); retry after ",
-                     kBusyRetryAfterSeconds, " s or when one finishes"));
+    return solver::WithReason(
+        absl::ResourceExhaustedError(absl::StrCat(
+            "this token already has ", max_per_owner_,
+            " heavy jobs (build, optimize, inbetween) running or queued, the limit "
+            "(--max-heavy-jobs-per-token); retry after ",
+            kBusyRetryAfterSeconds, " s or when one finishes")),
+        solver::kReasonHeavyJobsPerToken);
   }
   if (running_ >= max_running_) {
     if (queued_ >= max_queued_) {

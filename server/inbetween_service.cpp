@@ -34,6 +34,7 @@
 #include "solver/art/art_embedding.h"
 #include "solver/comesh/comesh_objective.h"
 #include "solver/comesh/comesh_optimizer.h"
+#include "solver/core/error_reason.h"
 #include "solver/geometry/graph_flow.h"
 #include "solver/interp/inbetweener.h"
 #include "solver/interp/timing.h"
@@ -1031,8 +1032,7 @@ grpc::Status InbetweenService::BuildMultimesh(
         }
         if (options_.metrics) options_.metrics->ObserveStage("build", seconds);
         // The mesher's refinement stops at --max-mesh-vertices; say which limit it hit.
-        if (absl::IsResourceExhausted(mesh.status()) &&
-            absl::StrContains(mesh.status().message(), "refinement needs more than")) {
+        if (solver::ErrorReason(mesh.status()) == solver::kReasonMeshVertexLimit) {
           return absl::ResourceExhaustedError(absl::StrCat(
               mesh.status().message(), "; the limit is ", options_.limits.max_mesh_vertices,
               " mesh vertices (--max-mesh-vertices): use fewer boundary_vertices or a larger "

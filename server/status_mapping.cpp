@@ -1,7 +1,10 @@
-// absl::Status -> grpc::Status, code for code, message unchanged.
+// absl::Status -> grpc::Status, code for code, message unchanged, a reason as ErrorInfo details.
 #include "server/status_mapping.h"
 
 #include <string>
+
+#include "inbetween/v1/inbetween.pb.h"
+#include "solver/core/error_reason.h"
 
 namespace inbetween::server {
 namespace {
@@ -53,7 +56,19 @@ grpc::StatusCode ToGrpcCode(absl::StatusCode code) {
 
 grpc::Status ToGrpcStatus(const absl::Status& status) {
   if (status.ok()) return grpc::Status::OK;
-  return grpc::Status(ToGrpcCode(status.code()), std::string(status.message()));
+  const grpc::StatusCode code = ToGrpcCode(status.code());
+  const std::string reason = solver::ErrorReason(status);
+  if (reason.empty()) return grpc::Status(code, std::string(status.message()));
+  inbetween::v1::ErrorInfo info;
+  info.set_reason(reason);
+  info.set_domain(std::string(solver::kErrorDomain));
+  inbetween::v1::ErrorStatus details;
+  details.set_code(static_cast<int32_t>(code));
+  details.set_message(std::string(status.message()));
+  inbetween::v1::ErrorDetail* detail = details.add_details();
+  detail->set_type_url(std::string(solver::kErrorInfoTypeUrl));
+  detail->set_value(info.SerializeAsString());
+  return grpc::Status(code, std::string(status.message()), details.SerializeAsString());
 }
 
 }  // namespace inbetween::server

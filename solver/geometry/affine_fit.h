@@ -1,5 +1,5 @@
 // The least-squares affine map between two point lists: the loop matching carries drawing 1's
-// loops by it (boundary_correspondence.cpp), and the map into another drawing starts from it
+// loops by it (boundary_loop_matching.cpp), and the map into another drawing starts from it
 // when it folds nothing (map_to_boundary.cpp).
 #pragma once
 

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "solver/core/error_reason.h"
 #include "solver/geometry/boundary_correspondence_internal.h"
 #include "solver/geometry/primitives.h"
 #include "solver/geometry/resample_outline.h"
@@ -645,7 +646,7 @@ absl::Status CheckSameEquivalence(const std::vector<BoundaryGraph>& graphs) {
                   " — the drawings must have the same topology: add an opening (a slit that "
                   "becomes a hole) where a drawing has fewer holes, or a cut where it has fewer "
                   "components");
-  return absl::InvalidArgumentError(message);
+  return WithReason(absl::InvalidArgumentError(message), kReasonTopologyDiffers);
 }
 
 absl::StatusOr<BoundaryCorrespondence> ComputeBoundaryCorrespondence(

@@ -38,6 +38,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "solver/core/error_reason.h"
 #include "solver/geometry/polygon.h"
 #include "solver/geometry/primitives.h"
 #include "solver/io/paint_union.h"
@@ -1281,7 +1282,8 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
     Context context(&collector, root);
     Traversal::load_document(root, context);
   } catch (const TooManyPoints& e) {
-    return absl::ResourceExhaustedError(absl::StrCat("SVG has ", e.message));
+    return WithReason(absl::ResourceExhaustedError(absl::StrCat("SVG has ", e.message)),
+                      kReasonDrawingPointLimit);
   } catch (const TooManyLayers& e) {
     return absl::ResourceExhaustedError(absl::StrCat("SVG has ", e.message));
   } catch (const boost::exception& e) {

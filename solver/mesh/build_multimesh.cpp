@@ -15,6 +15,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "solver/art/art_embedding.h"
+#include "solver/core/error_reason.h"
 #include "solver/geometry/boundary_correspondence.h"
 #include "solver/geometry/graph_flow.h"
 #include "solver/mesh/cgal_triangulate.h"
@@ -610,9 +611,7 @@ class AttemptBuilder {
     absl::StatusOr<DomainTriangulation> triangulation =
         CgalTriangulateDomain(bc_.shapes[ref_], ReferenceMeshOptions());
     if (!triangulation.ok()) {
-      return absl::Status(
-          triangulation.status().code(),
-          absl::StrCat("drawing ", ref_ + 1, ": ", triangulation.status().message()));
+      return Prefixed(triangulation.status(), absl::StrCat("drawing ", ref_ + 1, ": "));
     }
     absl::StatusOr<CutMesh> cut = CutAlongSeams(*triangulation, bc_);
     if (!cut.ok()) {

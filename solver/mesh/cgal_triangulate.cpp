@@ -22,6 +22,7 @@
 #include <stdexcept>
 
 #include "absl/strings/str_cat.h"
+#include "solver/core/error_reason.h"
 #include "solver/geometry/polygon.h"
 #include "solver/geometry/primitives.h"
 
@@ -139,10 +140,12 @@ absl::Status RefineBounded(Cdt& cdt, const Criteria& criteria, int max_vertices,
     last_inserted.set = false;
     mesher.try_one_step_refine_mesh();
     if (max_vertices > 0 && cdt.number_of_vertices() > static_cast<size_t>(max_vertices)) {
-      return absl::ResourceExhaustedError(absl::StrCat(
-          "triangulate: refinement needs more than ", max_vertices,
-          " vertices (a part of the drawing is far thinner than the rest: a sliver, a spike or "
-          "boundaries that nearly touch)"));
+      return WithReason(
+          absl::ResourceExhaustedError(absl::StrCat(
+              "triangulate: refinement needs more than ", max_vertices,
+              " vertices (a part of the drawing is far thinner than the rest: a sliver, a spike "
+              "or boundaries that nearly touch)")),
+          kReasonMeshVertexLimit);
     }
     if (!last_inserted.set) continue;
     const CgalPoint p(last_inserted.x, last_inserted.y);

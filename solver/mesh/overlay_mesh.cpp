@@ -14,6 +14,7 @@
 #include <tuple>
 
 #include "absl/strings/str_cat.h"
+#include "solver/core/error_reason.h"
 #include "solver/geometry/primitives.h"
 #include "solver/mesh/cgal_predicates.h"
 #include "solver/mesh/cgal_triangulate.h"
@@ -208,8 +209,10 @@ class Overlay {
     for (size_t t = 0; t < triangles_.size(); ++t) {
       if ((t & 1023) == 0 && Cancelled(cancel)) return absl::CancelledError("overlay cancelled");
       if (max_vertices > 0 && num_vertices() > max_vertices) {
-        return absl::ResourceExhaustedError(
-            absl::StrCat("overlay: the refinement needs more than ", max_vertices, " vertices"));
+        return WithReason(absl::ResourceExhaustedError(absl::StrCat(
+                              "overlay: the refinement needs more than ", max_vertices,
+                              " vertices")),
+                          kReasonMeshVertexLimit);
       }
       const Triangle& tri = triangles_[t];
       Point lo = disk_[tri[0]], hi = lo;
@@ -480,8 +483,9 @@ int RefineBound(int max_vertices) {
 }
 
 absl::Status TooManyVertices(int max_vertices) {
-  return absl::ResourceExhaustedError(
-      absl::StrCat("overlay: the refinement needs more than ", max_vertices, " vertices"));
+  return WithReason(absl::ResourceExhaustedError(absl::StrCat(
+                        "overlay: the refinement needs more than ", max_vertices, " vertices")),
+                    kReasonMeshVertexLimit);
 }
 
 // The worst triangle quality of the result over every drawing (4 sqrt(3) area / sum of squared

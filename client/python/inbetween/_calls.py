@@ -43,8 +43,7 @@ def retry_wait(policy: RetryPolicy, mode: str, attempt: int, error: InbetweenErr
     """The wait before attempt ``attempt + 1``, or None when ``error`` is final."""
     if mode == NEVER or (cancel is not None and cancel.cancelled):
         return None
-    orphan = (heavy and attempt > 1 and error.code == "RESOURCE_EXHAUSTED"
-              and "--max-heavy-jobs-per-token" in error.details)
+    orphan = heavy and attempt > 1 and error.reason == "HEAVY_JOBS_PER_TOKEN"
     if not (is_transient(error) or orphan) or attempt >= policy.max_attempts:
         return None
     wait = policy.backoff(attempt)

@@ -24,10 +24,14 @@ class InbetweenError(Exception):
     ``retry_after_ms``: the server's hint on a busy heavy-job pool (RESOURCE_EXHAUSTED), else
     None; ``maybe_applied``: True when an earlier attempt of this call failed in transit and a
     retry then got ABORTED / ALREADY_EXISTS, so the earlier attempt may have taken effect (re-read
-    the session); ``attempts``: how many attempts the call made (retries included)."""
+    the session); ``attempts``: how many attempts the call made (retries included); ``reason``:
+    the server's machine-readable reason (a google.rpc.ErrorInfo in the status details, domain
+    "inbetween.v1": MESH_VERTEX_LIMIT, DRAWING_POINT_LIMIT, TOPOLOGY_DIFFERS,
+    HEAVY_JOBS_PER_TOKEN), else None."""
 
     def __init__(self, code: str, details: str, retry_after_ms: Optional[int] = None,
-                 method: str = "", maybe_applied: bool = False, attempts: int = 1) -> None:
+                 method: str = "", maybe_applied: bool = False, attempts: int = 1,
+                 reason: Optional[str] = None) -> None:
         super().__init__(f"{code}: {details}")
         self.code = code
         self.status_code: Optional[grpc.StatusCode] = getattr(grpc.StatusCode, code, None)
@@ -36,6 +40,7 @@ class InbetweenError(Exception):
         self.method = method
         self.maybe_applied = maybe_applied
         self.attempts = attempts
+        self.reason = reason
 
     @staticmethod
     def from_rpc_error(error: grpc.RpcError, method: str = "") -> "InbetweenError":
@@ -143,6 +148,7 @@ def error_from_rpc(error: grpc.RpcError, method: str = "") -> InbetweenError:
     details_of = getattr(error, "details", None)
     details = (details_of() if callable(details_of) else None) or str(error)
     retry = None
+    reason = None
     trailing_of = getattr(error, "trailing_metadata", None)
     trailing = trailing_of() if callable(trailing_of) else None
     for item in trailing or ():
@@ -153,7 +159,29 @@ def error_from_rpc(error: grpc.RpcError, method: str = "") -> InbetweenError:
                 retry = int(value)
             except (TypeError, ValueError):
                 pass
+        elif key == "grpc-status-details-bin":
+            reason = _reason_of(value)
     name = code.name if isinstance(code, grpc.StatusCode) else str(code)
     if name == "RESOURCE_EXHAUSTED":
         details = _name_size_limit(details)
-    return InbetweenError.of(name, details, retry_after_ms=retry, method=method)
+    return InbetweenError.of(name, details, retry_after_ms=retry, method=method, reason=reason)
+
+
+_ERROR_INFO_TYPE_URL = "type.googleapis.com/google.rpc.ErrorInfo"
+
+
+def _reason_of(details_bin: Any) -> Optional[str]:
+    """The reason of the service's google.rpc.ErrorInfo in a grpc-status-details-bin trailer
+    (inbetween.proto ErrorStatus), or None."""
+    from inbetween.v1 import inbetween_pb2 as pb  # the generated stubs, as the clients use them
+    from google.protobuf.message import DecodeError
+    try:
+        status = pb.ErrorStatus.FromString(bytes(details_bin))
+        for detail in status.details:
+            if detail.type_url == _ERROR_INFO_TYPE_URL:
+                info = pb.ErrorInfo.FromString(detail.value)
+                if info.domain == "inbetween.v1" and info.reason:
+                    return info.reason
+    except (DecodeError, TypeError, ValueError):
+        return None
+    return None

@@ -164,6 +164,22 @@ class ClientTest(unittest.TestCase):
         with open(os.path.join(mesh, "frame_0001.svg"), encoding="utf-8") as source:
             self.assertIn('fill="#8ab"', source.read())  # the triangles, as without art
 
+    def test_errors_carry_the_servers_reason(self):
+        # A square and a square with a hole: the build fails with the reason TOPOLOGY_DIFFERS,
+        # read from the status details, not from the message.
+        session = self.client.create_session("reason")
+        session = self.client.put_svg(
+            session, '<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0 H10 V10 H0 Z"/></svg>')
+        session = self.client.put_svg(
+            session, '<svg xmlns="http://www.w3.org/2000/svg"><path fill-rule="evenodd" '
+                     'd="M0 0 H10 V10 H0 Z M3 3 H7 V7 H3 Z"/></svg>')
+        with self.assertRaises(inbetween.InbetweenError) as failed:
+            self.client.build(session)
+        self.assertEqual(failed.exception.reason, "TOPOLOGY_DIFFERS")
+        with self.assertRaises(inbetween.NotFoundError) as missing:
+            self.client.get_session("no-such-session")
+        self.assertIsNone(missing.exception.reason)
+
     def test_topology_edits_add_move_delete_and_a_bad_edit(self):
         session = self.client.put_svg(self.client.create_session("py-topology"), SQUARE)
         drawing = session.drawings[0].id

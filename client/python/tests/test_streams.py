@@ -93,8 +93,8 @@ class FramesRunTest(unittest.TestCase):
         self.assertIsNone(retry_wait(policy, NEVER, 1, unavailable, budget, None))
         internal = inbetween.InbetweenError.of("INTERNAL", "a bug")
         self.assertIsNone(retry_wait(policy, READ, 1, internal, budget, None))
-        busy = inbetween.InbetweenError.of(
-            "RESOURCE_EXHAUSTED", "over --max-heavy-jobs-per-token 1")
+        busy = inbetween.InbetweenError.of("RESOURCE_EXHAUSTED", "over --max-heavy-jobs-per-token 1",
+                                           reason="HEAVY_JOBS_PER_TOKEN")
         self.assertIsNone(retry_wait(policy, READ, 1, busy, budget, None, heavy=True))
         self.assertEqual(retry_wait(policy, READ, 2, busy, budget, None, heavy=True), 0.5)
         self.assertIsNone(retry_wait(policy, READ, 1, unavailable, Budget(0.05, "x"), None))

@@ -24,6 +24,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "server/inbetween_server.h"
+#include "server/status_mapping.h"
+#include "solver/core/error_reason.h"
 #include "tests/unit/server/many_layers_svg.h"
 
 namespace inbetween::client {
@@ -450,9 +452,12 @@ TEST_F(InbetweenClientFailoverTest, GetSessionAndListSessionsAreRetried) {
 
   // The heavy-job limit is retried only after a transient failure (the broken attempt's job),
   // and no sooner than kOrphanJobBackoff; as the first answer it goes straight back.
-  const grpc::Status busy(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                          "this token already has 2 heavy jobs (build, optimize, inbetween) "
-                          "running or queued, the limit (--max-heavy-jobs-per-token)");
+  // (As the server sends it: the reason in the status details.)
+  const grpc::Status busy = server::ToGrpcStatus(solver::WithReason(
+      absl::ResourceExhaustedError("this token already has 2 heavy jobs (build, optimize, "
+                                   "inbetween) running or queued, the limit "
+                                   "(--max-heavy-jobs-per-token)"),
+      solver::kReasonHeavyJobsPerToken));
   front_->faults = {{kUnavailable, 0}, {busy, 0}};
   ASSERT_TRUE(client->GetSession(session_.id(), false).ok());
   EXPECT_EQ(front_->unary_calls, 9);
@@ -608,6 +613,50 @@ TEST(InbetweenClientLimitsTest, RefusalsNameTheServerFlag) {
   // Other statuses pass unchanged.
   const grpc::Status other(grpc::StatusCode::RESOURCE_EXHAUSTED, "frames = 9 exceeds 8");
   EXPECT_EQ(FromGrpcStatus(other).message(), "frames = 9 exceeds 8");
+}
+
+// A reason the service attaches (status details: a google.rpc.ErrorInfo) comes back as the
+// status's reason, through a real server: a drawing whose topology differs from the other's.
+TEST(InbetweenClientReasonsTest, TheServicesReasonReachesTheClient) {
+  const absl::Status sent = solver::WithReason(absl::ResourceExhaustedError("busy"),
+                                               solver::kReasonHeavyJobsPerToken);
+  const absl::Status back = FromGrpcStatus(server::ToGrpcStatus(sent));
+  EXPECT_EQ(back.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_EQ(back.message(), "busy");
+  EXPECT_EQ(solver::ErrorReason(back), solver::kReasonHeavyJobsPerToken);
+  EXPECT_EQ(solver::ErrorReason(FromGrpcStatus(server::ToGrpcStatus(absl::InternalError("x")))),
+            "");
+  // Details that are not ours are ignored.
+  EXPECT_EQ(solver::ErrorReason(FromGrpcStatus(
+                grpc::Status(grpc::StatusCode::INTERNAL, "x", std::string("\xff\x01garbage")))),
+            "");
+
+  server::ServerOptions options;
+  options.listen = "127.0.0.1:0";
+  auto started = server::InbetweenServer::Start(options);
+  ASSERT_TRUE(started.ok()) << started.status();
+  InbetweenClient client(CreateChannelForServer("127.0.0.1:" + std::to_string((*started)->port()),
+                                                grpc::InsecureChannelCredentials()));
+  auto session = client.CreateSession("topology");
+  ASSERT_TRUE(session.ok()) << session.status();
+  const std::string disc =
+      R"(<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0 H10 V10 H0 Z"/></svg>)";
+  const std::string ring =
+      R"(<svg xmlns="http://www.w3.org/2000/svg"><path fill-rule="evenodd" )"
+      R"(d="M0 0 H10 V10 H0 Z M3 3 H7 V7 H3 Z"/></svg>)";
+  v1::Session current = *session;
+  for (const std::string& svg : {disc, ring}) {
+    v1::PutDrawingRequest request;
+    request.set_session_id(current.id());
+    request.set_expected_version(current.version());
+    request.mutable_drawing()->set_svg(svg);
+    auto put = client.PutDrawing(request);
+    ASSERT_TRUE(put.ok()) << put.status();
+    current = put->session();
+  }
+  auto built = client.BuildMultimesh(current, nullptr);
+  ASSERT_FALSE(built.ok());
+  EXPECT_EQ(solver::ErrorReason(built.status()), solver::kReasonTopologyDiffers) << built.status();
 }
 
 }  // namespace
