@@ -180,17 +180,23 @@ def _arc_length_parameters(path: List[XY], closed: bool) -> List[float]:
     return params
 
 
-def _point_at_parameter(path: List[XY], closed: bool, params: List[float], u: float) -> XY:
-    n = len(path)
-    if n == 1 or params[-1] == 0.0:
-        return path[0]
-    lo, hi = 0, n  # std::upper_bound
+def _upper_bound(params: List[float], u: float) -> int:
+    """std::upper_bound: the first index whose parameter is > u (len(params) if none)."""
+    lo, hi = 0, len(params)
     while lo < hi:
         mid = (lo + hi) // 2
         if params[mid] > u:
             hi = mid
         else:
             lo = mid + 1
+    return lo
+
+
+def _point_at_parameter(path: List[XY], closed: bool, params: List[float], u: float) -> XY:
+    n = len(path)
+    if n == 1 or params[-1] == 0.0:
+        return path[0]
+    lo = _upper_bound(params, u)
     a = 0 if lo == 0 else lo - 1
     if a + 1 == n and not closed:
         return path[n - 1]
@@ -260,14 +266,7 @@ def _squared_distances(a: List[XY], b: List[XY]) -> float:
 
 def _restart_at(path: List[XY], params: List[float], u: float) -> List[XY]:
     n = len(path)
-    lo, hi = 0, n  # std::upper_bound
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if params[mid] > u:
-            hi = mid
-        else:
-            lo = mid + 1
-    a = lo - 1
+    a = _upper_bound(params, u) - 1
     start = _point_at_parameter(path, True, params, u)
     out = [start]
     for k in range(1, n + 1):

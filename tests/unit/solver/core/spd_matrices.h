@@ -1,10 +1,14 @@
 // Test matrices for the sparse Cholesky tests.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <random>
 #include <vector>
+
+#include "solver/core/sparse_cholesky.h"
 
 namespace inbetween::solver::testing {
 
@@ -24,6 +28,23 @@ inline Eigen::SparseMatrix<double> DenseSpd(int n, unsigned seed) {
   m.setFromTriplets(upper.begin(), upper.end());
   m.makeCompressed();
   return m;
+}
+
+// Factors `a` supernodally (it must be large enough to go supernodal) and simplicially and
+// checks that the supernodal solution of two random right-hand sides is right and agrees with
+// the simplicial one.
+inline void ExpectSupernodalSolvesRight(const Eigen::SparseMatrix<double>& a) {
+  SparseCholesky super(SparseCholesky::Method::kAuto), simplicial;
+  ASSERT_TRUE(super.Compute(a).ok());
+  ASSERT_TRUE(super.supernodal());
+  ASSERT_TRUE(simplicial.Compute(a).ok());
+  const Eigen::SparseMatrix<double> full = a.selfadjointView<Eigen::Upper>();
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Random(a.rows(), 2);
+  Eigen::MatrixXd x = b, y = b;
+  ASSERT_TRUE(super.SolveInPlace(&x).ok());
+  ASSERT_TRUE(simplicial.SolveInPlace(&y).ok());
+  EXPECT_LT((full * x - b).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 1e-10 * y.cwiseAbs().maxCoeff());
 }
 
 }  // namespace inbetween::solver::testing
