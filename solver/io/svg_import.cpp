@@ -1216,17 +1216,10 @@ bool NoOverlaps(const std::vector<Outline>& outlines, const PaintRegion& region,
   return std::abs(region.layers_area - region.raw_area) <= 1e-6 * region.raw_area + slivers;
 }
 
-}  // namespace
-
-absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOptions& options,
-                                  SvgImportInfo* info) {
-  if (!(options.tolerance > 0) || !std::isfinite(options.tolerance)) {
-    return absl::InvalidArgumentError("SVG import: tolerance must be a positive number");
-  }
-  if (options.max_points < 1) {
-    return absl::InvalidArgumentError("SVG import: max_points must be positive");
-  }
-  const QuietXmlErrors quiet;
+// The document parsed and checked: well-formed XML with an <svg> root, no entity references,
+// ASCII in the attributes we parse, <use> elements expanded (libxml2 errors are kept quiet by
+// the caller's QuietXmlErrors).
+absl::StatusOr<std::unique_ptr<xmlDoc, DocDeleter>> ParseSvgDocument(std::string_view svg_text) {
   std::unique_ptr<xmlParserCtxt, ParserDeleter> ctxt(xmlNewParserCtxt());
   if (ctxt == nullptr) return absl::ResourceExhaustedError("SVG import: out of memory");
   // No network, no entity substitution, no DTD loading or validation; keep errors quiet.
@@ -1262,14 +1255,16 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
     return absl::Status(bad->code,
                         absl::StrCat("SVG element ", Describe(bad->use), ": ", bad->reason));
   }
+  return doc;
+}
 
-  Collector collector;
-  collector.tolerance = options.tolerance;
-  collector.max_points = static_cast<size_t>(options.max_points);
-  collector.max_layers = static_cast<size_t>(options.max_layers);
-  for (xmlNode* n = root; n != nullptr;) {  // ids, in document order (the first one wins)
+// Walks the document under `root` into `collector` (paint, outlines, cuts, openings, marks,
+// warnings): the ids first, in document order (the first one wins), then the elements. A limit
+// reached or an element that cannot be read ends the walk with its status.
+absl::Status CollectPaint(xmlNode* root, Collector* collector) {
+  for (xmlNode* n = root; n != nullptr;) {
     if (n->type == XML_ELEMENT_NODE) {
-      if (std::optional<std::string> id = Attribute(n, "id")) collector.by_id.emplace(*id, n);
+      if (std::optional<std::string> id = Attribute(n, "id")) collector->by_id.emplace(*id, n);
       if (n->children != nullptr) {
         n = n->children;
         continue;
@@ -1279,7 +1274,7 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
     n = (n == nullptr || n == root) ? nullptr : n->next;
   }
   try {
-    Context context(&collector, root);
+    Context context(collector, root);
     Traversal::load_document(root, context);
   } catch (const TooManyPoints& e) {
     return WithReason(absl::ResourceExhaustedError(absl::StrCat("SVG has ", e.message)),
@@ -1295,17 +1290,19 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   } catch (const std::exception& e) {
     return absl::InvalidArgumentError(absl::StrCat("SVG import failed: ", e.what()));
   }
-  WarnUnsupported(root, &collector.warnings);
-  const bool by_class = !collector.outline_class.empty();
-  if (collector.art.empty() && !by_class) {
-    return absl::InvalidArgumentError(
-        "SVG has no filled shape and no stroke: nothing is painted (elements with fill=\"none\" "
-        "and no stroke, hidden or fully transparent elements and empty paths are ignored)");
-  }
+  return absl::OkStatus();
+}
 
+// The drawing's outlines: the union of all paint (or of the class="outline" elements), or the
+// elements' own outlines when the drawing is one fill whose elements do not overlap; `report`
+// gets the source and the cleaning, `collector` a warning for paint outside the viewBox.
+absl::StatusOr<std::vector<Outline>> SilhouetteOutlines(xmlNode* root,
+                                                        const SvgImportOptions& options,
+                                                        bool by_class, Collector* collector,
+                                                        SvgImportInfo* report) {
   // The silhouette: the union of all paint, or of the class="outline" elements.
   std::vector<const ArtLayer*> silhouette;
-  for (const ArtLayer& layer : by_class ? collector.outline_class : collector.art) {
+  for (const ArtLayer& layer : by_class ? collector->outline_class : collector->art) {
     silhouette.push_back(&layer);
   }
   Point lo(kInf, kInf), hi(-kInf, -kInf);
@@ -1314,25 +1311,11 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
       for (const Point& p : path.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     }
   }
-  // The drawing with the outlines chosen below, and the report on them.
-  SvgImportInfo report;
-  report.fill_rgb = collector.largest_fill;
-  auto finish = [&](std::vector<Outline> outlines) {
-    report.warnings = std::move(collector.warnings);
-    if (info != nullptr) *info = std::move(report);
-    Drawing drawing;
-    drawing.outlines = std::move(outlines);
-    drawing.cuts = std::move(collector.cuts);
-    drawing.openings = std::move(collector.openings);
-    drawing.marks = std::move(collector.marks);
-    drawing.art = std::move(collector.art);
-    return drawing;
-  };
   // Coordinates beyond what the service accepts (|x| <= 1e9) are refused downstream, naming the
   // point; the union (quantized over the paint's extent) is not attempted for them.
   if (!(lo.cwiseAbs().maxCoeff() <= 1e9 && hi.cwiseAbs().maxCoeff() <= 1e9)) {
-    OrientByNesting(&collector.outlines);
-    return finish(std::move(collector.outlines));
+    OrientByNesting(&collector->outlines);
+    return std::move(collector->outlines);
   }
   PaintUnionOptions union_options;
   union_options.arc_tolerance = options.tolerance;
@@ -1343,12 +1326,12 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
   }
   // A drawing of one fill is united without cleaning first: when its elements do not overlap it
   // keeps its own outlines and the cleaning would be wasted (benchmark "import").
-  const bool one_fill = !by_class && OneFill(collector.art);
+  const bool one_fill = !by_class && OneFill(collector->art);
   PaintUnionOptions first = union_options;
   if (one_fill) first.gap_width = first.min_area = 0;
   absl::StatusOr<PaintRegion> region = UnionOfPaint(silhouette, first);
   const bool one_colour =
-      one_fill && region.ok() && NoOverlaps(collector.outlines, *region, options.tolerance);
+      one_fill && region.ok() && NoOverlaps(collector->outlines, *region, options.tolerance);
   if (one_fill && !one_colour && region.ok()) region = UnionOfPaint(silhouette, union_options);
   if (!region.ok()) {
     return absl::InvalidArgumentError(
@@ -1366,18 +1349,18 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
       seen = seen || view->intersects(box);
     }
     if (!seen) {
-      collector.warnings.push_back(
+      collector->warnings.push_back(
           "<svg>: all paint lies outside the viewBox (a browser would show nothing)");
     }
   }
 
   if (one_colour) {
-    OrientByNesting(&collector.outlines);
+    OrientByNesting(&collector->outlines);
     // The one-colour convention: the elements' own outlines, exactly as written.
-    report.source = SilhouetteSource::kElements;
-    report.cleaning.gap_width = union_options.gap_width;
-    report.cleaning.min_area = union_options.min_area;
-    return finish(std::move(collector.outlines));
+    report->source = SilhouetteSource::kElements;
+    report->cleaning.gap_width = union_options.gap_width;
+    report->cleaning.min_area = union_options.min_area;
+    return std::move(collector->outlines);
   }
   if (region->hairline) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -1391,9 +1374,52 @@ absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOpti
                      ": every piece is smaller than the minimum area (", region->cleaning.min_area,
                      " square user units; SvgImportOptions::min_area_fraction)"));
   }
-  report.source = by_class ? SilhouetteSource::kOutlineClass : SilhouetteSource::kUnion;
-  report.cleaning = region->cleaning;
-  return finish(std::move(region->outlines));
+  report->source = by_class ? SilhouetteSource::kOutlineClass : SilhouetteSource::kUnion;
+  report->cleaning = region->cleaning;
+  return std::move(region->outlines);
+}
+
+}  // namespace
+
+absl::StatusOr<Drawing> ImportSvg(std::string_view svg_text, const SvgImportOptions& options,
+                                  SvgImportInfo* info) {
+  if (!(options.tolerance > 0) || !std::isfinite(options.tolerance)) {
+    return absl::InvalidArgumentError("SVG import: tolerance must be a positive number");
+  }
+  if (options.max_points < 1) {
+    return absl::InvalidArgumentError("SVG import: max_points must be positive");
+  }
+  const QuietXmlErrors quiet;
+  absl::StatusOr<std::unique_ptr<xmlDoc, DocDeleter>> doc = ParseSvgDocument(svg_text);
+  if (!doc.ok()) return doc.status();
+  xmlNode* root = xmlDocGetRootElement(doc->get());
+  Collector collector;
+  collector.tolerance = options.tolerance;
+  collector.max_points = static_cast<size_t>(options.max_points);
+  collector.max_layers = static_cast<size_t>(options.max_layers);
+  if (absl::Status s = CollectPaint(root, &collector); !s.ok()) return s;
+  WarnUnsupported(root, &collector.warnings);
+  const bool by_class = !collector.outline_class.empty();
+  if (collector.art.empty() && !by_class) {
+    return absl::InvalidArgumentError(
+        "SVG has no filled shape and no stroke: nothing is painted (elements with fill=\"none\" "
+        "and no stroke, hidden or fully transparent elements and empty paths are ignored)");
+  }
+
+  SvgImportInfo report;
+  report.fill_rgb = collector.largest_fill;
+  absl::StatusOr<std::vector<Outline>> outlines =
+      SilhouetteOutlines(root, options, by_class, &collector, &report);
+  if (!outlines.ok()) return outlines.status();
+  report.warnings = std::move(collector.warnings);
+  if (info != nullptr) *info = std::move(report);
+  Drawing drawing;
+  drawing.outlines = *std::move(outlines);
+  drawing.cuts = std::move(collector.cuts);
+  drawing.openings = std::move(collector.openings);
+  drawing.marks = std::move(collector.marks);
+  drawing.art = std::move(collector.art);
+  return drawing;
 }
 
 }  // namespace inbetween::solver
