@@ -14,6 +14,7 @@
 #include "absl/strings/str_format.h"
 #include "solver/art/blend_paths.h"
 #include "solver/geometry/polygon.h"
+#include "solver/geometry/primitives.h"
 
 namespace inbetween::solver {
 namespace {
@@ -228,13 +229,6 @@ ArtLayer FadedLayer(const EmbeddedLayer& layer, double weight, const Points& fra
   return faded;
 }
 
-// The length of a closed polyline.
-double PathLength(const Points& path) {
-  double length = 0.0;
-  for (size_t i = 0; i < path.size(); ++i) length += (path[(i + 1) % path.size()] - path[i]).norm();
-  return length;
-}
-
 class Morph {
  public:
   Morph(const std::vector<EmbeddedArt>& keys, const Points& frame, const FrameArtOptions& options)
@@ -271,7 +265,9 @@ class Morph {
       // Closed paths drawn from other points or in the other direction in different keys: each
       // runs from the point nearest the first member's start, in its direction, in this frame.
       if (closed && !placed[0].empty()) {
-        for (size_t m = 1; m < placed.size(); ++m) placed[m] = AlignClosedPath(placed[0], placed[m]);
+        for (size_t m = 1; m < placed.size(); ++m) {
+          placed[m] = AlignClosedPath(placed[0], placed[m]);
+        }
       }
       out.paths.push_back({placed[0].empty()
                                ? Points{}
@@ -280,7 +276,6 @@ class Morph {
     }
     return out;
   }
-
 
   // Closed paths in different counts (a face that gains a mouth hole, one cell that becomes two):
   // each path of the member with the most (group[most]) is morphed with the path of every other
@@ -328,7 +323,7 @@ class Morph {
       std::vector<bool> used(own.size(), false);
       for (Pair& pair : pairs) {
         if (used[pair.i] || partner[m][pair.j]) continue;
-        const double length = PathLength(full[pair.j]);
+        const double length = CumulativeLength(full[pair.j]).back();  // the perimeter
         if (!(pair.cost <= kPairDistance * kPairDistance * length * length)) return std::nullopt;
         used[pair.i] = true;
         partner[m][pair.j] = std::move(pair.aligned);
@@ -348,7 +343,9 @@ class Morph {
     std::vector<ArtPath> paths;
     for (size_t j = 0; j < full.size(); ++j) {
       std::vector<Points> placed;
-      for (size_t m = 0; m < group.size(); ++m) placed.push_back(partner[m][j] ? *partner[m][j] : full[j]);
+      for (size_t m = 0; m < group.size(); ++m) {
+        placed.push_back(partner[m][j] ? *partner[m][j] : full[j]);
+      }
       paths.push_back({BlendPaths(placed, true, weights, options_.merge_fraction), true});
     }
     return paths;

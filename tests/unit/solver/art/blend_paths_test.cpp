@@ -56,7 +56,8 @@ TEST(ArtBlendPathsTest, ClosedPathsAreAlignedToTheReferencesStartAndDirection) {
   EXPECT_EQ(AlignClosedPath(square, {{4, 4}, {0, 4}, {0, 0}, {4, 0}}), square);
   EXPECT_EQ(AlignClosedPath(square, {{0, 0}, {0, 4}, {4, 4}, {4, 0}}), square);
   const Points octagon_like = {{2, 0}, {4, 0}, {4, 4}, {0, 4}, {0, 0}};
-  EXPECT_EQ(AlignClosedPath(square, octagon_like), (Points{{0, 0}, {2, 0}, {4, 0}, {4, 4}, {0, 4}}));
+  EXPECT_EQ(AlignClosedPath(square, octagon_like),
+            (Points{{0, 0}, {2, 0}, {4, 0}, {4, 4}, {0, 4}}));
   // A start between the path's own vertices gets a vertex there: same point set.
   const Points shifted = {{1, 1}, {5, 1}, {5, 5}, {1, 5}};
   const Points diamond = {{3, 0}, {6, 3}, {3, 6}, {0, 3}};

@@ -1003,7 +1003,8 @@ TEST(ComeshOptimizerTest, OutlineGuardKeepsTheKeysWithinTheBuildTolerance) {
   unguarded.outline_tolerance = 0.0;
   ComeshReport report, unguarded_report;
   absl::StatusOr<Multimesh> guarded = OptimizeComesh(*m, options, nullptr, nullptr, &report);
-  absl::StatusOr<Multimesh> free = OptimizeComesh(*m, unguarded, nullptr, nullptr, &unguarded_report);
+  absl::StatusOr<Multimesh> free =
+      OptimizeComesh(*m, unguarded, nullptr, nullptr, &unguarded_report);
   ASSERT_TRUE(guarded.ok()) << guarded.status();
   ASSERT_TRUE(free.ok()) << free.status();
   double free_worst = 0.0;
