@@ -84,12 +84,7 @@ chaos() {
   for n in 1 2 3; do pids[replica$n]=$(inspect "replica$n" '{{.State.Pid}}'); done
   cli "${LONG[@]}" --out "$out" >"$out.txt" 2>"$err" &
   pid=$!
-  for _ in $(seq 1 1200); do
-    grep -q '^frames' "$err" && break
-    kill -0 "$pid" 2>/dev/null || break
-    sleep 0.05
-  done
-  grep -q '^frames' "$err" || { cat "$err"; echo "no frame arrived"; return 1; }
+  wait_first_frame "$pid" "$err" || { cat "$err"; echo "no frame arrived"; return 1; }
   kill -STOP "$pid"
   line=$(nginx_log | grep '/inbetween.v1.Inbetween/BuildMultimesh ' | tail -1)
   sid=$(grep -oE 'session=[0-9a-f]+' <<<"$line" | cut -d= -f2)

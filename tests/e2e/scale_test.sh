@@ -59,12 +59,7 @@ chaos_try() {
   local victim="" resume streamed
   cli "${LONG[@]}" --out "$out" >"$out.txt" 2>"$err" &
   cli_pid=$!
-  for _ in $(seq 1 1200); do
-    grep -q '^frames' "$err" && break
-    kill -0 "$cli_pid" 2>/dev/null || break
-    sleep 0.05
-  done
-  grep -q '^frames' "$err" || { cat "$err"; echo "round $r: no frame arrived"; return 1; }
+  wait_first_frame "$cli_pid" "$err" || { cat "$err"; echo "round $r: no frame arrived"; return 1; }
   kill -STOP "$cli_pid" || return 1
   # The CLI's session: the last one built (calls are sequential in this test).
   line=$(grep '|/inbetween.v1.Inbetween/BuildMultimesh|' "$WORK/nginx/access.log" | tail -1)

@@ -28,3 +28,15 @@ start_server() {
   done
   cat "$log"; echo "server did not report its port" >&2; return 1
 }
+
+# Waits (up to 60 s) until the CLI running as PID has written its first "frames" line to the file
+# ERR; fails when it never does (the process ended first, or the time ran out).
+wait_first_frame() {
+  local pid=$1 err=$2
+  for _ in $(seq 1 1200); do
+    grep -q '^frames' "$err" && return 0
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.05
+  done
+  grep -q '^frames' "$err"
+}
