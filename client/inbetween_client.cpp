@@ -52,9 +52,18 @@ absl::Status FromGrpcStatus(const grpc::Status& status) {
   }
   for (const v1::ErrorDetail& detail : details.details()) {
     v1::ErrorInfo info;
+    v1::BadRequest bad;
+    v1::RetryInfo retry;
     if (detail.type_url() == solver::kErrorInfoTypeUrl && info.ParseFromString(detail.value()) &&
         info.domain() == solver::kErrorDomain && !info.reason().empty()) {
-      return solver::WithReason(out, info.reason());
+      out = solver::WithReason(out, info.reason());
+    } else if (detail.type_url() == solver::kBadRequestTypeUrl &&
+               bad.ParseFromString(detail.value()) && bad.field_violations_size() > 0) {
+      out.SetPayload(solver::kErrorFieldPayload, absl::Cord(bad.field_violations(0).field()));
+    } else if (detail.type_url() == solver::kRetryInfoTypeUrl &&
+               retry.ParseFromString(detail.value())) {
+      out = solver::WithRetryAfter(out, retry.retry_delay().seconds() * 1000 +
+                                            retry.retry_delay().nanos() / 1'000'000);
     }
   }
   return out;

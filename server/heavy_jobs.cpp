@@ -30,21 +30,27 @@ absl::StatusOr<HeavyJobs::Slot> HeavyJobs::Acquire(const std::string& owner,
   int& mine = per_owner_[owner];
   if (mine >= max_per_owner_) {
     if (mine == 0) per_owner_.erase(owner);
-    return solver::WithReason(
-        absl::ResourceExhaustedError(absl::StrCat(
-            "this token already has ", max_per_owner_,
-            " heavy jobs (build, optimize, inbetween) running or queued, the limit "
-            "(--max-heavy-jobs-per-token); retry after ",
-            kBusyRetryAfterSeconds, " s or when one finishes")),
-        solver::kReasonHeavyJobsPerToken);
+    return solver::WithRetryAfter(
+        solver::WithReason(
+            absl::ResourceExhaustedError(absl::StrCat(
+                "this token already has ", max_per_owner_,
+                " heavy jobs (build, optimize, inbetween) running or queued, the limit "
+                "(--max-heavy-jobs-per-token); retry after ",
+                kBusyRetryAfterSeconds, " s or when one finishes")),
+            solver::kReasonHeavyJobsPerToken),
+        kBusyRetryAfterSeconds * 1000);
   }
   if (running_ >= max_running_) {
     if (queued_ >= max_queued_) {
       if (mine == 0) per_owner_.erase(owner);
-      return absl::ResourceExhaustedError(
-          absl::StrCat("server busy: ", running_, " heavy jobs running and ", queued_,
-                       " queued, the limits (--max-heavy-jobs, --heavy-queue); retry after ",
-                       kBusyRetryAfterSeconds, " s"));
+      return solver::WithRetryAfter(
+          solver::WithReason(
+              absl::ResourceExhaustedError(absl::StrCat(
+                  "server busy: ", running_, " heavy jobs running and ", queued_,
+                  " queued, the limits (--max-heavy-jobs, --heavy-queue); retry after ",
+                  kBusyRetryAfterSeconds, " s")),
+              solver::kReasonServerBusy),
+          kBusyRetryAfterSeconds * 1000);
     }
     ++queued_;
     ++mine;

@@ -62,6 +62,22 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const Serve
   return grpc::SslServerCredentials(ssl);
 }
 
+// The first line of --redis-password-file (a trailing newline is not part of the password).
+absl::StatusOr<std::string> ReadPasswordFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!in || !std::getline(in, line)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--redis-password-file: cannot read a line from '", path, "'"));
+  }
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--redis-password-file: '", path, "' holds an empty password"));
+  }
+  return line;
+}
+
 absl::StatusOr<std::shared_ptr<SessionStore>> OpenStore(const ServerOptions& options) {
   if (options.store == "memory") {
     return std::make_shared<MemorySessionStore>(options.max_sessions);
@@ -77,6 +93,12 @@ absl::StatusOr<std::shared_ptr<SessionStore>> OpenStore(const ServerOptions& opt
   if (absl::StartsWith(options.store, "redis://")) {
     RedisStoreOptions redis;
     redis.max_sessions = options.max_sessions;
+    redis.session_ttl = options.session_ttl;
+    if (!options.redis_password_file.empty()) {
+      absl::StatusOr<std::string> password = ReadPasswordFile(options.redis_password_file);
+      if (!password.ok()) return password.status();
+      redis.password = *std::move(password);
+    }
     absl::StatusOr<std::unique_ptr<RedisSessionStore>> store =
         RedisSessionStore::Open(options.store, redis);
     if (!store.ok()) return store.status();

@@ -32,6 +32,11 @@ struct ServerOptions {
   // Sessions of the dir and Redis stores not used for this long are dropped from memory (they
   // stay in the store and reload on next use); 0 = never. --idle-evict-seconds.
   std::chrono::seconds idle_evict{600};
+  // Redis store: a session expires this long after its last use (create, write, read); 0 =
+  // never. --session-ttl-seconds.
+  std::chrono::seconds session_ttl{7 * 24 * 3600};
+  // Redis store: a file holding the AUTH password (first line); --redis-password-file.
+  std::string redis_password_file;
   bool reflection = true;
   std::chrono::milliseconds shutdown_grace{5000};
   int max_message_bytes = kMaxMessageBytes;  // --max-message-bytes, both directions

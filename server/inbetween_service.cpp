@@ -589,9 +589,11 @@ absl::Status CheckSessionQuota(const SessionStore& store, const ServiceOptions& 
   if (!options.tokens) return absl::OkStatus();
   const size_t owned = store.CountOwned(caller.owner);
   if (owned >= options.limits.max_sessions_per_token) {
-    return absl::ResourceExhaustedError(absl::StrCat(
-        "this token already has ", owned, " sessions, the limit is ",
-        options.limits.max_sessions_per_token, " (--max-sessions-per-token); delete some first"));
+    return solver::WithReason(
+        absl::ResourceExhaustedError(absl::StrCat(
+            "this token already has ", owned, " sessions, the limit is ",
+            options.limits.max_sessions_per_token, " (--max-sessions-per-token); delete some first")),
+        solver::kReasonSessionsPerToken);
   }
   return absl::OkStatus();
 }

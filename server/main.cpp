@@ -15,6 +15,7 @@
 
 #include "server/inbetween_server.h"
 #include "server/logging.h"
+#include "server/redis_session_store.h"
 #include "server/stop_signals.h"
 #include "solver/core/retain_memory.h"
 
@@ -100,6 +101,15 @@ int main(int argc, char** argv) {
                  "the store on next use); 0 = never")
       ->capture_default_str()
       ->check(CLI::Range(int64_t{0}, int64_t{30'000'000}));
+  int64_t session_ttl_seconds = options.session_ttl.count();
+  app.add_option("--session-ttl-seconds", session_ttl_seconds,
+                 "redis store: a session expires this long after its last use (create, write, "
+                 "read); 0 = never")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t{0}, int64_t{10} * 365 * 24 * 3600));
+  app.add_option("--redis-password-file", options.redis_password_file,
+                 "redis store: file whose first line is Redis' AUTH password (requirepass)")
+      ->check(CLI::ExistingFile);
   app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off")
       ->capture_default_str();
   app.add_option("--log-format", log_format, "text|json")->capture_default_str();
@@ -134,6 +144,7 @@ int main(int argc, char** argv) {
   options.service.log_ok_rpcs_at_info = true;
   options.store = store;
   options.idle_evict = std::chrono::seconds(idle_evict_seconds);
+  options.session_ttl = std::chrono::seconds(session_ttl_seconds);
   options.reflection = !no_reflection;
   options.shutdown_grace = std::chrono::milliseconds(grace_ms);
   auto server = inbetween::server::InbetweenServer::Start(options);
@@ -142,7 +153,8 @@ int main(int argc, char** argv) {
     return server.status().code() == absl::StatusCode::kInvalidArgument ? 2 : 1;
   }
   const std::string address = HostOf(listen) + ":" + std::to_string((*server)->port());
-  spdlog::info("listening on {} (store {}, reflection {}, tls {}, tokens {})", address, store,
+  spdlog::info("listening on {} (store {}, reflection {}, tls {}, tokens {})", address,
+               inbetween::server::RedactRedisUrl(store),
                no_reflection ? "off" : "on", options.tls_cert.empty() ? "off" : "on",
                options.tokens_file.empty() ? "off" : "on");
   if ((*server)->metrics_port() != 0) {

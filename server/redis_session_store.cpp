@@ -14,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
 #include "server/session_snapshot.h"
+#include "solver/core/error_reason.h"
 
 namespace inbetween::server {
 
@@ -37,9 +38,50 @@ std::string AllKey() { return absl::StrCat(kPrefix, "all"); }
 std::string OwnerKey(absl::string_view owner) { return absl::StrCat(kPrefix, "own:", owner); }
 std::string SequenceKey() { return absl::StrCat(kPrefix, "seq"); }
 
+// Lua shared by the scripts below: `now` (Redis' clock, ms) and `sweep`, which drops the index
+// entries (all, own:<owner>, owner, exp) of up to 256 sessions whose hash has expired. An entry of
+// exp is a lower bound (a read extends the TTL without touching exp): a session still present is
+// re-scored by its real expiry. The ZADD is a pcall so that a sweep never fails for memory.
+static_assert(kPrefix == "inbetween:", "kSweepLua's P must equal kPrefix");
+constexpr char kSweepLua[] = R"lua(
+local P = 'inbetween:'
+local function now()
+  local t = redis.call('TIME')
+  return tonumber(t[1]) * 1000 + math.floor(tonumber(t[2]) / 1000)
+end
+local function sweep()
+  local due = redis.call('ZRANGEBYSCORE', P .. 'exp', '-inf', now(), 'LIMIT', 0, 256)
+  for _, id in ipairs(due) do
+    local at = redis.call('PEXPIRETIME', P .. 's:' .. id)
+    if at == -2 then
+      local o = redis.call('HGET', P .. 'owner', id)
+      redis.call('ZREM', P .. 'all', id)
+      if o then redis.call('ZREM', P .. 'own:' .. o, id) end
+      redis.call('HDEL', P .. 'owner', id)
+      redis.call('ZREM', P .. 'exp', id)
+    elseif at == -1 then
+      redis.call('ZREM', P .. 'exp', id)
+    else
+      redis.pcall('ZADD', P .. 'exp', at, id)
+    end
+  end
+end
+-- Sets the session's expiry ttl ms from now (0: none) and records it in exp.
+local function retain(key, id, ttl)
+  if ttl > 0 then
+    redis.call('PEXPIRE', key, ttl)
+    redis.call('ZADD', P .. 'exp', now() + ttl, id)
+  else
+    redis.call('PERSIST', key)
+    redis.call('ZREM', P .. 'exp', id)
+  end
+end
+)lua";
+
 // KEYS: session, all, own:<owner>, seq. ARGV: id, max sessions, version, owner, created,
-// summary, snapshot. Returns {"ok", sequence} | {"exists"} | {"full"}.
-constexpr char kCreateScript[] = R"lua(
+// summary, snapshot, ttl ms. Returns {"ok", sequence} | {"exists"} | {"full"}.
+constexpr char kCreateBody[] = R"lua(
+sweep()
 if redis.call('EXISTS', KEYS[1]) == 1 then return {'exists'} end
 if redis.call('ZCARD', KEYS[2]) >= tonumber(ARGV[2]) then return {'full'} end
 local q = redis.call('INCR', KEYS[4])
@@ -47,30 +89,62 @@ redis.call('HSET', KEYS[1], 'v', ARGV[3], 'o', ARGV[4], 'c', ARGV[5], 'q', q, 'm
            'd', ARGV[7])
 redis.call('ZADD', KEYS[2], q, ARGV[1])
 redis.call('ZADD', KEYS[3], q, ARGV[1])
+redis.call('HSET', P .. 'owner', ARGV[1], ARGV[4])
+retain(KEYS[1], ARGV[1], tonumber(ARGV[8]))
 return {'ok', tostring(q)}
 )lua";
 
-// KEYS: session. ARGV: expected version, new version, summary, snapshot.
+// KEYS: session. ARGV: expected version, new version, summary, snapshot, id, ttl ms.
 // Returns {"ok"} | {"missing"} | {"stale", current version}.
-constexpr char kPutScript[] = R"lua(
+constexpr char kPutBody[] = R"lua(
 local v = redis.call('HGET', KEYS[1], 'v')
 if not v then return {'missing'} end
 if v ~= ARGV[1] then return {'stale', v} end
 redis.call('HSET', KEYS[1], 'v', ARGV[2], 'm', ARGV[3], 'd', ARGV[4])
+retain(KEYS[1], ARGV[5], tonumber(ARGV[6]))
 return {'ok'}
+)lua";
+
+// KEYS: session. ARGV: ttl ms. The version, and a read counts as use: the TTL starts again.
+// PEXPIRE and PERSIST are allowed when Redis is out of memory, so reads keep working then.
+constexpr char kTouchScript[] = R"lua(
+local v = redis.call('HGET', KEYS[1], 'v')
+if v then
+  if tonumber(ARGV[1]) > 0 then redis.call('PEXPIRE', KEYS[1], ARGV[1])
+  else redis.call('PERSIST', KEYS[1]) end
+end
+return v
 )lua";
 
 // KEYS: session, all, own:<owner>. ARGV: expected version (0 = any), id.
 // Returns {"ok"} | {"missing"} | {"stale", current version}.
-constexpr char kDeleteScript[] = R"lua(
+constexpr char kDeleteBody[] = R"lua(
 local v = redis.call('HGET', KEYS[1], 'v')
 if not v then return {'missing'} end
 if ARGV[1] ~= '0' and v ~= ARGV[1] then return {'stale', v} end
 redis.call('DEL', KEYS[1])
 redis.call('ZREM', KEYS[2], ARGV[2])
 redis.call('ZREM', KEYS[3], ARGV[2])
+redis.call('HDEL', P .. 'owner', ARGV[2])
+redis.call('ZREM', P .. 'exp', ARGV[2])
 return {'ok'}
 )lua";
+
+// KEYS: a sorted set (all or own:<owner>). Its size once expired sessions are swept.
+constexpr char kCountBody[] = R"lua(
+sweep()
+return redis.call('ZCARD', KEYS[1])
+)lua";
+
+const std::string& Script(const char* body) {
+  static const auto* scripts = new std::map<const char*, std::string>{
+      {kCreateBody, absl::StrCat(kSweepLua, kCreateBody)},
+      {kPutBody, absl::StrCat(kSweepLua, kPutBody)},
+      {kDeleteBody, absl::StrCat(kSweepLua, kDeleteBody)},
+      {kCountBody, absl::StrCat(kSweepLua, kCountBody)},
+  };
+  return scripts->at(body);
+}
 
 // KEYS: own:<owner>. ARGV: after sequence, count, session key prefix.
 // Returns id, sequence, summary triples (one consistent view of the index and the summaries).
@@ -113,16 +187,38 @@ absl::Status Malformed(absl::string_view what) {
   return absl::InternalError(absl::StrCat("session store: unexpected Redis reply to ", what));
 }
 
+// Where a redis:// URL's credentials end ('@' before the host), or npos.
+size_t CredentialsEnd(absl::string_view url) {
+  absl::string_view rest = url;
+  if (!absl::ConsumePrefix(&rest, "redis://")) return absl::string_view::npos;
+  const size_t at = rest.substr(0, rest.find('/')).rfind('@');
+  return at == absl::string_view::npos ? at : at + 8;
+}
+
 }  // namespace
+
+std::string RedactRedisUrl(absl::string_view url) {
+  const size_t at = CredentialsEnd(url);
+  if (at == absl::string_view::npos) return std::string(url);
+  return absl::StrCat("redis://***", url.substr(at));
+}
 
 absl::StatusOr<RedisAddress> ParseRedisUrl(absl::string_view url) {
   const auto bad = [&](absl::string_view why) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--store: '", url, "' ", why, " (use redis://HOST:PORT[/DB])"));
+    return absl::InvalidArgumentError(absl::StrCat("--store: '", RedactRedisUrl(url), "' ", why,
+                                                   " (use redis://[[USER]:PASSWORD@]HOST:PORT[/DB])"));
   };
   absl::string_view rest = url;
   if (!absl::ConsumePrefix(&rest, "redis://")) return bad("is not a redis:// URL");
   RedisAddress address;
+  if (const size_t at = CredentialsEnd(url); at != absl::string_view::npos) {
+    const absl::string_view credentials = url.substr(8, at - 8);
+    const size_t colon = credentials.find(':');
+    if (colon == absl::string_view::npos) return bad("has credentials without ':PASSWORD'");
+    address.user = std::string(credentials.substr(0, colon));
+    address.password = std::string(credentials.substr(colon + 1));
+    rest = url.substr(at + 1);
+  }
   if (const size_t slash = rest.find('/'); slash != absl::string_view::npos) {
     if (!absl::SimpleAtoi(rest.substr(slash + 1), &address.db) || address.db < 0) {
       return bad("has a database that is not a number");
@@ -145,7 +241,11 @@ absl::StatusOr<RedisAddress> ParseRedisUrl(absl::string_view url) {
 }
 
 RedisSessionStore::RedisSessionStore(RedisAddress address, RedisStoreOptions options)
-    : address_(std::move(address)), options_(options), rng_(std::random_device{}()) {}
+    : address_(std::move(address)), options_(std::move(options)), rng_(std::random_device{}()) {}
+
+std::string RedisSessionStore::Where() const {
+  return absl::StrCat("session store: redis ", address_.host, ":", address_.port);
+}
 
 RedisSessionStore::~RedisSessionStore() {
   for (redisContext* c : idle_) redisFree(c);
@@ -155,10 +255,15 @@ absl::StatusOr<std::unique_ptr<RedisSessionStore>> RedisSessionStore::Open(
     absl::string_view url, RedisStoreOptions options) {
   absl::StatusOr<RedisAddress> address = ParseRedisUrl(url);
   if (!address.ok()) return address.status();
-  std::unique_ptr<RedisSessionStore> store(new RedisSessionStore(*address, options));
+  if (!options.password.empty()) {
+    address->user.clear();  // --redis-password-file: the default user
+    address->password = options.password;
+  }
+  std::unique_ptr<RedisSessionStore> store(new RedisSessionStore(*address, std::move(options)));
   absl::StatusOr<Reply> pong = store->Command({"PING"});
   if (!pong.ok()) {
-    return absl::UnavailableError(absl::StrCat("--store ", url, ": ", pong.status().message()));
+    return absl::UnavailableError(
+        absl::StrCat("--store ", RedactRedisUrl(url), ": ", pong.status().message()));
   }
   return store;
 }
@@ -167,7 +272,7 @@ absl::StatusOr<redisContext*> RedisSessionStore::Connect() const {
   const auto ms = options_.timeout.count();
   const timeval timeout{static_cast<time_t>(ms / 1000), static_cast<suseconds_t>(ms % 1000 * 1000)};
   redisContext* c = redisConnectWithTimeout(address_.host.c_str(), address_.port, timeout);
-  const std::string where = absl::StrCat("redis ", address_.host, ":", address_.port);
+  const std::string where = Where();
   if (c == nullptr) return absl::UnavailableError(absl::StrCat(where, ": out of memory"));
   if (c->err != 0) {
     absl::Status error = absl::UnavailableError(absl::StrCat(where, ": ", c->errstr));
@@ -175,6 +280,24 @@ absl::StatusOr<redisContext*> RedisSessionStore::Connect() const {
     return error;
   }
   redisSetTimeout(c, timeout);
+  if (!address_.password.empty()) {
+    std::vector<const char*> argv = {"AUTH"};
+    std::vector<size_t> lengths = {4};
+    if (!address_.user.empty()) {
+      argv.push_back(address_.user.data());
+      lengths.push_back(address_.user.size());
+    }
+    argv.push_back(address_.password.data());
+    lengths.push_back(address_.password.size());
+    Reply reply(static_cast<redisReply*>(
+        redisCommandArgv(c, static_cast<int>(argv.size()), argv.data(), lengths.data())));
+    if (reply.null() || reply->type == REDIS_REPLY_ERROR) {
+      absl::Status error = absl::UnavailableError(absl::StrCat(
+          where, ": AUTH refused: ", reply.null() ? absl::string_view(c->errstr) : Str(*reply)));
+      redisFree(c);
+      return error;
+    }
+  }
   if (address_.db != 0) {
     Reply reply(static_cast<redisReply*>(redisCommand(c, "SELECT %d", address_.db)));
     if (reply.null() || reply->type == REDIS_REPLY_ERROR) {
@@ -214,8 +337,7 @@ absl::StatusOr<RedisSessionStore::Reply> RedisSessionStore::Command(
       // The connection is broken (Redis restarted, or a timeout mid-reply): never reuse it, nor
       // the other idle ones (they most likely broke the same way). A read that failed on a
       // pooled connection is tried once more on a fresh one; a write is not (it may have run).
-      absl::Status error = absl::UnavailableError(absl::StrCat(
-          "session store: redis ", address_.host, ":", address_.port, ": ", c->errstr));
+      absl::Status error = absl::UnavailableError(absl::StrCat(Where(), ": ", c->errstr));
       redisFree(c);
       std::vector<redisContext*> stale;
       {
@@ -231,7 +353,22 @@ absl::StatusOr<RedisSessionStore::Reply> RedisSessionStore::Command(
       idle_.push_back(c);
     }
     if (reply->type == REDIS_REPLY_ERROR) {
-      return absl::InternalError(absl::StrCat("session store: redis ", args[0], ": ", Str(*reply)));
+      const absl::string_view text = Str(*reply);
+      if (absl::StrContains(text, "OOM command not allowed")) {
+        // maxmemory reached under noeviction: nothing was written (the scripts' first growing
+        // command is refused before any change).
+        return solver::WithReason(
+            absl::ResourceExhaustedError(absl::StrCat(
+                Where(), " is out of memory (maxmemory): no new session or change can be stored "
+                         "until sessions expire or are deleted; reads still work")),
+            solver::kReasonStoreFull);
+      }
+      if (absl::StartsWith(text, "NOAUTH")) {
+        return absl::UnavailableError(absl::StrCat(
+            Where(), " needs a password: ", text,
+            " (give it with --redis-password-file or in the --store URL)"));
+      }
+      return absl::InternalError(absl::StrCat(Where(), " ", args[0], ": ", text));
     }
     return reply;
   }
@@ -264,7 +401,7 @@ absl::StatusOr<SessionState> RedisSessionStore::GetLatest(absl::string_view id) 
 
 absl::StatusOr<SessionState> RedisSessionStore::Load(absl::string_view id, bool use_cache) const {
   const std::string key = SessionKey(id);
-  absl::StatusOr<Reply> version = Command({"HGET", key, "v"});
+  absl::StatusOr<Reply> version = Command({"EVAL", kTouchScript, "1", key, TtlArgument()});
   if (!version.ok()) return version.status();
   if ((*version)->type == REDIS_REPLY_NIL) {
     std::lock_guard lock(cache_mutex_);
@@ -306,11 +443,12 @@ absl::StatusOr<SessionState> RedisSessionStore::Create(SessionState state) {
     SessionState stamped = state;
     StampCreated(stamped, id);
     absl::StatusOr<Reply> reply =
-        Command({"EVAL", kCreateScript, "4", SessionKey(id), AllKey(), OwnerKey(stamped.owner),
-                 SequenceKey(), id, absl::StrCat(options_.max_sessions),
+        Command({"EVAL", Script(kCreateBody), "4", SessionKey(id), AllKey(),
+                 OwnerKey(stamped.owner), SequenceKey(), id, absl::StrCat(options_.max_sessions),
                  absl::StrCat(stamped.session.version()), stamped.owner,
                  absl::StrCat(stamped.session.created_unix_ms()),
-                 SessionSummary(stamped.session).SerializeAsString(), EncodeSnapshot(stamped)},
+                 SessionSummary(stamped.session).SerializeAsString(), EncodeSnapshot(stamped),
+                 TtlArgument()},
                 /*idempotent=*/false);
     if (!reply.ok()) return reply.status();
     const absl::string_view verdict = Verdict(**reply);
@@ -353,9 +491,10 @@ absl::StatusOr<SessionState> RedisSessionStore::Replace(SessionState state,
   StampPut(state, current, same_version);
   state.owner = std::string(Str(*(*fixed)->element[0]));
   absl::StatusOr<Reply> reply =
-      Command({"EVAL", kPutScript, "1", key, absl::StrCat(expected_version),
+      Command({"EVAL", Script(kPutBody), "1", key, absl::StrCat(expected_version),
                absl::StrCat(state.session.version()),
-               SessionSummary(state.session).SerializeAsString(), EncodeSnapshot(state)},
+               SessionSummary(state.session).SerializeAsString(), EncodeSnapshot(state), id,
+               TtlArgument()},
               /*idempotent=*/false);
   if (!reply.ok()) return reply.status();
   const absl::string_view verdict = Verdict(**reply);
@@ -398,7 +537,7 @@ absl::StatusOr<SessionPage> RedisSessionStore::List(size_t page_size, absl::stri
 }
 
 size_t RedisSessionStore::CountOwned(absl::string_view owner) const {
-  absl::StatusOr<Reply> reply = Command({"ZCARD", OwnerKey(owner)});
+  absl::StatusOr<Reply> reply = Command({"EVAL", Script(kCountBody), "1", OwnerKey(owner)});
   if (!reply.ok() || (*reply)->type != REDIS_REPLY_INTEGER) {
     spdlog::warn("session store: cannot count sessions: {}",
                  reply.ok() ? "bad reply" : std::string(reply.status().message()));
@@ -408,7 +547,7 @@ size_t RedisSessionStore::CountOwned(absl::string_view owner) const {
 }
 
 size_t RedisSessionStore::Count() const {
-  absl::StatusOr<Reply> reply = Command({"ZCARD", AllKey()});
+  absl::StatusOr<Reply> reply = Command({"EVAL", Script(kCountBody), "1", AllKey()});
   if (!reply.ok() || (*reply)->type != REDIS_REPLY_INTEGER) return 0;
   return static_cast<size_t>((*reply)->integer);
 }
@@ -419,7 +558,7 @@ absl::Status RedisSessionStore::Delete(absl::string_view id, uint64_t expected_v
   if (!owner.ok()) return owner.status();
   if ((*owner)->type != REDIS_REPLY_STRING) return SessionNotFoundError(id);
   absl::StatusOr<Reply> reply =
-      Command({"EVAL", kDeleteScript, "3", key, AllKey(), OwnerKey(Str(**owner)),
+      Command({"EVAL", Script(kDeleteBody), "3", key, AllKey(), OwnerKey(Str(**owner)),
                absl::StrCat(expected_version), std::string(id)},
               /*idempotent=*/false);
   if (!reply.ok()) return reply.status();

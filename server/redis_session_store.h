@@ -7,6 +7,13 @@
 // positions, stats)}; sorted sets all and own:<owner> (id by sequence) for counting and listing;
 // counter seq. Create, Put and Delete are Lua scripts, so the version check and the write are
 // one atomic step in Redis: of two replicas writing the same version, one gets ABORTED.
+//
+// Retention: with a session TTL each s:<id> expires that long after its last use (create, write,
+// read); sorted set exp (id by expiry ms, a lower bound) and hash owner (id -> owner) let the
+// scripts that count or create drop an expired session's index entries (a bounded sweep).
+// Memory: Redis should run with maxmemory and maxmemory-policy noeviction, so no live session is
+// evicted silently; a write Redis refuses for memory is RESOURCE_EXHAUSTED (reason STORE_FULL),
+// while reads keep working.
 #pragma once
 
 #include <chrono>
@@ -29,16 +36,25 @@ struct RedisStoreOptions {
   size_t max_sessions = 10000;  // in the whole Redis database (all replicas)
   size_t max_cached = 256;      // sessions cached in this process (least recently used dropped)
   std::chrono::milliseconds timeout{5000};  // connect and per-command timeout
+  // A session expires this long after its last use; 0 = never (--session-ttl-seconds).
+  std::chrono::milliseconds session_ttl{0};
+  // AUTH password (--redis-password-file); when set it wins over a password in the URL.
+  std::string password;
 };
 
 struct RedisAddress {
   std::string host;
   int port = 6379;
   int db = 0;
+  std::string user;      // ACL user; empty = the default user
+  std::string password;  // empty = no AUTH
 };
 
-// "redis://HOST:PORT[/DB]" (HOST may be [IPv6]); INVALID_ARGUMENT naming --store otherwise.
+// "redis://[[USER]:PASSWORD@]HOST:PORT[/DB]" (HOST may be [IPv6]); INVALID_ARGUMENT naming
+// --store otherwise. Error messages never repeat the password.
 absl::StatusOr<RedisAddress> ParseRedisUrl(absl::string_view url);
+// `url` with any user and password replaced by "***", for logs and messages.
+std::string RedactRedisUrl(absl::string_view url);
 
 class RedisSessionStore final : public SessionStore {
  public:
@@ -80,7 +96,10 @@ class RedisSessionStore final : public SessionStore {
   // INTERNAL on a Redis error reply.
   absl::StatusOr<Reply> Command(const std::vector<std::string>& args, bool idempotent = true) const;
   absl::StatusOr<redisContext*> Connect() const;
+  // "session store: redis HOST:PORT" (no credentials), the start of every message.
+  std::string Where() const;
   void Remember(const SessionState& state) const;
+  std::string TtlArgument() const { return std::to_string(options_.session_ttl.count()); }
 
   const RedisAddress address_;
   const RedisStoreOptions options_;

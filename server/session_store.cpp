@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "solver/core/error_reason.h"
 
 namespace inbetween::server {
 
@@ -26,9 +27,11 @@ absl::Status SessionNotFoundError(absl::string_view id) {
 }
 
 absl::Status SessionLimitError(size_t max_sessions) {
-  return absl::ResourceExhaustedError(absl::StrCat("the server holds the maximum of ", max_sessions,
-                                                   " sessions (--max-sessions ", max_sessions,
-                                                   "); delete some first"));
+  return solver::WithReason(
+      absl::ResourceExhaustedError(absl::StrCat("the server holds the maximum of ", max_sessions,
+                                                " sessions (--max-sessions ", max_sessions,
+                                                "); delete some first")),
+      solver::kReasonSessionLimit);
 }
 
 absl::StatusOr<uint64_t> ParsePageToken(absl::string_view page_token) {

@@ -27,11 +27,14 @@ class InbetweenError(Exception):
     the session); ``attempts``: how many attempts the call made (retries included); ``reason``:
     the server's machine-readable reason (a google.rpc.ErrorInfo in the status details, domain
     "inbetween.v1": MESH_VERTEX_LIMIT, DRAWING_POINT_LIMIT, TOPOLOGY_DIFFERS,
-    HEAVY_JOBS_PER_TOKEN), else None."""
+    HEAVY_JOBS_PER_TOKEN, SERVER_BUSY, SESSIONS_PER_TOKEN, SESSION_LIMIT, STORE_FULL), else None;
+    ``field``: the offending request field ("parameters.frames", from a google.rpc.BadRequest)
+    of an INVALID_ARGUMENT / OUT_OF_RANGE, else None. ``retry_after_ms`` also comes from a
+    google.rpc.RetryInfo when the trailer is absent."""
 
     def __init__(self, code: str, details: str, retry_after_ms: Optional[int] = None,
                  method: str = "", maybe_applied: bool = False, attempts: int = 1,
-                 reason: Optional[str] = None) -> None:
+                 reason: Optional[str] = None, field: Optional[str] = None) -> None:
         super().__init__(f"{code}: {details}")
         self.code = code
         self.status_code: Optional[grpc.StatusCode] = getattr(grpc.StatusCode, code, None)
@@ -41,6 +44,7 @@ class InbetweenError(Exception):
         self.maybe_applied = maybe_applied
         self.attempts = attempts
         self.reason = reason
+        self.field = field
 
     @staticmethod
     def from_rpc_error(error: grpc.RpcError, method: str = "") -> "InbetweenError":
@@ -148,7 +152,7 @@ def error_from_rpc(error: grpc.RpcError, method: str = "") -> InbetweenError:
     details_of = getattr(error, "details", None)
     details = (details_of() if callable(details_of) else None) or str(error)
     retry = None
-    reason = None
+    found = _Details()
     trailing_of = getattr(error, "trailing_metadata", None)
     trailing = trailing_of() if callable(trailing_of) else None
     for item in trailing or ():
@@ -160,28 +164,51 @@ def error_from_rpc(error: grpc.RpcError, method: str = "") -> InbetweenError:
             except (TypeError, ValueError):
                 pass
         elif key == "grpc-status-details-bin":
-            reason = _reason_of(value)
+            found = _details_of(value)
     name = code.name if isinstance(code, grpc.StatusCode) else str(code)
     if name == "RESOURCE_EXHAUSTED":
         details = _name_size_limit(details)
-    return InbetweenError.of(name, details, retry_after_ms=retry, method=method, reason=reason)
+    if retry is None:
+        retry = found.retry_after_ms
+    return InbetweenError.of(name, details, retry_after_ms=retry, method=method,
+                             reason=found.reason, field=found.field)
 
 
 _ERROR_INFO_TYPE_URL = "type.googleapis.com/google.rpc.ErrorInfo"
+_BAD_REQUEST_TYPE_URL = "type.googleapis.com/google.rpc.BadRequest"
+_RETRY_INFO_TYPE_URL = "type.googleapis.com/google.rpc.RetryInfo"
 
 
-def _reason_of(details_bin: Any) -> Optional[str]:
-    """The reason of the service's google.rpc.ErrorInfo in a grpc-status-details-bin trailer
-    (inbetween.proto ErrorStatus), or None."""
+class _Details:
+    """What a grpc-status-details-bin trailer says: reason, offending field, retry delay."""
+
+    def __init__(self) -> None:
+        self.reason: Optional[str] = None
+        self.field: Optional[str] = None
+        self.retry_after_ms: Optional[int] = None
+
+
+def _details_of(details_bin: Any) -> _Details:
+    """The service's google.rpc.ErrorInfo, BadRequest and RetryInfo in a grpc-status-details-bin
+    trailer (inbetween.proto ErrorStatus)."""
     from inbetween.v1 import inbetween_pb2 as pb  # the generated stubs, as the clients use them
     from google.protobuf.message import DecodeError
+    found = _Details()
     try:
         status = pb.ErrorStatus.FromString(bytes(details_bin))
         for detail in status.details:
             if detail.type_url == _ERROR_INFO_TYPE_URL:
                 info = pb.ErrorInfo.FromString(detail.value)
                 if info.domain == "inbetween.v1" and info.reason:
-                    return info.reason
+                    found.reason = info.reason
+            elif detail.type_url == _BAD_REQUEST_TYPE_URL:
+                bad = pb.BadRequest.FromString(detail.value)
+                if bad.field_violations:
+                    found.field = bad.field_violations[0].field
+            elif detail.type_url == _RETRY_INFO_TYPE_URL:
+                delay = pb.RetryInfo.FromString(detail.value).retry_delay
+                found.retry_after_ms = delay.seconds * 1000 + delay.nanos // 1_000_000
     except (DecodeError, TypeError, ValueError):
-        return None
+        return _Details()
+    return found
     return None

@@ -179,6 +179,15 @@ class ClientTest(unittest.TestCase):
         with self.assertRaises(inbetween.NotFoundError) as missing:
             self.client.get_session("no-such-session")
         self.assertIsNone(missing.exception.reason)
+        self.assertIsNone(missing.exception.field)
+
+    def test_errors_name_the_offending_field(self):
+        # An SVG without paint: INVALID_ARGUMENT with the field from a google.rpc.BadRequest.
+        session = self.client.create_session("field")
+        with self.assertRaises(inbetween.InvalidArgumentError) as failed:
+            self.client.put_svg(session, '<svg xmlns="http://www.w3.org/2000/svg"></svg>')
+        self.assertEqual(failed.exception.field, "drawing.svg")
+        self.assertIn("drawing.svg", failed.exception.details)
 
     def test_topology_edits_add_move_delete_and_a_bad_edit(self):
         session = self.client.put_svg(self.client.create_session("py-topology"), SQUARE)

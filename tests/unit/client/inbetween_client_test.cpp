@@ -626,6 +626,14 @@ TEST(InbetweenClientReasonsTest, TheServicesReasonReachesTheClient) {
   EXPECT_EQ(solver::ErrorReason(back), solver::kReasonHeavyJobsPerToken);
   EXPECT_EQ(solver::ErrorReason(FromGrpcStatus(server::ToGrpcStatus(absl::InternalError("x")))),
             "");
+  // The offending field and the retry delay come back too.
+  const absl::Status field = FromGrpcStatus(
+      server::ToGrpcStatus(absl::InvalidArgumentError("parameters.frames = 1 is not in [2, 9]")));
+  EXPECT_EQ(solver::ErrorField(field), "parameters.frames");
+  const absl::Status retry =
+      FromGrpcStatus(server::ToGrpcStatus(solver::WithRetryAfter(sent, 2000)));
+  EXPECT_EQ(solver::RetryAfterMs(retry), 2000);
+  EXPECT_EQ(solver::ErrorReason(retry), solver::kReasonHeavyJobsPerToken);
   // Details that are not ours are ignored.
   EXPECT_EQ(solver::ErrorReason(FromGrpcStatus(
                 grpc::Status(grpc::StatusCode::INTERNAL, "x", std::string("\xff\x01garbage")))),

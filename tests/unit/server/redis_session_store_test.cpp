@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "solver/core/error_reason.h"
 #include "tests/unit/server/redis_fixture.h"
 #include "tests/unit/server/store_writers.h"
 #include "tests/unit/server/test_server.h"
@@ -238,6 +239,142 @@ TEST_F(RedisSessionStoreTest, RedisGoingAwayIsUnavailableNotACrash) {
   EXPECT_EQ(got.status().code(), absl::StatusCode::kUnavailable) << got.status();
   EXPECT_EQ(a->Put(*created, 1).status().code(), absl::StatusCode::kUnavailable);
   EXPECT_EQ(a->Count(), 0u);
+}
+
+// One raw command on the test's Redis (CONFIG SET, PTTL, ...): its integer or status text.
+std::string Raw(int port, const std::vector<std::string>& args, const std::string& password = "") {
+  redisContext* c = redisConnect("127.0.0.1", port);
+  std::string out;
+  if (c == nullptr || c->err != 0) return "no connection";
+  if (!password.empty()) {
+    freeReplyObject(redisCommand(c, "AUTH %s", password.c_str()));
+  }
+  std::vector<const char*> argv;
+  std::vector<size_t> lengths;
+  for (const std::string& a : args) {
+    argv.push_back(a.data());
+    lengths.push_back(a.size());
+  }
+  auto* reply = static_cast<redisReply*>(
+      redisCommandArgv(c, static_cast<int>(args.size()), argv.data(), lengths.data()));
+  if (reply != nullptr) {
+    out = reply->type == REDIS_REPLY_INTEGER ? std::to_string(reply->integer)
+                                             : std::string(reply->str ? reply->str : "", reply->len);
+    freeReplyObject(reply);
+  }
+  redisFree(c);
+  return out;
+}
+
+TEST(RedisUrlTest, CredentialsAreParsedAndNeverRepeated) {
+  auto a = ParseRedisUrl("redis://:s3cret@127.0.0.1:6380/2");
+  ASSERT_TRUE(a.ok()) << a.status();
+  EXPECT_EQ(a->user, "");
+  EXPECT_EQ(a->password, "s3cret");
+  EXPECT_EQ(a->host, "127.0.0.1");
+  EXPECT_EQ(a->db, 2);
+  auto b = ParseRedisUrl("redis://app:p@ss@[::1]:7000");
+  ASSERT_TRUE(b.ok()) << b.status();
+  EXPECT_EQ(b->user, "app");
+  EXPECT_EQ(b->password, "p@ss");
+  EXPECT_EQ(b->host, "::1");
+  EXPECT_EQ(RedactRedisUrl("redis://app:p@ss@host:1/2"), "redis://***@host:1/2");
+  EXPECT_EQ(RedactRedisUrl("redis://host:1"), "redis://host:1");
+  auto bad = ParseRedisUrl("redis://:s3cret@host");
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(bad.status().message().find("s3cret"), std::string::npos) << bad.status();
+  auto no_colon = ParseRedisUrl("redis://s3cret@host:1");
+  EXPECT_EQ(no_colon.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(no_colon.status().message().find("s3cret"), std::string::npos) << no_colon.status();
+}
+
+TEST_F(RedisSessionStoreTest, APasswordIsSentAndAMissingOneIsNamed) {
+  ASSERT_EQ(Raw(redis_->port(), {"CONFIG", "SET", "requirepass", "pa ss"}), "OK");
+  RedisStoreOptions options;
+  options.timeout = std::chrono::milliseconds(2000);
+  auto none = RedisSessionStore::Open(redis_->url(), options);
+  EXPECT_EQ(none.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_NE(none.status().message().find("--redis-password-file"), std::string::npos)
+      << none.status();
+  options.password = "wrong";
+  auto wrong = RedisSessionStore::Open(redis_->url(), options);
+  EXPECT_EQ(wrong.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_NE(wrong.status().message().find("AUTH"), std::string::npos) << wrong.status();
+  EXPECT_EQ(wrong.status().message().find("wrong"), std::string::npos) << wrong.status();
+  options.password = "pa ss";
+  auto right = RedisSessionStore::Open(redis_->url(), options);
+  ASSERT_TRUE(right.ok()) << right.status();
+  ASSERT_TRUE((*right)->Create(StoredSessionState("alice")).ok());
+  // The same password in the URL.
+  const std::string url = "redis://:pa ss@127.0.0.1:" + std::to_string(redis_->port());
+  auto by_url = RedisSessionStore::Open(url);
+  ASSERT_TRUE(by_url.ok()) << by_url.status();
+  EXPECT_EQ((*by_url)->Count(), 1u);
+  Raw(redis_->port(), {"CONFIG", "SET", "requirepass", ""}, "pa ss");
+}
+
+TEST_F(RedisSessionStoreTest, SessionsExpireAfterTheirLastUseAndLeaveNoIndexEntries) {
+  RedisStoreOptions options;
+  options.session_ttl = std::chrono::milliseconds(60'000);
+  auto a = Open(options);
+  auto created = a->Create(StoredSessionState("alice"));
+  ASSERT_TRUE(created.ok()) << created.status();
+  const std::string key = "inbetween:s:" + created->session.id();
+  const int64_t fresh = std::stoll(Raw(redis_->port(), {"PTTL", key}));
+  EXPECT_GT(fresh, 50'000);
+  EXPECT_LE(fresh, 60'000);
+  // A read is a use: the TTL starts again.
+  ASSERT_EQ(Raw(redis_->port(), {"PEXPIRE", key, "5000"}), "1");
+  ASSERT_TRUE(a->Get(created->session.id()).ok());
+  EXPECT_GT(std::stoll(Raw(redis_->port(), {"PTTL", key})), 50'000);
+  // ... and so is a write.
+  ASSERT_EQ(Raw(redis_->port(), {"PEXPIRE", key, "5000"}), "1");
+  ASSERT_TRUE(a->Put(*created, 1).ok());
+  EXPECT_GT(std::stoll(Raw(redis_->port(), {"PTTL", key})), 50'000);
+
+  // An expired session is gone, and counting or creating drops its index entries.
+  RedisStoreOptions brief;
+  brief.session_ttl = std::chrono::milliseconds(200);
+  auto c = Open(brief);
+  auto gone = c->Create(StoredSessionState("alice"));
+  ASSERT_TRUE(gone.ok());
+  EXPECT_EQ(a->CountOwned("alice"), 2u);
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  EXPECT_EQ(c->Get(gone->session.id()).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(a->CountOwned("alice"), 1u);
+  EXPECT_EQ(a->Count(), 1u);
+  EXPECT_EQ(Raw(redis_->port(), {"HEXISTS", "inbetween:owner", gone->session.id()}), "0");
+  EXPECT_EQ(Raw(redis_->port(), {"ZCARD", "inbetween:exp"}), "1");
+  auto page = a->List(10, "", "alice");
+  ASSERT_TRUE(page.ok());
+  ASSERT_EQ(page->sessions.size(), 1u);
+  EXPECT_EQ(page->sessions[0].session.id(), created->session.id());
+  const auto& other = page->sessions[0];
+
+  // TTL 0: sessions are kept (an existing TTL is removed on the next use).
+  RedisStoreOptions keep;
+  auto b = Open(keep);
+  ASSERT_TRUE(b->Get(other.session.id()).ok());
+  EXPECT_EQ(Raw(redis_->port(), {"PTTL", "inbetween:s:" + other.session.id()}), "-1");
+}
+
+TEST_F(RedisSessionStoreTest, AFullRedisRefusesNewSessionsButKeepsServingOld) {
+  auto a = Open();
+  auto first = a->Create(StoredSessionState("alice"));
+  ASSERT_TRUE(first.ok()) << first.status();
+  ASSERT_EQ(Raw(redis_->port(), {"CONFIG", "SET", "maxmemory-policy", "noeviction"}), "OK");
+  ASSERT_EQ(Raw(redis_->port(), {"CONFIG", "SET", "maxmemory", "1"}), "OK");  // always over
+  auto refused = a->Create(StoredSessionState("alice"));
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted) << refused.status();
+  EXPECT_EQ(solver::ErrorReason(refused.status()), solver::kReasonStoreFull);
+  EXPECT_NE(refused.status().message().find("maxmemory"), std::string::npos);
+  EXPECT_EQ(a->Put(*first, 1).status().code(), absl::StatusCode::kResourceExhausted);
+  auto read = a->Get(first->session.id());  // reads (and their TTL refresh) still work
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->session.version(), 1u);
+  EXPECT_EQ(a->Count(), 1u);
+  ASSERT_EQ(Raw(redis_->port(), {"CONFIG", "SET", "maxmemory", "0"}), "OK");
+  EXPECT_TRUE(a->Create(StoredSessionState("alice")).ok());
 }
 
 }  // namespace
