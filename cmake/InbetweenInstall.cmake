@@ -25,7 +25,8 @@ set(INBETWEEN_EXPORTED_TARGETS
 set(INBETWEEN_EXPORTED_SYSTEM_LIBS "")
 # Namespaced targets the exported link interfaces may name; InbetweenConfig.cmake.in finds each
 # namespace's package (PkgConfig:: by the same pkg_check_modules calls as this build).
-set(INBETWEEN_CONFIG_NAMESPACES Eigen3 absl spdlog nlohmann_json CGAL Threads PkgConfig)
+set(INBETWEEN_CONFIG_NAMESPACES Eigen3 absl spdlog nlohmann_json CGAL Threads prometheus-cpp
+    PkgConfig)
 # "PREFIX modules..." as in the pkg_check_modules calls of CMakeLists.txt, server/ and
 # client/render/.
 set(INBETWEEN_CONFIG_PKGCONFIG "PROTOBUF protobuf" "GRPCPP grpc++" "LIBXML2 libxml-2.0"
@@ -49,7 +50,7 @@ function(inbetween_exportable_link_item item out)
     set(name "${CMAKE_MATCH_1}")
     set(INBETWEEN_EXPORTED_SYSTEM_LIBS ${INBETWEEN_EXPORTED_SYSTEM_LIBS} ${name} PARENT_SCOPE)
     set(inner "$<BUILD_INTERFACE:${inner}>$<INSTALL_INTERFACE:Inbetween::lib_${name}>")
-  elseif(inner MATCHES "^([A-Za-z0-9_]+)::")
+  elseif(inner MATCHES "^([A-Za-z0-9_-]+)::")
     if(NOT CMAKE_MATCH_1 IN_LIST INBETWEEN_CONFIG_NAMESPACES OR
        (CMAKE_MATCH_1 STREQUAL "PkgConfig" AND NOT inner IN_LIST INBETWEEN_CONFIG_PKGCONFIG_TARGETS))
       message(FATAL_ERROR "${inner} is in the link interface of an exported Inbetween target: "

@@ -173,8 +173,8 @@ absl::StatusOr<std::unique_ptr<InbetweenServer>> InbetweenServer::Start(
   }
   if (!options.metrics_listen.empty()) {
     InbetweenServer* self = server.get();
-    absl::StatusOr<std::unique_ptr<MetricsHttpServer>> http =
-        MetricsHttpServer::Start(options.metrics_listen, [self] { return self->RenderMetrics(); });
+    absl::StatusOr<std::unique_ptr<MetricsHttpServer>> http = MetricsHttpServer::Start(
+        options.metrics_listen, server->metrics_, [self] { return self->ScrapedGauges(); });
     if (!http.ok()) return http.status();
     server->metrics_server_ = *std::move(http);
   }
@@ -222,9 +222,11 @@ int InbetweenServer::port() const { return port_; }
 
 int InbetweenServer::metrics_port() const { return metrics_server_ ? metrics_server_->port() : 0; }
 
-std::string InbetweenServer::RenderMetrics() const {
+std::string InbetweenServer::RenderMetrics() const { return metrics_->Render(ScrapedGauges()); }
+
+std::vector<Metrics::Gauge> InbetweenServer::ScrapedGauges() const {
   const HeavyJobs& heavy = service_->heavy_jobs();
-  return metrics_->Render({
+  return {
       {"inbetween_active_sessions", "Sessions in the store.", static_cast<double>(store_->Count())},
       {"inbetween_cached_sessions", "Sessions held in this process's memory.",
        static_cast<double>(store_->CachedCount())},
@@ -235,7 +237,7 @@ std::string InbetweenServer::RenderMetrics() const {
       {"inbetween_heavy_jobs_max", "Heavy-job slots (--max-heavy-jobs).",
        static_cast<double>(heavy.max_running())},
       {"inbetween_serving", "1 while serving, 0 while draining.", draining_ ? 0.0 : 1.0},
-  });
+  };
 }
 
 void InbetweenServer::Shutdown() {

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "server/inbetween_service.h"
@@ -73,6 +74,8 @@ class InbetweenServer {
  private:
   InbetweenServer() = default;
   void EvictIdleLoop();
+  // The gauges read at each scrape: sessions, heavy-job pool, serving/draining.
+  std::vector<Metrics::Gauge> ScrapedGauges() const;
 
   ServerOptions options_;
   int port_ = 0;

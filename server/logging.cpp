@@ -1,61 +1,133 @@
-// Logging configuration. The JSON line format uses a custom spdlog flag (%*) that writes the
-// message JSON-escaped, so user-provided names in messages cannot break the line.
+// Logging configuration. The JSON line format uses two custom spdlog flags: %* writes the message
+// JSON-escaped, %& the extra fields of an RPC line, so user-provided names cannot break the line.
 #include "server/logging.h"
 
 #include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 
 namespace inbetween::server {
 namespace {
+
+// Whether ConfigureLogging chose JSON lines (LogRpc then passes its fields as JSON fields).
+std::atomic<bool> json_lines{false};
+
+// The extra JSON fields (",\"request\":...") of the line being logged on this thread, written by
+// the %& flag. spdlog 1.10 has no structured fields (its MDC, from 1.13 on, is the same
+// thread-local design); the server's logger is synchronous, so the line is formatted on this
+// thread within the spdlog call that set them.
+thread_local const std::string* json_fields = nullptr;
+
+// Length of the valid UTF-8 sequence at the start of `s` (1 to 4), or 0 when it is not one.
+size_t Utf8SequenceLength(std::string_view s) {
+  const auto byte = [&](size_t i) { return static_cast<unsigned char>(s[i]); };
+  const unsigned char lead = byte(0);
+  size_t length;
+  unsigned char low = 0x80, high = 0xbf;  // allowed range of the second byte
+  if (lead < 0x80) return 1;
+  if (lead >= 0xc2 && lead <= 0xdf) {
+    length = 2;
+  } else if (lead >= 0xe0 && lead <= 0xef) {
+    length = 3;
+    if (lead == 0xe0) low = 0xa0;   // no overlong forms
+    if (lead == 0xed) high = 0x9f;  // no surrogates
+  } else if (lead >= 0xf0 && lead <= 0xf4) {
+    length = 4;
+    if (lead == 0xf0) low = 0x90;   // no overlong forms
+    if (lead == 0xf4) high = 0x8f;  // nothing above U+10FFFF
+  } else {
+    return 0;
+  }
+  if (s.size() < length || byte(1) < low || byte(1) > high) return 0;
+  for (size_t i = 2; i < length; ++i) {
+    if (byte(i) < 0x80 || byte(i) > 0xbf) return 0;
+  }
+  return length;
+}
+
+// `s` as the inside of a JSON string: quote, backslash and control characters escaped, bytes that
+// are not UTF-8 replaced by U+FFFD (a JSON text is UTF-8), everything else unchanged. Out is
+// std::string or spdlog's memory buffer.
+template <typename Out>
+void AppendJsonEscaped(std::string_view s, Out& out) {
+  const auto append = [&out](std::string_view piece) {
+    out.append(piece.data(), piece.data() + piece.size());
+  };
+  for (size_t i = 0; i < s.size();) {
+    const char c = s[i];
+    switch (c) {
+      case '"':
+        append("\\\"");
+        break;
+      case '\\':
+        append("\\\\");
+        break;
+      case '\n':
+        append("\\n");
+        break;
+      case '\r':
+        append("\\r");
+        break;
+      case '\t':
+        append("\\t");
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(c));
+          append(buf);
+        } else if (const size_t n = Utf8SequenceLength(s.substr(i)); n == 0) {
+          append("\\ufffd");
+        } else {
+          append(s.substr(i, n));
+          i += n;
+          continue;
+        }
+    }
+    ++i;
+  }
+}
 
 class JsonEscapedMessage final : public spdlog::custom_flag_formatter {
  public:
   void format(const spdlog::details::log_msg& msg, const std::tm&,
               spdlog::memory_buf_t& dest) override {
-    for (char c : msg.payload) {
-      switch (c) {
-        case '"':
-          Append(dest, "\\\"");
-          break;
-        case '\\':
-          Append(dest, "\\\\");
-          break;
-        case '\n':
-          Append(dest, "\\n");
-          break;
-        case '\r':
-          Append(dest, "\\r");
-          break;
-        case '\t':
-          Append(dest, "\\t");
-          break;
-        default:
-          if (static_cast<unsigned char>(c) < 0x20) {
-            char buf[8];
-            std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(c));
-            Append(dest, buf);
-          } else {
-            dest.push_back(c);
-          }
-      }
-    }
+    AppendJsonEscaped(std::string_view(msg.payload.data(), msg.payload.size()), dest);
   }
   std::unique_ptr<custom_flag_formatter> clone() const override {
     return std::make_unique<JsonEscapedMessage>();
   }
+};
 
- private:
-  static void Append(spdlog::memory_buf_t& dest, std::string_view s) {
-    dest.append(s.data(), s.data() + s.size());
+class JsonFields final : public spdlog::custom_flag_formatter {
+ public:
+  void format(const spdlog::details::log_msg&, const std::tm&,
+              spdlog::memory_buf_t& dest) override {
+    if (json_fields != nullptr) {
+      dest.append(json_fields->data(), json_fields->data() + json_fields->size());
+    }
+  }
+  std::unique_ptr<custom_flag_formatter> clone() const override {
+    return std::make_unique<JsonFields>();
   }
 };
+
+// ,"key":"value" with the value JSON-escaped.
+void AppendJsonString(std::string& out, std::string_view key, std::string_view value) {
+  out.append(",\"").append(key).append("\":\"");
+  AppendJsonEscaped(value, out);
+  out += '"';
+}
 
 }  // namespace
 
@@ -87,12 +159,13 @@ absl::Status ConfigureLogging(absl::string_view level, absl::string_view format)
   spdlog::set_level(parsed);
   if (format == "json") {
     auto formatter = std::make_unique<spdlog::pattern_formatter>(spdlog::pattern_time_type::utc);
-    formatter->add_flag<JsonEscapedMessage>('*').set_pattern(
-        R"({"time":"%Y-%m-%dT%H:%M:%S.%eZ","level":"%l","thread":%t,"msg":"%*"})");
+    formatter->add_flag<JsonEscapedMessage>('*').add_flag<JsonFields>('&').set_pattern(
+        R"({"time":"%Y-%m-%dT%H:%M:%S.%eZ","level":"%l","thread":%t,"msg":"%*"%&})");
     spdlog::set_formatter(std::move(formatter));
   } else {
     spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%^%l%$] %v");
   }
+  json_lines = format == "json";
   return absl::OkStatus();
 }
 
@@ -100,15 +173,38 @@ void LogRpc(absl::string_view request_id, absl::string_view rpc_name, absl::stri
             const grpc::Status& status, double seconds, bool ok_at_info) {
   const std::string_view rpc(rpc_name.data(), rpc_name.size());
   const std::string_view request(request_id.data(), request_id.size());
-  const std::string session =
-      session_id.empty() ? std::string() : absl::StrCat(" session=", session_id);
+  const std::string_view session(session_id.data(), session_id.size());
+  const std::string code =
+      absl::StatusCodeToString(static_cast<absl::StatusCode>(status.error_code()));
+  const spdlog::level::level_enum level = !status.ok() ? spdlog::level::warn
+                                          : ok_at_info ? spdlog::level::info
+                                                       : spdlog::level::debug;
+  if (!spdlog::should_log(level)) return;
+  if (json_lines) {
+    std::string fields;
+    AppendJsonString(fields, "request", request);
+    AppendJsonString(fields, "method", rpc);
+    if (!session.empty()) AppendJsonString(fields, "session", session);
+    AppendJsonString(fields, "status", code);
+    // Finite in practice (a clock difference); null keeps the line JSON if it ever is not.
+    absl::StrAppend(&fields, ",\"seconds\":",
+                    std::isfinite(seconds) ? absl::StrFormat("%.6f", seconds) : "null");
+    if (!status.ok()) AppendJsonString(fields, "error", status.error_message());
+    struct Scope {  // the fields belong to this one line, even if logging throws
+      explicit Scope(const std::string* f) { json_fields = f; }
+      ~Scope() { json_fields = nullptr; }
+    } scope(&fields);
+    spdlog::log(level, "{} {} in {:.3f} s", rpc, code, seconds);
+    return;
+  }
+  const std::string session_text =
+      session.empty() ? std::string() : absl::StrCat(" session=", session_id);
   if (status.ok()) {
-    spdlog::log(ok_at_info ? spdlog::level::info : spdlog::level::debug,
-                "request={} rpc={}{} status=OK seconds={:.3f}", request, rpc, session, seconds);
+    spdlog::log(level, "request={} rpc={}{} status=OK seconds={:.3f}", request, rpc, session_text,
+                seconds);
   } else {
-    spdlog::warn("request={} rpc={}{} status={} seconds={:.3f} error={}", request, rpc, session,
-                 absl::StatusCodeToString(static_cast<absl::StatusCode>(status.error_code())),
-                 seconds, status.error_message());
+    spdlog::log(level, "request={} rpc={}{} status={} seconds={:.3f} error={}", request, rpc,
+                session_text, code, seconds, status.error_message());
   }
 }
 

@@ -1,178 +1,227 @@
-// Metrics: counters/histograms under one mutex; MetricsHttpServer: a blocking accept loop with a
-// poll timeout so that it notices shutdown, one request per connection (Connection: close).
+// Metrics on prometheus-cpp: a Registry with counter and histogram families (prometheus-cpp's
+// families and metrics synchronise themselves), TextSerializer for Render, and an Exposer (the
+// civetweb HTTP server prometheus-cpp ships) for GET /metrics; at the end, the stack size fix its
+// civetweb threads need (pthread_attr_setstacksize).
 #include "server/metrics.h"
 
-#include <arpa/inet.h>
+#include <dlfcn.h>
+#include <link.h>
 #include <netdb.h>
-#include <netinet/in.h>
-#include <poll.h>
+#include <pthread.h>
 #include <sys/socket.h>
-#include <unistd.h>
 
-#include <array>
 #include <cstring>
+#include <exception>
+#include <sstream>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
+#include "prometheus/collectable.h"
+#include "prometheus/counter.h"
+#include "prometheus/exposer.h"
+#include "prometheus/family.h"
+#include "prometheus/histogram.h"
+#include "prometheus/metric_family.h"
+#include "prometheus/registry.h"
+#include "prometheus/text_serializer.h"
 
 namespace inbetween::server {
 namespace {
 
-constexpr std::array<double, 12> kBuckets = {0.001, 0.0025, 0.005, 0.01, 0.025, 0.05,
-                                             0.1,   0.25,   0.5,   1.0,  5.0,   30.0};
+// Upper bounds in seconds, shared by RPC latency and solver stages: 1 ms to 30 s.
+const prometheus::Histogram::BucketBoundaries& Buckets() {
+  static const auto* const buckets = new prometheus::Histogram::BucketBoundaries{
+      0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 5.0, 30.0};
+  return *buckets;
+}
 
 }  // namespace
 
-void Metrics::Observe(Histogram& h, double seconds) {
-  if (h.buckets.empty()) h.buckets.assign(kBuckets.size(), 0);
-  for (size_t i = 0; i < kBuckets.size(); ++i) {
-    if (seconds <= kBuckets[i]) {
-      ++h.buckets[i];
-      break;
-    }
-  }
-  ++h.count;
-  h.sum += seconds;
-}
+struct Metrics::Families {
+  std::shared_ptr<prometheus::Registry> registry = std::make_shared<prometheus::Registry>();
+  prometheus::Family<prometheus::Counter>& rpcs =
+      prometheus::BuildCounter()
+          .Name("inbetween_rpcs_total")
+          .Help("Finished RPCs by method and status code.")
+          .Register(*registry);
+  prometheus::Family<prometheus::Histogram>& rpc_seconds =
+      prometheus::BuildHistogram()
+          .Name("inbetween_rpc_duration_seconds")
+          .Help("RPC latency by method and status code.")
+          .Register(*registry);
+  prometheus::Family<prometheus::Histogram>& stage_seconds =
+      prometheus::BuildHistogram()
+          .Name("inbetween_stage_seconds")
+          .Help("Solver stage run time by stage.")
+          .Register(*registry);
+  prometheus::Counter& frames_solved = prometheus::BuildCounter()
+                                           .Name("inbetween_frames_solved_total")
+                                           .Help("Inbetween frames solved.")
+                                           .Register(*registry)
+                                           .Add({});
+};
+
+Metrics::Metrics() : families_(std::make_unique<Families>()) {}
+
+Metrics::~Metrics() = default;
 
 void Metrics::ObserveRpc(absl::string_view method, absl::string_view code, double seconds) {
-  std::lock_guard lock(mutex_);
-  ++rpc_counts_[{std::string(method), std::string(code)}];
-  Observe(rpc_seconds_[absl::StrCat("method=\"", method, "\",code=\"", code, "\"")], seconds);
+  const prometheus::Labels labels = {{"method", std::string(method)}, {"code", std::string(code)}};
+  families_->rpcs.Add(labels).Increment();
+  families_->rpc_seconds.Add(labels, Buckets()).Observe(seconds);
 }
 
 void Metrics::ObserveStage(absl::string_view stage, double seconds) {
-  std::lock_guard lock(mutex_);
-  Observe(stage_seconds_[absl::StrCat("stage=\"", stage, "\"")], seconds);
+  families_->stage_seconds.Add({{"stage", std::string(stage)}}, Buckets()).Observe(seconds);
 }
 
-void Metrics::RenderHistogram(std::string& out, absl::string_view name,
-                              const std::map<std::string, Histogram, std::less<>>& histograms) {
-  for (const auto& [labels, h] : histograms) {
-    uint64_t cumulative = 0;
-    for (size_t i = 0; i < kBuckets.size(); ++i) {
-      cumulative += h.buckets.empty() ? 0 : h.buckets[i];
-      absl::StrAppend(&out, name, "_bucket{", labels, ",le=\"", absl::StrFormat("%g", kBuckets[i]),
-                      "\"} ", cumulative, "\n");
-    }
-    absl::StrAppend(&out, name, "_bucket{", labels, ",le=\"+Inf\"} ", h.count, "\n");
-    absl::StrAppend(&out, name, "_sum{", labels, "} ", absl::StrFormat("%.6f", h.sum), "\n");
-    absl::StrAppend(&out, name, "_count{", labels, "} ", h.count, "\n");
+void Metrics::CountFrameSolved() { families_->frames_solved.Increment(); }
+
+uint64_t Metrics::frames_solved() const {
+  return static_cast<uint64_t>(families_->frames_solved.Value());
+}
+
+std::vector<prometheus::MetricFamily> Metrics::Collect(const std::vector<Gauge>& gauges) const {
+  std::vector<prometheus::MetricFamily> families = families_->registry->Collect();
+  for (const Gauge& g : gauges) {
+    prometheus::MetricFamily family{g.name, g.help, prometheus::MetricType::Gauge, {}};
+    family.metric.emplace_back().gauge.value = g.value;
+    families.push_back(std::move(family));
   }
+  return families;
 }
 
 std::string Metrics::Render(const std::vector<Gauge>& gauges) const {
-  std::string out;
-  std::lock_guard lock(mutex_);
-  out += "# HELP inbetween_rpcs_total Finished RPCs by method and status code.\n";
-  out += "# TYPE inbetween_rpcs_total counter\n";
-  for (const auto& [key, count] : rpc_counts_) {
-    absl::StrAppend(&out, "inbetween_rpcs_total{method=\"", key.first, "\",code=\"", key.second,
-                    "\"} ", count, "\n");
-  }
-  out += "# HELP inbetween_rpc_duration_seconds RPC latency by method and status code.\n";
-  out += "# TYPE inbetween_rpc_duration_seconds histogram\n";
-  RenderHistogram(out, "inbetween_rpc_duration_seconds", rpc_seconds_);
-  out += "# HELP inbetween_stage_seconds Solver stage run time by stage.\n";
-  out += "# TYPE inbetween_stage_seconds histogram\n";
-  RenderHistogram(out, "inbetween_stage_seconds", stage_seconds_);
-  absl::StrAppend(&out,
-                  "# HELP inbetween_frames_solved_total Inbetween frames solved.\n"
-                  "# TYPE inbetween_frames_solved_total counter\n"
-                  "inbetween_frames_solved_total ",
-                  frames_solved(), "\n");
-  for (const Gauge& g : gauges) {
-    absl::StrAppend(&out, "# HELP ", g.name, " ", g.help, "\n# TYPE ", g.name, " gauge\n", g.name,
-                    " ", absl::StrFormat("%g", g.value), "\n");
-  }
-  return out;
+  std::ostringstream out;
+  prometheus::TextSerializer().Serialize(out, Collect(gauges));
+  return out.str();
 }
 
-absl::StatusOr<std::unique_ptr<MetricsHttpServer>> MetricsHttpServer::Start(
-    const std::string& listen, std::function<std::string()> render) {
+namespace {
+
+// The gauges are read when scraped, through a Collectable of our own: their values belong to the
+// store and the heavy-job pool, and the Exposer has no hook to refresh Gauge objects before it
+// collects.
+class ScrapedMetrics final : public prometheus::Collectable {
+ public:
+  explicit ScrapedMetrics(std::function<std::vector<prometheus::MetricFamily>()> collect)
+      : collect_(std::move(collect)) {}
+  std::vector<prometheus::MetricFamily> Collect() const override { return collect_(); }
+
+ private:
+  std::function<std::vector<prometheus::MetricFamily>()> collect_;
+};
+
+// `listen` (HOST:PORT, HOST a name or an IPv4 address) as civetweb's listening_ports value, a
+// numeric "IPv4:PORT". Debian's civetweb is built without IPv6, so an IPv6 address is refused here
+// with a message that says so, rather than failing to bind.
+absl::StatusOr<std::string> CivetwebAddress(const std::string& listen) {
   const size_t colon = listen.rfind(':');
   if (colon == std::string::npos || colon == 0) {
     return absl::InvalidArgumentError(
         absl::StrCat("--metrics-listen: '", listen, "' is not HOST:PORT"));
   }
-  std::string host = listen.substr(0, colon);
-  if (host.size() > 2 && host.front() == '[' && host.back() == ']') {
-    host = host.substr(1, host.size() - 2);
-  }
+  const std::string host = listen.substr(0, colon);
   const std::string port = listen.substr(colon + 1);
+  if (host.find(':') != std::string::npos) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--metrics-listen: '", listen,
+                     "' is IPv6, which the metrics endpoint (civetweb, as Debian builds it) does "
+                     "not serve; use an IPv4 address such as 0.0.0.0:PORT"));
+  }
   addrinfo hints{};
-  hints.ai_family = AF_UNSPEC;
+  hints.ai_family = AF_INET;
   hints.ai_socktype = SOCK_STREAM;
   hints.ai_flags = AI_PASSIVE;
   addrinfo* found = nullptr;
   if (getaddrinfo(host.c_str(), port.c_str(), &hints, &found) != 0 || found == nullptr) {
     return absl::InvalidArgumentError(
-        absl::StrCat("--metrics-listen: cannot resolve '", listen, "'"));
+        absl::StrCat("--metrics-listen: cannot resolve '", listen, "' to an IPv4 address"));
   }
-  std::unique_ptr<MetricsHttpServer> server(new MetricsHttpServer());
-  server->fd_ = socket(found->ai_family, found->ai_socktype | SOCK_CLOEXEC, found->ai_protocol);
-  const int one = 1;
-  if (server->fd_ >= 0) setsockopt(server->fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
-  const bool bound = server->fd_ >= 0 &&
-                     bind(server->fd_, found->ai_addr, found->ai_addrlen) == 0 &&
-                     ::listen(server->fd_, 16) == 0;
+  char numeric_host[NI_MAXHOST];
+  char numeric_port[NI_MAXSERV];
+  const int named =
+      getnameinfo(found->ai_addr, found->ai_addrlen, numeric_host, sizeof(numeric_host),
+                  numeric_port, sizeof(numeric_port), NI_NUMERICHOST | NI_NUMERICSERV);
   freeaddrinfo(found);
-  if (!bound) {
-    return absl::UnavailableError(
-        absl::StrCat("--metrics-listen: cannot bind '", listen, "': ", std::strerror(errno)));
+  if (named != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--metrics-listen: cannot resolve '", listen, "' to an IPv4 address"));
   }
-  sockaddr_storage address{};
-  socklen_t length = sizeof(address);
-  getsockname(server->fd_, reinterpret_cast<sockaddr*>(&address), &length);
-  server->port_ =
-      ntohs(address.ss_family == AF_INET6 ? reinterpret_cast<sockaddr_in6*>(&address)->sin6_port
-                                          : reinterpret_cast<sockaddr_in*>(&address)->sin_port);
-  server->render_ = std::move(render);
-  server->thread_ = std::thread([s = server.get()] { s->Serve(); });
+  return absl::StrCat(numeric_host, ":", numeric_port);
+}
+
+// Bytes of static TLS (every loaded module's PT_TLS segment, aligned) that glibc places at the top
+// of each new thread's stack.
+size_t StaticTlsBytes() {
+  size_t total = 0;
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, size_t, void* sum) {
+        for (int i = 0; i < info->dlpi_phnum; ++i) {
+          const ElfW(Phdr)& segment = info->dlpi_phdr[i];
+          if (segment.p_type != PT_TLS) continue;
+          const size_t align = segment.p_align > 0 ? segment.p_align : 1;
+          *static_cast<size_t*>(sum) += (segment.p_memsz + align - 1) / align * align;
+        }
+        return 0;
+      },
+      &total);
+  return total;
+}
+
+}  // namespace
+
+// Declared in this order so that the exposer (whose threads call the collectable) stops first.
+struct MetricsHttpServer::Exposed {
+  std::shared_ptr<ScrapedMetrics> scraped;
+  std::unique_ptr<prometheus::Exposer> exposer;
+};
+
+absl::StatusOr<std::unique_ptr<MetricsHttpServer>> MetricsHttpServer::Start(
+    const std::string& listen, std::shared_ptr<const Metrics> metrics, GaugeReader gauges) {
+  absl::StatusOr<std::string> address = CivetwebAddress(listen);
+  if (!address.ok()) return address.status();
+  std::unique_ptr<MetricsHttpServer> server(new MetricsHttpServer());
+  server->exposed_ = std::make_unique<Exposed>();
+  server->exposed_->scraped =
+      std::make_shared<ScrapedMetrics>([metrics = std::move(metrics), gauges = std::move(gauges)] {
+        return metrics->Collect(gauges());
+      });
+  // The Exposer throws (civetweb's CivetException) when it cannot listen; exceptions stay in here.
+  try {
+    server->exposed_->exposer = std::make_unique<prometheus::Exposer>(*address);
+  } catch (const std::exception&) {
+    return absl::UnavailableError(absl::StrCat("--metrics-listen: cannot bind '", listen,
+                                               "' (address in use or not local?)"));
+  }
+  server->exposed_->exposer->RegisterCollectable(server->exposed_->scraped);
+  const std::vector<int> ports = server->exposed_->exposer->GetListeningPorts();
+  if (ports.empty()) {
+    return absl::UnavailableError(
+        absl::StrCat("--metrics-listen: no port bound for '", listen, "'"));
+  }
+  server->port_ = ports.front();
   return server;
 }
 
-MetricsHttpServer::~MetricsHttpServer() {
-  stop_ = true;
-  if (thread_.joinable()) thread_.join();
-  if (fd_ >= 0) close(fd_);
-}
-
-void MetricsHttpServer::Serve() {
-  while (!stop_) {
-    pollfd p{fd_, POLLIN, 0};
-    if (poll(&p, 1, 100) <= 0) continue;
-    const int client = accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
-    if (client < 0) continue;
-    // Read the request head (up to 8 KiB, 1 s); only the request line matters.
-    std::string request;
-    char buffer[2048];
-    while (request.find("\r\n\r\n") == std::string::npos && request.size() < 8192) {
-      pollfd c{client, POLLIN, 0};
-      if (poll(&c, 1, 1000) <= 0) break;
-      const ssize_t n = read(client, buffer, sizeof(buffer));
-      if (n <= 0) break;
-      request.append(buffer, static_cast<size_t>(n));
-    }
-    std::string status = "404 Not Found";
-    std::string body = "not found; try GET /metrics\n";
-    std::string type = "text/plain; charset=utf-8";
-    if (request.rfind("GET /metrics ", 0) == 0 || request.rfind("GET /metrics?", 0) == 0) {
-      status = "200 OK";
-      body = render_();
-      type = "text/plain; version=0.0.4; charset=utf-8";
-    }
-    const std::string response =
-        absl::StrCat("HTTP/1.1 ", status, "\r\nContent-Type: ", type,
-                     "\r\nContent-Length: ", body.size(), "\r\nConnection: close\r\n\r\n", body);
-    size_t sent = 0;
-    while (sent < response.size()) {
-      const ssize_t n = send(client, response.data() + sent, response.size() - sent, MSG_NOSIGNAL);
-      if (n <= 0) break;
-      sent += static_cast<size_t>(n);
-    }
-    close(client);
-  }
-}
+MetricsHttpServer::~MetricsHttpServer() = default;
 
 }  // namespace inbetween::server
+
+// Debian's civetweb (under prometheus::Exposer) gives each of its threads a fixed 100 KiB stack,
+// and glibc carves the static TLS of every loaded library out of a requested stack size: OpenBLAS
+// and METIS hold ~90 KiB of it in our processes, which left civetweb's workers ~7 KiB, and they
+// overflowed on the first request. This definition comes before libc's for the dynamic linker; it
+// adds the static TLS to the sizes civetweb asks for, so its threads get the usable stack it meant,
+// and passes every other caller's request through unchanged.
+extern "C" int pthread_attr_setstacksize(pthread_attr_t* attr, size_t size) noexcept {
+  using Next = int (*)(pthread_attr_t*, size_t);
+  static const auto next = reinterpret_cast<Next>(dlsym(RTLD_NEXT, "pthread_attr_setstacksize"));
+  Dl_info caller;
+  if (dladdr(__builtin_return_address(0), &caller) != 0 && caller.dli_fname != nullptr &&
+      std::strstr(caller.dli_fname, "libcivetweb") != nullptr) {
+    static const size_t tls = inbetween::server::StaticTlsBytes();
+    size += tls;
+  }
+  return next(attr, size);
+}

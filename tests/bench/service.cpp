@@ -102,11 +102,12 @@ uint64_t CurrentVersion(v1::Inbetween::Stub& stub, const std::string& session_id
   return response.session().version();
 }
 
-// inbetween_rpcs_total{method=METHOD,code="CANCELLED"} in the server's metrics text.
+// inbetween_rpcs_total{code="CANCELLED",method=METHOD} in the server's metrics text (label names
+// in sorted order, as prometheus-cpp writes them).
 uint64_t CancelledCount(const inbetween::server::InbetweenServer& server,
                         const std::string& method) {
   const std::string text = server.RenderMetrics();
-  const std::string key = "inbetween_rpcs_total{method=\"" + method + "\",code=\"CANCELLED\"} ";
+  const std::string key = "inbetween_rpcs_total{code=\"CANCELLED\",method=\"" + method + "\"} ";
   const size_t at = text.find(key);
   return at == std::string::npos ? 0 : std::strtoull(text.c_str() + at + key.size(), nullptr, 10);
 }

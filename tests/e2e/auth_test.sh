@@ -39,9 +39,9 @@ print(urllib.request.urlopen(f"http://127.0.0.1:{sys.argv[1]}/metrics", timeout=
 PY
 }
 curl_metrics >"$WORK/metrics.txt"
-grep -q 'inbetween_rpcs_total{method="CreateSession",code="OK"} 1' "$WORK/metrics.txt" || { cat "$WORK/metrics.txt"; exit 1; }
+grep -q 'inbetween_rpcs_total{code="OK",method="CreateSession"} 1' "$WORK/metrics.txt" || { cat "$WORK/metrics.txt"; exit 1; }
 grep -q 'code="UNAUTHENTICATED"' "$WORK/metrics.txt"
-grep -q 'inbetween_rpc_duration_seconds_bucket{method="BuildMultimesh",code="OK",le="+Inf"} 1' "$WORK/metrics.txt"
+grep -q 'inbetween_rpc_duration_seconds_bucket{code="OK",method="BuildMultimesh",le="+Inf"} 1' "$WORK/metrics.txt"
 grep -q '^inbetween_active_sessions 1' "$WORK/metrics.txt"
 grep -q '^inbetween_heavy_queue_depth 0' "$WORK/metrics.txt"
 # One log line per RPC with its request id.

@@ -1,6 +1,7 @@
 // Bearer tokens (--tokens): UNAUTHENTICATED without a valid token, sessions owned by their token
 // (another token sees NOT_FOUND, lists only its own), health open; limits with their flags;
-// metrics text and the /metrics responder.
+// metrics text (prometheus-cpp's exposition: label names in sorted order) and the /metrics
+// endpoint (prometheus-cpp's Exposer) with its --metrics-listen errors.
 #include <arpa/inet.h>
 #include <gmock/gmock.h>
 #include <grpcpp/client_context.h>
@@ -45,12 +46,13 @@ TEST(MetricsTest, RendersCountersHistogramsAndGauges) {
   metrics.ObserveRpc("GetSession", "NOT_FOUND", 0.2);
   metrics.ObserveStage("build", 1.5);
   const std::string text = metrics.Render({{"inbetween_active_sessions", "Sessions.", 3}});
-  EXPECT_THAT(text, HasSubstr("inbetween_rpcs_total{method=\"GetSession\",code=\"OK\"} 1"));
-  EXPECT_THAT(text, HasSubstr("inbetween_rpcs_total{method=\"GetSession\",code=\"NOT_FOUND\"} 1"));
+  EXPECT_THAT(text, HasSubstr("# TYPE inbetween_rpcs_total counter"));
+  EXPECT_THAT(text, HasSubstr("inbetween_rpcs_total{code=\"OK\",method=\"GetSession\"} 1"));
+  EXPECT_THAT(text, HasSubstr("inbetween_rpcs_total{code=\"NOT_FOUND\",method=\"GetSession\"} 1"));
   // Latency per method and status code: the fast OK call and the slow NOT_FOUND one apart.
-  const std::string ok = "inbetween_rpc_duration_seconds_bucket{method=\"GetSession\",code=\"OK\",";
+  const std::string ok = "inbetween_rpc_duration_seconds_bucket{code=\"OK\",method=\"GetSession\",";
   const std::string missing =
-      "inbetween_rpc_duration_seconds_bucket{method=\"GetSession\",code=\"NOT_FOUND\",";
+      "inbetween_rpc_duration_seconds_bucket{code=\"NOT_FOUND\",method=\"GetSession\",";
   EXPECT_THAT(text, HasSubstr(ok + "le=\"0.005\"} 1"));
   EXPECT_THAT(text, HasSubstr(ok + "le=\"+Inf\"} 1"));
   EXPECT_THAT(text, HasSubstr(missing + "le=\"0.1\"} 0"));
@@ -58,9 +60,40 @@ TEST(MetricsTest, RendersCountersHistogramsAndGauges) {
   EXPECT_THAT(
       text,
       HasSubstr(
-          "inbetween_rpc_duration_seconds_count{method=\"GetSession\",code=\"NOT_FOUND\"} 1"));
+          "inbetween_rpc_duration_seconds_count{code=\"NOT_FOUND\",method=\"GetSession\"} 1"));
+  EXPECT_THAT(text, HasSubstr("inbetween_stage_seconds_bucket{stage=\"build\",le=\"1\"} 0"));
+  EXPECT_THAT(text, HasSubstr("inbetween_stage_seconds_bucket{stage=\"build\",le=\"5\"} 1"));
   EXPECT_THAT(text, HasSubstr("inbetween_stage_seconds_count{stage=\"build\"} 1"));
-  EXPECT_THAT(text, HasSubstr("inbetween_active_sessions 3"));
+  EXPECT_THAT(text, HasSubstr("inbetween_stage_seconds_sum{stage=\"build\"} 1.5"));
+  EXPECT_THAT(text, HasSubstr("inbetween_frames_solved_total 0"));
+  EXPECT_THAT(text,
+              HasSubstr("# TYPE inbetween_active_sessions gauge\ninbetween_active_sessions 3\n"));
+  metrics.CountFrameSolved();
+  EXPECT_EQ(metrics.frames_solved(), 1u);
+  EXPECT_THAT(metrics.Render({}), HasSubstr("inbetween_frames_solved_total 1"));
+}
+
+TEST(MetricsHttpServerTest, BadAddressesNameTheFlag) {
+  const auto metrics = std::make_shared<Metrics>();
+  const auto no_gauges = [] { return std::vector<Metrics::Gauge>{}; };
+  // Not HOST:PORT, no such port, IPv6 (Debian's civetweb is built without it).
+  for (const char* listen : {"9090", ":9090", "127.0.0.1:notaport", "[::1]:0", "[::]:9090"}) {
+    auto server = MetricsHttpServer::Start(listen, metrics, no_gauges);
+    ASSERT_FALSE(server.ok()) << listen;
+    EXPECT_EQ(server.status().code(), absl::StatusCode::kInvalidArgument) << listen;
+    EXPECT_THAT(std::string(server.status().message()), HasSubstr("--metrics-listen")) << listen;
+  }
+  // A port that is taken (by the first server) and an address of no local interface.
+  auto first = MetricsHttpServer::Start("127.0.0.1:0", metrics, no_gauges);
+  ASSERT_TRUE(first.ok()) << first.status();
+  ASSERT_GT((*first)->port(), 0);
+  for (const std::string listen :
+       {"127.0.0.1:" + std::to_string((*first)->port()), std::string("192.0.2.1:0")}) {
+    auto server = MetricsHttpServer::Start(listen, metrics, no_gauges);
+    ASSERT_FALSE(server.ok()) << listen;
+    EXPECT_EQ(server.status().code(), absl::StatusCode::kUnavailable) << listen;
+    EXPECT_THAT(std::string(server.status().message()), HasSubstr("--metrics-listen")) << listen;
+  }
 }
 
 // GET `path` from 127.0.0.1:port; the whole response.
@@ -192,14 +225,23 @@ TEST_F(SecuredServerTest, FrameLimitAndMetricsEndpoint) {
   // The stage check comes first for a session without a multimesh.
   EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::FAILED_PRECONDITION);
 
+  // Served by civetweb's threads in a process holding OpenBLAS's and METIS's static TLS: they
+  // overflowed their stack before metrics.cpp's pthread_attr_setstacksize made room for it.
   ASSERT_GT(server_->metrics_port(), 0);
   const std::string metrics = HttpGet(server_->metrics_port(), "/metrics");
   EXPECT_THAT(metrics, HasSubstr("HTTP/1.1 200 OK"));
-  EXPECT_THAT(metrics, HasSubstr("inbetween_rpcs_total{method=\"CreateSession\",code=\"OK\"} 1"));
+  EXPECT_THAT(metrics, HasSubstr("inbetween_rpcs_total{code=\"OK\",method=\"CreateSession\"} 1"));
   EXPECT_THAT(metrics, HasSubstr("code=\"FAILED_PRECONDITION\""));
+  EXPECT_THAT(metrics, HasSubstr("# TYPE inbetween_active_sessions gauge"));
   EXPECT_THAT(metrics, HasSubstr("inbetween_active_sessions 1"));
   EXPECT_THAT(metrics, HasSubstr("inbetween_heavy_queue_depth 0"));
   EXPECT_THAT(HttpGet(server_->metrics_port(), "/other"), HasSubstr("404"));
+
+  // The next scrape sees the next call counted and the gauge read anew.
+  ASSERT_TRUE(Create("token-a", &session).ok());
+  const std::string after = HttpGet(server_->metrics_port(), "/metrics");
+  EXPECT_THAT(after, HasSubstr("inbetween_rpcs_total{code=\"OK\",method=\"CreateSession\"} 2"));
+  EXPECT_THAT(after, HasSubstr("inbetween_active_sessions 2"));
 }
 
 // Many clients at once through the real gRPC server (its handler threads): every call gets its
@@ -241,9 +283,9 @@ TEST_F(SecuredServerTest, ConcurrentCallsGetTheirOwnersAnswersAndAreAllCounted) 
   const std::string metrics = HttpGet(server_->metrics_port(), "/metrics");
   const std::string total = std::to_string(kClients * kRounds);
   EXPECT_THAT(metrics,
-              HasSubstr("inbetween_rpcs_total{method=\"GetSession\",code=\"OK\"} " + total));
+              HasSubstr("inbetween_rpcs_total{code=\"OK\",method=\"GetSession\"} " + total));
   EXPECT_THAT(metrics,
-              HasSubstr("inbetween_rpcs_total{method=\"GetSession\",code=\"NOT_FOUND\"} " + total));
+              HasSubstr("inbetween_rpcs_total{code=\"NOT_FOUND\",method=\"GetSession\"} " + total));
 }
 
 }  // namespace

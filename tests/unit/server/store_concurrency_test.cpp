@@ -197,8 +197,8 @@ TEST(StoreConcurrencyTest, MetricsCountEveryObservationWhileRendering) {
   const std::string text = metrics.Render({});
   for (const char* method : {"PutDrawing", "GetSession"}) {
     std::smatch m;
-    const std::regex counter(std::string("inbetween_rpcs_total\\{method=\"") + method +
-                             "\",code=\"OK\"\\} ([0-9]+)");
+    const std::regex counter(std::string("inbetween_rpcs_total\\{code=\"OK\",method=\"") + method +
+                             "\"\\} ([0-9]+)");
     ASSERT_TRUE(std::regex_search(text, m, counter)) << text;
     EXPECT_EQ(m[1].str(), std::to_string(kThreads / 2 * kEach));
   }
