@@ -1,13 +1,16 @@
 #!/usr/bin/python3
 """Checks docker/ and deploy/k8s/ without a container engine (driven by containers_test.sh).
 
-Usage: containers_check.py --src SRC --bin BUILD_DIR --work DIR --redis-port PORT [--k8s RENDERED]
+Usage: containers_check.py --src SRC --bin BUILD_DIR --work DIR [--k8s RENDERED]
 Static checks of docker/Dockerfile, docker/compose.yaml, docker/runtime-packages.txt and the
 rendered `kubectl kustomize deploy/k8s` (RENDERED), then their commands run for real on loopback:
-the servers started with the compose and Kubernetes flags (on a real Redis), the nginx entrypoint
-in front of them, the HEALTHCHECK script and inbetween-loadgen with the compose arguments. Every
-failure is listed; exit 1 if there is any. Needs Debian's python3-yaml and python3-grpcio
-(/usr/bin/python3), apt-cache, dpkg, ldd, nginx, haproxy, node.
+Redis as compose (docker/redis-entrypoint.sh) and Kubernetes (its shell command) start it, with a
+password from a secret file and maxmemory/noeviction, the servers with the compose and Kubernetes
+flags on it (tokens on), the nginx entrypoint in front of them, the HEALTHCHECK scripts and
+inbetween-loadgen with the compose arguments (its token from the secret file). Secrets: the
+password is in no process's argv, none is committed. Every failure is listed; exit 1 if there is
+any. Needs Debian's python3-yaml and python3-grpcio (/usr/bin/python3), apt-cache, dpkg, ldd,
+nginx, haproxy, node, redis-server and redis-cli; git for the committed-secrets checks.
 """
 import argparse
 import fnmatch
@@ -15,6 +18,7 @@ import json
 import os
 import re
 import shlex
+import shutil
 import socket
 import subprocess
 import sys
@@ -179,6 +183,190 @@ def check_health_answers(src):
         server.stop(0)
 
 
+# ------------------------------------------------------------------------ secrets and Redis
+
+
+def k8s_expand(text, env):
+    """Kubernetes' expansion of a container's command and args: $(NAME) of a defined variable
+    becomes its value, $$ becomes $, anything else stays as it is (the kubelet's
+    third_party/forked/golang/expansion)."""
+    out, i = [], 0
+    while i < len(text):
+        if text[i] == "$" and i + 1 < len(text):
+            if text[i + 1] == "$":
+                out.append("$")
+                i += 2
+                continue
+            end = text.find(")", i + 2) if text[i + 1] == "(" else -1
+            if end != -1:
+                name = text[i + 2 : end]
+                out.append(str(env[name]) if name in env else text[i : end + 1])
+                i = end + 1
+                continue
+            out.append(text[i : i + 2])
+            i += 2
+            continue
+        out.append(text[i])
+        i += 1
+    return "".join(out)
+
+
+def redis_bytes(value):
+    """Redis' memory size (1gb, 512mb, 100000000) in bytes, or None."""
+    m = re.fullmatch(r"(\d+)(k|kb|m|mb|g|gb)?", str(value or "").lower())
+    units = {None: 1, "k": 1000, "kb": 1024, "m": 10**6, "mb": 1024**2, "g": 10**9, "gb": 1024**3}
+    return int(m.group(1)) * units[m.group(2)] if m else None
+
+
+def sample_secrets():
+    """Values for the secrets of the local runs: a password Redis' configuration must quote (a
+    space, a double quote, a backslash), and a bearer token."""
+    import secrets
+
+    return f'pass word "{secrets.token_hex(6)}" back\\slash', f"tok-{secrets.token_urlsafe(16)}"
+
+
+def write_file(path, text):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+def redis_cli(port, *args, password=None):
+    """redis-cli's answer on 127.0.0.1:PORT; the password goes through REDISCLI_AUTH."""
+    env = {k: v for k, v in os.environ.items() if k != "REDISCLI_AUTH"}
+    if password is not None:
+        env["REDISCLI_AUTH"] = password
+    out = run(["redis-cli", "-h", "127.0.0.1", "-p", str(port)] + list(args), env=env, timeout=10)
+    return (out.stdout + out.stderr).replace("\r", "").strip()
+
+
+def start_redis(procs, work, name, make_cmd, password, env=None):
+    """MAKE_CMD(port) (an entrypoint or shell that execs redis-server) on a free loopback port,
+    another one if that port was taken. Returns (port, argv file) once Redis answers with
+    PASSWORD and reports the started process's pid (the exec kept it), else (None, None).
+    redis-server replaces its argv with a title once it runs, so `redis-server` is found first
+    in a directory where a script records the arguments it gets (NUL-separated, in the argv
+    file) and execs the real one."""
+    real = shutil.which("redis-server")
+    spy = write_file(os.path.join(work, "redis-argv/redis-server"),
+                     f'#!/bin/sh\nprintf \'%s\\0\' "$@" >"$INBETWEEN_REDIS_ARGV"\n'
+                     f'exec {shlex.quote(real)} "$@"\n')
+    os.chmod(spy, 0o755)
+    argv_file = os.path.join(work, f"{name}.argv")
+    env = dict(env or os.environ, INBETWEEN_REDIS_ARGV=argv_file,
+               PATH=os.path.dirname(spy) + os.pathsep + os.environ.get("PATH", ""))
+    proc = None
+    for _ in range(5):
+        port = free_port()
+        proc = procs.start(name, make_cmd(port), env=env)
+        for _ in range(200):
+            if proc.poll() is not None or redis_cli(port, "ping", password=password) == "PONG":
+                break
+            time.sleep(0.05)
+        if f"process_id:{proc.pid}" in redis_cli(port, "info", "server", password=password):
+            return port, argv_file
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    check(False, f"{name}: Redis did not start (or not as the started process):\n{log_of(proc)}")
+    return None, None
+
+
+def argv_holding(secret):
+    """The pids whose command line contains SECRET (any user can read every process's argv)."""
+    needle, found = secret.encode(), []
+    for pid in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                if pid.isdigit() and needle in f.read():
+                    found.append(int(pid))
+        except OSError:
+            pass
+    return found
+
+
+def check_redis_secured(name, port, password, maxmemory, argv_file):
+    """Redis on PORT refuses clients without PASSWORD, has maxmemory MAXMEMORY (Redis' notation)
+    with noeviction; redis-server got its configuration from stdin (ARGV_FILE: its arguments)
+    and the password is in no process's argv."""
+    with open(argv_file, "rb") as f:
+        argv = f.read().split(b"\0")
+    check(argv[:1] == [b"-"], f"{name}: redis-server's first argument is not - (stdin): {argv}")
+    check(
+        password.encode() not in b" ".join(argv), f"{name}: redis-server got the password in argv"
+    )
+    reply = redis_cli(port, "ping")
+    check(reply.startswith("NOAUTH"), f"{name}: PING without a password answered {reply!r}")
+    reply = redis_cli(port, "ping", password=password + "x")
+    check(reply != "PONG", f"{name}: a wrong password was accepted")
+    words = redis_cli(port, "config", "get", "maxmemory*", password=password).split("\n")
+    conf = dict(zip(words[::2], words[1::2]))
+    check(
+        redis_bytes(maxmemory)
+        and conf.get("maxmemory") == str(redis_bytes(maxmemory))
+        and conf.get("maxmemory-policy") == "noeviction",
+        f"{name}: not maxmemory {maxmemory} with noeviction: {conf}",
+    )
+    holders = argv_holding(password)
+    check(not holders, f"{name}: the Redis password is in the command line of pids {holders}")
+
+
+def call_status(addr, token=None, method="ListSessions"):
+    """(gRPC code, serialized status details) of METHOD with an empty request on ADDR, with the
+    bearer TOKEN if any. An empty ListSessions reads the store, an empty CreateSession writes."""
+    import grpc
+
+    with grpc.insecure_channel(addr) as channel:
+        call = channel.unary_unary(f"/{HEALTH_SERVICE}/{method}")
+        metadata = [("authorization", f"Bearer {token}")] if token else None
+        try:
+            call(b"", metadata=metadata, timeout=20)
+            return "OK", b""
+        except grpc.RpcError as e:
+            details = dict(e.trailing_metadata() or ()).get("grpc-status-details-bin", b"")
+            return e.code().name, details
+
+
+def call_code(addr, token=None):
+    return call_status(addr, token)[0]
+
+
+def check_tokens_required(name, addr, token):
+    """Tokens on: a call without one is refused; with TOKEN it passes and reaches Redis."""
+    code = call_code(addr)
+    check(code == "UNAUTHENTICATED", f"{name}: a call without a token got {code}")
+    code = call_code(addr, token)
+    check(code == "OK", f"{name}: ListSessions with the token got {code} (Redis AUTH?)")
+
+
+def check_secrets_not_committed(src, files):
+    """No secret value in git: nothing under docker/secrets/ is tracked but its .gitignore, the
+    compose secrets' FILES are ignored, and no tracked manifest is a Kubernetes Secret."""
+    inside = run(["git", "-C", src, "rev-parse", "--is-inside-work-tree"])
+    if inside.returncode != 0 or inside.stdout.strip() != "true":
+        print("secrets: the source is not a git work tree; the git checks are skipped")
+        return
+    tracked = run(["git", "-C", src, "ls-files", "docker/secrets"]).stdout.split()
+    check(
+        set(tracked) <= {"docker/secrets/.gitignore"},
+        f"files under docker/secrets/ are in git: {tracked}",
+    )
+    for name, path in files.items():
+        rel = os.path.relpath(path, src)
+        check(
+            run(["git", "-C", src, "check-ignore", "-q", rel]).returncode == 0,
+            f"compose secret {name}: {rel} is not git-ignored",
+        )
+    for rel in run(["git", "-C", src, "ls-files", "deploy", "docker"]).stdout.split():
+        if rel.endswith((".yaml", ".yml")) and os.path.exists(os.path.join(src, rel)):
+            with open(os.path.join(src, rel)) as f:
+                kinds = [d.get("kind") for d in yaml.safe_load_all(f) if isinstance(d, dict)]
+            check("Secret" not in kinds, f"{rel} is a Kubernetes Secret (its value is in git)")
+    print(f"secrets: {len(files)} compose secrets git-ignored, no Secret manifest in git")
+
+
 # ---------------------------------------------------------------------------- Dockerfile
 
 
@@ -266,7 +454,8 @@ def check_dockerfile(src, bin_dir, server_flags, gateway_flags):
         for l in open(os.path.join(src, ".dockerignore"))
         if l.strip() and not l.startswith("#")
     ]
-    for d in ("build", "build/test", "build-server", "out", "client/web/node_modules"):
+    for d in ("build", "build/test", "build-server", "out", "client/web/node_modules",
+              "docker/secrets"):
         check(dockerignored(ignore, d), f".dockerignore does not exclude {d}/ from the context")
 
     # Sources copied from the context exist and are not excluded by .dockerignore.
@@ -464,6 +653,28 @@ def check_dockerfile(src, bin_dir, server_flags, gateway_flags):
             ),
             "the proxy stage does not install nginx and haproxy",
         )
+    redis = images.get("redis")
+    if redis:
+        # The password: the entrypoint script feeds it to redis-server on stdin, the health check
+        # authenticates; maxmemory with noeviction by default.
+        def copied(image, command):
+            path = command if "/" in command else os.path.join("/usr/local/bin", command)
+            return image["copies"].get(path, (None, ""))[1]
+
+        check(
+            redis["entry"][:1] and copied(redis, redis["entry"][0]) == "docker/redis-entrypoint.sh",
+            f"the redis image's ENTRYPOINT is not docker/redis-entrypoint.sh: {redis['entry']}",
+        )
+        hc = exec_form(re.sub(r"^.*?\bCMD\s+", "", redis["health"] or "")) or []
+        check(
+            hc and copied(redis, hc[0]) == "docker/redis-healthcheck.sh",
+            f"the redis HEALTHCHECK is not docker/redis-healthcheck.sh: {redis['health']}",
+        )
+        check(
+            redis_bytes(flag_value(redis["cmd"], "--maxmemory"))
+            and flag_value(redis["cmd"], "--maxmemory-policy") == "noeviction",
+            f"the redis image's CMD has no --maxmemory with noeviction: {redis['cmd']}",
+        )
     return images
 
 
@@ -578,6 +789,60 @@ def check_compose(src, images, server_flags, loadgen_flags, gateway_flags):
     def target(svc):
         return (svc.get("build") or {}).get("target")
 
+    # Secrets: compose's top-level file secrets under docker/secrets/ (git-ignored, outside the
+    # build context), mounted at /run/secrets/NAME; never a value in a command or environment.
+    secret_files = {}
+    for name in ("redis_password", "tokens"):
+        file = ((compose.get("secrets") or {}).get(name) or {}).get("file")
+        path = os.path.normpath(os.path.join(src, "docker", file or "."))
+        check(
+            file and os.path.dirname(path) == os.path.join(src, "docker/secrets"),
+            f"compose: no top-level secret {name} with a file under docker/secrets/",
+        )
+        secret_files[name] = path
+
+    def secrets_of(svc):
+        return [r if isinstance(r, str) else r.get("source") for r in svc.get("secrets") or []]
+
+    for name, svc in services.items():
+        args = [str(x) for x in (svc.get("entrypoint") or []) + (svc.get("command") or [])]
+        for a in args:
+            if a.startswith("/run/secrets/"):
+                check(
+                    os.path.basename(a) in secrets_of(svc),
+                    f"compose {name}: {a} is not one of its secrets {secrets_of(svc)}",
+                )
+        check(
+            "--token" not in args and "--requirepass" not in args,
+            f"compose {name}: a secret value in its command line: {args}",
+        )
+        for key in svc.get("environment") or {}:
+            check(
+                not re.search(r"PASSWORD|TOKEN|SECRET", key, re.I),
+                f"compose {name}: environment {key} looks like a secret value",
+            )
+
+    # Redis: the image's entrypoint (password from the secret on stdin), an authenticating
+    # health check, maxmemory with noeviction.
+    rcmd = [str(x) for x in redis.get("command") or []]
+    check(
+        "redis_password" in secrets_of(redis) and not redis.get("entrypoint"),
+        "compose redis: does not mount the secret redis_password for the image's entrypoint",
+    )
+    check(
+        redis_bytes(flag_value(rcmd, "--maxmemory"))
+        and flag_value(rcmd, "--maxmemory-policy") == "noeviction",
+        f"compose redis: no --maxmemory with --maxmemory-policy noeviction: {rcmd}",
+    )
+    rtest = [str(x) for x in (redis.get("healthcheck") or {}).get("test") or []]
+    redis_copies = images.get("redis", {}).get("copies", {})
+    health_script = redis_copies.get(os.path.join("/usr/local/bin", rtest[1] if len(rtest) > 1
+                                                  else ""), (None, ""))[1]
+    check(
+        rtest[:1] == ["CMD"] and health_script == "docker/redis-healthcheck.sh",
+        f"compose redis: the healthcheck is not the image's authenticating PING: {rtest}",
+    )
+
     replicas = {
         n: s
         for n, s in services.items()
@@ -597,6 +862,18 @@ def check_compose(src, images, server_flags, loadgen_flags, gateway_flags):
         check(
             svc.get("depends_on", {}).get("redis", {}).get("condition") == "service_healthy",
             f"compose {name}: does not wait for a healthy redis",
+        )
+        check(
+            flag_value(args, "--redis-password-file") == "/run/secrets/redis_password",
+            f"compose {name}: no --redis-password-file /run/secrets/redis_password",
+        )
+        check(
+            flag_value(args, "--tokens") == "/run/secrets/tokens",
+            f"compose {name}: no --tokens /run/secrets/tokens (tokens are on by default)",
+        )
+        check(
+            (flag_value(args, "--session-ttl-seconds") or "").isdigit(),
+            f"compose {name}: no explicit --session-ttl-seconds",
         )
 
     nginx = services.get("nginx", {})
@@ -651,6 +928,11 @@ def check_compose(src, images, server_flags, loadgen_flags, gateway_flags):
         "compose loadgen: its entrypoint is not the image's inbetween-loadgen",
     )
     check(set(flags_of(largs)) <= loadgen_flags, f"compose loadgen: unknown flags in {largs}")
+    check(
+        flag_value(largs, "--token-file") == "/run/secrets/tokens",
+        "compose loadgen: does not read its token from the secret "
+        "(--token-file /run/secrets/tokens)",
+    )
     tgt = flag_value(largs, "--target") or ":0"
     check(
         tgt.rsplit(":", 1)[0] in ("127.0.0.1", "localhost") and port_of(tgt) == proxy_port,
@@ -685,16 +967,59 @@ def check_compose(src, images, server_flags, loadgen_flags, gateway_flags):
         proxy_port=proxy_port,
         loadgen_args=largs,
         drawings=drawings,
+        secret_files=secret_files,
+        redis_command=rcmd,
+        redis_health=rtest,
     )
 
 
-def run_compose_locally(src, bin_dir, procs, work, redis_port, compose):
-    """The compose services' commands on loopback: replicas on a real Redis, the proxy image's
-    nginx entrypoint in front of them, the HEALTHCHECK script, inbetween-loadgen through nginx."""
+def run_compose_locally(src, bin_dir, procs, work, compose):
+    """The compose services' commands on loopback: Redis through the image's entrypoint script
+    with compose's command and a password file, replicas on it with their secrets, the proxy
+    image's nginx entrypoint in front of them, the HEALTHCHECK scripts, inbetween-loadgen through
+    nginx."""
     server_bin = os.path.join(bin_dir, "server/inbetween-server")
+    password, token = sample_secrets()
+    files = {
+        "redis_password": write_file(os.path.join(work, "compose-secrets/redis_password"),
+                                     password + "\n"),
+        # A comment first: inbetween-loadgen --token-file skips it, as the server does.
+        "tokens": write_file(os.path.join(work, "compose-secrets/tokens"),
+                             f"# compose's tokens\n{token} compose\n"),
+    }
+
+    def local(args):
+        """/run/secrets/NAME (compose's mounts) -> the test's file."""
+        return [files.get(a[len("/run/secrets/"):], a) if a.startswith("/run/secrets/") else a
+                for a in args]
+
+    entry = os.path.join(src, "docker/redis-entrypoint.sh")
+    health = [os.path.join(src, "docker/redis-healthcheck.sh")] + compose["redis_health"][2:]
+    out = run([entry, "--port", str(free_port())], timeout=30,
+              env=dict(os.environ, REDIS_PASSWORD_FILE=os.path.join(work, "no-such-file")))
+    check(out.returncode != 0 and "password file" in out.stderr,
+          f"docker/redis-entrypoint.sh started without a password file: {out.stderr}")
+    env = dict(os.environ, REDIS_PASSWORD_FILE=files["redis_password"])
+    rcmd = with_value(compose["redis_command"], "--dir", os.path.join(work, "compose-redis"))
+    os.makedirs(os.path.join(work, "compose-redis"), exist_ok=True)
+    redis_port, argv_file = start_redis(
+        procs, work, "compose-redis",
+        lambda p: [entry] + rcmd + ["--port", str(p), "--bind", "127.0.0.1", "--save", ""],
+        password, env=env)
+    if not redis_port:
+        return
+    check_redis_secured("compose redis", redis_port, password,
+                        flag_value(compose["redis_command"], "--maxmemory"), argv_file)
+    out = run(health[:1] + ["-p", str(redis_port)] + health[1:], env=env, timeout=30)
+    check(out.returncode == 0, f"compose redis healthcheck: {out.stdout}{out.stderr}")
+    wrong = write_file(os.path.join(work, "compose-secrets/wrong"), "not-the-password\n")
+    out = run(health[:1] + ["-p", str(redis_port)] + health[1:], timeout=30,
+              env=dict(os.environ, REDIS_PASSWORD_FILE=wrong))
+    check(out.returncode != 0, "compose redis healthcheck passes with a wrong password")
+
     addrs = {}
     for name, svc in sorted(compose["replicas"].items()):
-        args = with_value(svc["command"], "--listen", "127.0.0.1:0")
+        args = with_value(local(svc["command"]), "--listen", "127.0.0.1:0")
         args = with_value(args, "--metrics-listen", "127.0.0.1:0")
         args = with_value(args, "--store", f"redis://127.0.0.1:{redis_port}")
         addrs[name] = start_server(procs, server_bin, f"compose-{name}", args)
@@ -703,6 +1028,7 @@ def run_compose_locally(src, bin_dir, procs, work, redis_port, compose):
     for name, addr in addrs.items():
         rc, out = healthcheck(src, addr)
         check(rc == 0, f"HEALTHCHECK against compose {name} ({addr}): {out}")
+        check_tokens_required(f"compose {name}", addr, token)
     port = free_port()
     env = dict(
         os.environ,
@@ -725,10 +1051,13 @@ def run_compose_locally(src, bin_dir, procs, work, redis_port, compose):
     )
     rc, out = healthcheck(src, f"127.0.0.1:{port}")
     check(rc == 0, f"HEALTHCHECK through the nginx entrypoint: {out}")
+    check_tokens_required("compose nginx", f"127.0.0.1:{port}", token)
+    holders = argv_holding(token)
+    check(not holders, f"compose: the bearer token is in the command line of pids {holders}")
 
     # The load generator with the compose arguments: target nginx here, drawings from examples/,
     # a short bounded run.
-    args = list(compose["loadgen_args"])
+    args = local(compose["loadgen_args"])
     args = with_value(args, "--target", f"127.0.0.1:{port}")
     i = args.index("--drawings") + 1
     for local in compose["drawings"]:
@@ -758,9 +1087,26 @@ def run_compose_locally(src, bin_dir, procs, work, redis_port, compose):
             f"the compose load run through nginx: {json.dumps(report)[:600]}",
         )
         print(
-            f"compose on loopback: 3 replicas on Redis, nginx entrypoint, loadgen "
-            f"{report['requests']} requests, {report['streams_completed']} streams, 0 lost"
+            f"compose on loopback: Redis with a password and noeviction, 3 replicas with tokens, "
+            f"nginx entrypoint, loadgen (--token-file) {report['requests']} requests, "
+            f"{report['streams_completed']} streams, 0 lost"
         )
+
+    # A full store as a client sees it: Redis at maxmemory with noeviction refuses a new session
+    # (RESOURCE_EXHAUSTED, reason STORE_FULL in the status details), reads keep working.
+    redis_cli(redis_port, "config", "set", "maxmemory", "1", password=password)
+    code, details = call_status(f"127.0.0.1:{port}", token, "CreateSession")
+    check(
+        code == "RESOURCE_EXHAUSTED" and b"STORE_FULL" in details,
+        f"compose: CreateSession on a full Redis got {code} {details!r}, not RESOURCE_EXHAUSTED "
+        "with reason STORE_FULL",
+    )
+    code = call_code(f"127.0.0.1:{port}", token)
+    if check(code == "OK", f"compose: ListSessions on a full Redis got {code}"):
+        print("compose: a full Redis refuses CreateSession (RESOURCE_EXHAUSTED, STORE_FULL); "
+              "ListSessions still answers")
+    redis_cli(redis_port, "config", "set", "maxmemory",
+              flag_value(compose["redis_command"], "--maxmemory"), password=password)
 
 
 # ------------------------------------------------------------------------------- kubernetes
@@ -770,7 +1116,43 @@ def labels_match(selector, labels):
     return bool(selector) and all(labels.get(k) == v for k, v in selector.items())
 
 
-def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags):
+def secret_source(workload, container, path):
+    """(Secret name, key) of the file PATH in CONTAINER of WORKLOAD, or None."""
+    volumes = {v["name"]: v for v in workload["spec"]["template"]["spec"].get("volumes", [])}
+    for m in container.get("volumeMounts", []):
+        base = m["mountPath"].rstrip("/") + "/"
+        secret = volumes.get(m["name"], {}).get("secret")
+        if path.startswith(base) and secret:
+            rel = path[len(base):]
+            items = secret.get("items")
+            key = next((i["key"] for i in items if i["path"] == rel), None) if items else rel
+            return (secret.get("secretName"), key) if key else None
+    return None
+
+
+def local_secret_mounts(workload, container, values, local_dir):
+    """{mountPath: a local directory} for CONTAINER's Secret volumes, each file written from
+    VALUES (by key) as the kubelet would project it."""
+    volumes = {v["name"]: v for v in workload["spec"]["template"]["spec"].get("volumes", [])}
+    mounts = {}
+    for m in container.get("volumeMounts", []):
+        secret = volumes.get(m["name"], {}).get("secret")
+        if secret:
+            d = os.path.join(local_dir, m["name"])
+            items = secret.get("items") or [{"key": k, "path": k} for k in values]
+            for i in items:
+                write_file(os.path.join(d, i["path"]), values.get(i["key"], ""))
+            mounts[m["mountPath"].rstrip("/") + "/"] = d + "/"
+    return mounts
+
+
+def localized(text, mounts):
+    for mount, d in mounts.items():
+        text = text.replace(mount, d)
+    return text
+
+
+def check_k8s(src, bin_dir, procs, work, rendered, server_flags):
     docs = [d for d in yaml.safe_load_all(open(rendered)) if d]
     kinds = {}
     for d in docs:
@@ -833,10 +1215,7 @@ def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags):
     for e in c.get("env", []):
         ref = e.get("valueFrom", {}).get("configMapKeyRef")
         env[e["name"]] = configmaps.get(ref["name"], {}).get(ref["key"]) if ref else e.get("value")
-    args = [
-        re.sub(r"\$\(([A-Za-z_][A-Za-z0-9_]*)\)", lambda m: str(env.get(m.group(1), m.group(0))), a)
-        for a in c.get("args", [])
-    ]
+    args = [k8s_expand(a, env) for a in c.get("args", [])]
     check(c["image"].startswith("inbetween-server:"), f"the server image has no tag: {c['image']}")
     check(not any("$(" in a for a in args), f"the server args have unresolved variables: {args}")
     check(
@@ -859,6 +1238,23 @@ def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags):
         0 < heavy * threads <= max(1, round(cpus)),
         f"--max-heavy-jobs {heavy} x --solver-threads {threads} does not fit the CPU limit "
         f"{limits['cpu']}",
+    )
+    # No secret in the manifests (the operator creates inbetween-secrets); the servers read it.
+    check(not kinds.get("Secret"), "the manifests hold a Secret: its value would be committed")
+    check(
+        "replicas" not in deploy["spec"],
+        "the server Deployment sets replicas: every apply would reset its HPA's count",
+    )
+    for flag, key in (("--redis-password-file", "redis-password"), ("--tokens", "tokens")):
+        path = flag_value(args, flag) or ""
+        check(
+            secret_source(deploy, c, path) == ("inbetween-secrets", key),
+            f"the server's {flag} {path!r} is not the key {key} of the Secret inbetween-secrets",
+        )
+    raw_ttl = flag_value(c.get("args", []), "--session-ttl-seconds") or ""
+    check(
+        raw_ttl.startswith("$(") and (flag_value(args, "--session-ttl-seconds") or "").isdigit(),
+        f"the server's --session-ttl-seconds is not a number from the ConfigMap: {raw_ttl!r}",
     )
     grace = int(flag_value(args, "--shutdown-grace-ms") or 5000) / 1000
     check(
@@ -898,12 +1294,42 @@ def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags):
     store = flag_value(args, "--store") or ""
     m = re.fullmatch(r"redis://([a-z0-9-]+):(\d+)", store)
     redis = [w for w in workloads if image_of(w).startswith("redis:")]
+    redis_script = redis_probe = None
     if check(m and redis, f"--store {store} is not redis://SERVICE:PORT, or no Redis workload"):
         svc = [s for s in services_for(redis[0]) if s["metadata"]["name"] == m.group(1)]
         check(
             svc and any(p["port"] == int(m.group(2)) for p in svc[0]["spec"]["ports"]),
             f"--store {store}: no Service of that name and port selects the Redis pods",
         )
+        # The password from the Secret on stdin (`redis-server -`, in a shell), maxmemory with
+        # noeviction, a probe that authenticates.
+        rc = containers(redis[0])[0]
+        renv = {e["name"]: e.get("value", "") for e in rc.get("env", [])}
+        rcmd = [k8s_expand(x, renv) for x in rc.get("command", []) + rc.get("args", [])]
+        script = rcmd[2] if rcmd[:2] == ["sh", "-c"] and len(rcmd) == 3 else ""
+        paths = set(re.findall(r"/run/[\w./-]+", script))
+        check(
+            "redis-server -" in script
+            and re.search(r"^\s*requirepass ", script, re.M)
+            and any(secret_source(redis[0], rc, p) == ("inbetween-secrets", "redis-password")
+                    for p in paths),
+            f"Redis does not get requirepass on stdin from the Secret's redis-password: {rcmd}",
+        )
+        maxmemory = re.search(r"--maxmemory (\S+)", script)
+        check(
+            maxmemory and redis_bytes(maxmemory.group(1))
+            and re.search(r"--maxmemory-policy noeviction\b", script),
+            f"Redis has no --maxmemory with --maxmemory-policy noeviction: {script}",
+        )
+        probe = (rc.get("readinessProbe") or {}).get("exec", {}).get("command") or []
+        check(
+            "REDISCLI_AUTH" in " ".join(probe)
+            and any(secret_source(redis[0], rc, p) == ("inbetween-secrets", "redis-password")
+                    for p in re.findall(r"/run/[\w./-]+", " ".join(probe))),
+            f"Redis' readinessProbe does not authenticate with the Secret: {probe}",
+        )
+        if script and maxmemory:
+            redis_script, redis_probe = script, probe
 
     # The proxy: HAProxy from the proxy image with the generated ConfigMap.
     proxies = [w for w in kinds.get("Deployment", []) if image_of(w).startswith("inbetween-proxy")]
@@ -945,16 +1371,52 @@ def check_k8s(src, bin_dir, procs, work, redis_port, rendered, server_flags):
             hpas[0]["spec"]["maxReplicas"] if hpas else 0,
         )
 
-    # The Deployment's args, run for real: a server on the test's Redis, health as the probes ask.
-    run_args = with_value(args, "--listen", "127.0.0.1:0")
-    run_args = with_value(run_args, "--metrics-listen", "127.0.0.1:0")
-    run_args = with_value(run_args, "--store", f"redis://127.0.0.1:{redis_port}")
-    addr = start_server(
-        procs, os.path.join(bin_dir, "server/inbetween-server"), "k8s-server", run_args
-    )
-    if addr:
-        rc, out = healthcheck(src, addr, c["readinessProbe"]["grpc"]["service"])
-        check(rc == 0, f"the Deployment's server does not answer its probe's health check: {out}")
+    # Redis' command, run for real: the shell script with the Secret's file projected into a
+    # local directory (a password that needs quoting), on a free port; its probe.
+    password, token = sample_secrets()
+    values = {"redis-password": password + "\n", "tokens": f"{token} k8s\n"}
+    redis_port = None
+    if redis_script:
+        rc = containers(redis[0])[0]
+        mounts = local_secret_mounts(redis[0], rc, values, os.path.join(work, "k8s-redis-secrets"))
+        data = os.path.join(work, "k8s-redis-data")
+        os.makedirs(data, exist_ok=True)
+        script = localized(redis_script, mounts).replace(" --dir /data", f" --dir {data}")
+        redis_port, argv_file = start_redis(
+            procs, work, "k8s-redis",
+            lambda p: ["sh", "-c", script.replace(
+                "redis-server -", f"redis-server - --port {p} --bind 127.0.0.1 --save ''", 1)],
+            password)
+    if redis_port:
+        check_redis_secured("k8s redis", redis_port, password,
+                            re.search(r"--maxmemory (\S+)", redis_script).group(1), argv_file)
+        probe = [localized(x, mounts).replace("redis-cli ", f"redis-cli -p {redis_port} ", 1)
+                 for x in redis_probe]
+        out = run(probe, timeout=30)
+        check(out.returncode == 0, f"Redis' readinessProbe fails: {out.stdout}{out.stderr}")
+        wrong = local_secret_mounts(redis[0], rc, {"redis-password": "wrong\n"},
+                                    os.path.join(work, "k8s-wrong-secrets"))
+        out = run([localized(x, wrong).replace("redis-cli ", f"redis-cli -p {redis_port} ", 1)
+                   for x in redis_probe], timeout=30)
+        check(out.returncode != 0, "Redis' readinessProbe passes with a wrong password")
+
+        # The Deployment's args, run for real: a server on that Redis with the Secret's files,
+        # health as the probes ask, tokens required.
+        mounts = local_secret_mounts(deploy, c, values, os.path.join(work, "k8s-server-secrets"))
+        run_args = [localized(a, mounts) for a in args]
+        run_args = with_value(run_args, "--listen", "127.0.0.1:0")
+        run_args = with_value(run_args, "--metrics-listen", "127.0.0.1:0")
+        run_args = with_value(run_args, "--store", f"redis://127.0.0.1:{redis_port}")
+        addr = start_server(
+            procs, os.path.join(bin_dir, "server/inbetween-server"), "k8s-server", run_args
+        )
+        if addr:
+            rc_, out = healthcheck(src, addr, c["readinessProbe"]["grpc"]["service"])
+            check(
+                rc_ == 0,
+                f"the Deployment's server does not answer its probe's health check: {out}",
+            )
+            check_tokens_required("the Deployment's server", addr, token)
     print(f"kubernetes: {', '.join(f'{k} {len(v)}' for k, v in sorted(kinds.items()))}")
 
 
@@ -1005,7 +1467,6 @@ def main():
     ap.add_argument("--src", required=True)
     ap.add_argument("--bin", required=True)
     ap.add_argument("--work", required=True)
-    ap.add_argument("--redis-port", required=True, type=int)
     ap.add_argument("--k8s")
     a = ap.parse_args()
     server_bin = os.path.join(a.bin, "server/inbetween-server")
@@ -1043,9 +1504,10 @@ def main():
         images = check_dockerfile(a.src, a.bin, server_flags, gateway_flags)
         check_runtime_packages(a.src, [server_bin, loadgen_bin])
         compose = check_compose(a.src, images, server_flags, loadgen_flags, gateway_flags)
-        run_compose_locally(a.src, a.bin, procs, a.work, a.redis_port, compose)
+        check_secrets_not_committed(a.src, compose["secret_files"])
+        run_compose_locally(a.src, a.bin, procs, a.work, compose)
         if a.k8s:
-            check_k8s(a.src, a.bin, procs, a.work, a.redis_port, a.k8s, server_flags)
+            check_k8s(a.src, a.bin, procs, a.work, a.k8s, server_flags)
     finally:
         procs.stop_all()
     if FAILURES:

@@ -6,13 +6,17 @@
 # config); compose.yaml has Redis, 3 replicas, nginx, the gateway and the load generator under the
 # `load` profile; every runtime package exists in Debian and together they cover what ldd lists
 # for inbetween-server and inbetween-loadgen; every Dockerfile stage starts from its BASE_IMAGE
-# and the build stage runs exactly scripts/setup and scripts/build. Then the commands of
-# compose.yaml and of the Deployment run for real on loopback: replicas with their flags on a real
-# Redis, the proxy image's nginx entrypoint in front, the HEALTHCHECK script, inbetween-loadgen
-# through nginx.
+# and the build stage runs exactly scripts/setup and scripts/build; Redis has a password from a
+# secret and maxmemory with noeviction (compose and Kubernetes), the servers --tokens and
+# --redis-password-file, the Deployment leaves replicas to its HPA, no secret value is committed.
+# Then the commands of compose.yaml and of the Kubernetes manifests run for real on loopback:
+# Redis as each starts it (the password on stdin, never in argv) with its authenticating health
+# check, replicas with their flags on it (calls without a token refused), the proxy image's nginx
+# entrypoint in front, the HEALTHCHECK script, inbetween-loadgen (--token-file) through nginx, and
+# a full Redis (noeviction) refusing a new session with STORE_FULL while reads answer.
 source "$(dirname "$0")/lib/common.sh"
 source "$(dirname "$0")/lib/cluster.sh"
-for tool in nginx haproxy node apt-cache dpkg ldd; do
+for tool in nginx haproxy node apt-cache dpkg ldd redis-server redis-cli; do
   command -v "$tool" >/dev/null || { echo "$tool is not installed (scripts/setup)"; exit 1; }
 done
 "$PY" -c 'import yaml, grpc' || { echo "python3-yaml and python3-grpcio are needed (scripts/setup)"; exit 1; }
@@ -26,6 +30,5 @@ else
        "Debian's kubernetes-client)"
 fi
 
-start_redis
 "$PY" "$INBETWEEN_SRC/tests/e2e/containers_check.py" --src "$INBETWEEN_SRC" --bin "$INBETWEEN_BIN" \
-  --work "$WORK" --redis-port "$REDIS_PORT" "${k8s[@]}"
+  --work "$WORK" "${k8s[@]}"

@@ -6,8 +6,12 @@
 # host network, loopback only. Through nginx the CLI streams a long animation; after its first
 # frame the replica container serving it gets SIGKILL: the CLI resumes on another replica and
 # its frames.json is identical to an uninterrupted run, and every session still answers (also
-# after the container is started again). Skips (exit 77) where Podman cannot run: not root, no
-# podman or runc, no base image and no way to make one.
+# after the container is started again). The stack runs with compose's secrets (made by `up` in
+# the test's directory): Redis refuses clients without the password and has maxmemory with
+# noeviction, neither the password nor the token is in any process's command line, calls without
+# the token are refused, and compose's load generator (its token from the secret file) runs a
+# short load through nginx. Skips (exit 77) where Podman cannot run: not root, no podman or runc,
+# no base image and no way to make one.
 source "$(dirname "$0")/lib/common.sh"
 PY=/usr/bin/python3
 t0=$SECONDS
@@ -48,14 +52,52 @@ containers prebuilt --bin "$INBETWEEN_BIN" --tag smoke --log "$WORK/build.log"
 echo "images in $((SECONDS - t)) s"
 t=$SECONDS
 # The gateway is left out: its image needs the npm registry (tests/e2e/web_test.sh covers it).
-containers up --project "$project" --tag smoke --free-ports --without gateway --state "$state"
+# The secrets (Redis' password, the bearer tokens) are made in the test's directory, not in
+# docker/secrets/.
+containers up --project "$project" --tag smoke --free-ports --without gateway --state "$state" \
+  --secrets-dir "$WORK/secrets"
 echo "stack up (redis, 3 replicas healthy, nginx) in $((SECONDS - t)) s"
 port() { "$PY" -c 'import json,sys; print(json.load(open(sys.argv[1]))["ports"][sys.argv[2]][sys.argv[3]])' "$state" "$1" "$2"; }
 NGINX_ADDR="127.0.0.1:$(port nginx grpc)"
 declare -A REPLICA_OF
 for n in 1 2 3; do REPLICA_OF["127.0.0.1:$(port "replica$n" grpc)"]="replica$n"; done
+TOKEN=$(awk '!/^#/ && NF { print $1; exit }' "$WORK/secrets/tokens")
+[[ -n "$TOKEN" ]] || { echo "up made no token in $WORK/secrets/tokens"; exit 1; }
 
-cli() { "$CLI_BIN" --server "$NGINX_ADDR" "$@"; }
+# Redis in its container: no answer without the password; maxmemory with noeviction (the
+# password is read inside the container, so it is in no command line here either).
+REDIS_PORT=$(port redis redis)
+redis_auth() {
+  containers podman exec "$project-redis" sh -c \
+    "REDISCLI_AUTH=\"\$(head -n 1 /run/secrets/redis_password)\" redis-cli -p $REDIS_PORT $*"
+}
+out=$(containers podman exec "$project-redis" redis-cli -p "$REDIS_PORT" ping 2>&1 || true)
+[[ "$out" == NOAUTH* ]] || { echo "redis answered PING without a password: $out"; exit 1; }
+[[ "$(redis_auth config get maxmemory-policy | tail -1)" == noeviction &&
+   "$(redis_auth config get maxmemory | tail -1)" =~ ^[1-9][0-9]*$ ]] ||
+  { redis_auth config get 'maxmemory*'; echo "redis has no maxmemory with noeviction"; exit 1; }
+# No process on this machine (the containers' included) has a secret in its command line.
+"$PY" - "$WORK/secrets/redis_password" "$WORK/secrets/tokens" <<'PYCHECK' || exit 1
+import os, sys
+password = open(sys.argv[1]).readline().rstrip("\r\n")
+token = next(l.split()[0] for l in open(sys.argv[2]) if l.split() and not l.startswith("#"))
+for pid in filter(str.isdigit, os.listdir("/proc")):
+    try:
+        argv = open(f"/proc/{pid}/cmdline", "rb").read()
+    except OSError:
+        continue
+    for name, value in (("the Redis password", password), ("the token", token)):
+        if value.encode() in argv:
+            sys.exit(f"{name} is in the command line of pid {pid}: {argv[:80]!r}")
+PYCHECK
+# Tokens are on: through nginx, a call without one is refused.
+out=$("$CLI_BIN" --server "$NGINX_ADDR" inspect 00000000 2>&1 || true)
+grep -qE "UNAUTHENTICATED|missing bearer token" <<<"$out" ||
+  { echo "a call without a token: $out"; exit 1; }
+echo "secrets: redis needs its password (maxmemory, noeviction), no secret in any argv," \
+     "tokens required"
+
+cli() { "$CLI_BIN" --server "$NGINX_ADDR" --token "$TOKEN" "$@"; }
 session_of() { grep -oE '^session [0-9a-f]+' "$1" | awk '{print $2}'; }
 inspect() { containers podman inspect --format "$2" "$project-$1"; }
 # nginx's access log, read as a file (`podman logs` takes too long between the pause and the kill).
@@ -130,5 +172,20 @@ for sid in "${SESSIONS[@]}"; do
   cli inspect "$sid" >"$WORK/inspect.out" 2>&1 || { cat "$WORK/inspect.out"; echo "session $sid lost"; exit 1; }
   grep -q "$sid" "$WORK/inspect.out" || { cat "$WORK/inspect.out"; echo "inspect $sid: no id"; exit 1; }
 done
+
+# compose's load generator in its container (profile `load`), its token from the mounted secret
+# file: a short load through nginx, no call refused for want of a token.
+t=$SECONDS
+containers load --state "$state" --json "$WORK/load.json" -- --studios 2 --seconds 5 \
+  --max-requests 40 >"$WORK/load.log" 2>&1 || { cat "$WORK/load.log"; echo "loadgen failed"; exit 1; }
+"$PY" - "$WORK/load.json" <<'PYCHECK' || { cat "$WORK/load.log"; exit 1; }
+import json, sys
+report = json.load(open(sys.argv[1]))
+errors = report.get("errors_by_code", {})
+if report.get("requests", 0) < 1 or "UNAUTHENTICATED" in errors or report.get("lost_sessions"):
+    sys.exit(f"the load through nginx: {json.dumps(report)[:600]}")
+print(f"load: {report['requests']} requests with the secret's token, errors {errors}")
+PYCHECK
+echo "load in $((SECONDS - t)) s"
 echo "ok: ${#SESSIONS[@]} sessions, 1 replica container killed mid-stream, 0 lost, frames identical;" \
      "$((SECONDS - t0)) s"

@@ -1,10 +1,12 @@
 // inbetween-loadgen: N virtual studios against one inbetween-server (or a proxy in front of
 // replicas), loopback targets only; prints a table of per-RPC latencies and errors by code, and
-// writes the same as JSON with --json. See docs/scale-out.md.
+// writes the same as JSON with --json. See docs/scale-out.md. A server with --tokens needs
+// --token TOKEN or --token-file PATH (one or the other; the file keeps it out of argv).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <string>
 
 #include "tools/loadgen/load_generator.h"
 
@@ -28,13 +30,35 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(2, 100000));
   app.add_option("--optimize-iterations", options.optimize_outer_iterations,
                  "OptimizeComesh outer iterations per session (0 = no OptimizeComesh)");
-  app.add_option("--token", options.token, "Bearer token");
+  std::string token_file;
+  CLI::Option* token_opt = app.add_option("--token", options.token, "Bearer token");
+  // A file keeps the token out of argv (visible to every user); the same file as the server's
+  // --tokens works, so one secret serves both (docker/compose.yaml).
+  app.add_option("--token-file", token_file,
+                 "Read the bearer token from this file: the first word of its first line that is "
+                 "neither empty nor a # comment (a --tokens file's TOKEN [NAME] lines work)")
+      ->check(CLI::ExistingFile)
+      ->excludes(token_opt);
   app.add_option("--json", json_path, "Also write the report as JSON here");
   CLI11_PARSE(app, argc, argv);
 
   if (absl::Status ok = inbetween::loadgen::CheckLoopbackTarget(target); !ok.ok()) {
     std::fprintf(stderr, "error: %s\n", std::string(ok.message()).c_str());
     return 2;
+  }
+  if (!token_file.empty()) {
+    std::ifstream in(token_file);
+    std::string line, word;
+    while (std::getline(in, line)) {
+      std::istringstream words(line);
+      if (words >> word && word[0] != '#') break;
+      word.clear();
+    }
+    if (word.empty()) {
+      std::fprintf(stderr, "error: --token-file %s holds no token\n", token_file.c_str());
+      return 2;
+    }
+    options.token = word;
   }
   options.duration = std::chrono::seconds(seconds);
   for (const std::string& path : drawings) {
