@@ -6,7 +6,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <functional>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <system_error>
 
 #include "absl/strings/ascii.h"
@@ -27,6 +30,8 @@ namespace inbetween::render {
 namespace {
 
 namespace fs = std::filesystem;
+using Wants = std::function<bool(std::string_view format)>;
+using Progress = std::function<void(std::string_view stage, int done, int total)>;
 
 std::string ValidFormats() {
   std::string list;
@@ -173,29 +178,45 @@ absl::StatusOr<std::vector<std::string>> ParseFormats(const std::string& list) {
   return CheckFormats(formats);
 }
 
-absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
-                          ExportReport* report) {
-  // 1. Validate everything and set up the encoders before touching the file system.
-  absl::StatusOr<std::vector<std::string>> formats = CheckFormats(options.formats);
-  if (!formats.ok()) return formats.status();
-  const auto wants = [&](std::string_view f) {
-    return std::find(formats->begin(), formats->end(), f) != formats->end();
-  };
-  if (options.dir.empty()) return absl::InvalidArgumentError("no output directory given");
-  if (!(options.fps > 0) || !std::isfinite(options.fps)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("frame rate ", options.fps, " must be positive"));
-  }
-  // The fill also goes verbatim into the SVG, so it is checked for every format.
-  absl::StatusOr<Rgba8> fill = ParseColor(options.fill);
-  if (!fill.ok()) return fill.status();
-  if (absl::Status s = CheckFrameSet(frames); !s.ok()) return s;
+namespace {
 
-  const bool raster_frames = wants("png") || wants("gif") || wants("webp");
-  std::optional<FrameRasterizer> raster;
+// The GIF palette: background, the fill (or every key's fill, whose blends lie on the ramps
+// between them), the overlay colour; with art, the art's colours instead of the fills.
+std::vector<Rgba8> GifPalette(const FrameSet& frames, const ExportOptions& options,
+                              const Rgba8& fill, const FrameRasterizer& raster) {
+  std::vector<Rgba8> palette;
+  if (!options.transparent) palette.push_back(raster.background());
+  if (options.drawing_fills && !frames.fills.empty()) {
+    for (const Rgba8& c : frames.fills) {
+      if (std::find(palette.begin(), palette.end(), c) == palette.end()) palette.push_back(c);
+    }
+  } else {
+    palette.push_back(fill);
+  }
+  if (options.mesh_overlay) palette.push_back(kMeshOverlayColor);
+  if (raster.draws_art()) {
+    std::vector<Rgba8> base;
+    if (!options.transparent) base.push_back(raster.background());
+    if (options.mesh_overlay) base.push_back(kMeshOverlayColor);
+    palette = ArtPaletteColors(frames, std::move(base));
+  }
+  return palette;
+}
+
+// What the requested formats need, made before anything is written: a format that cannot be
+// produced fails the export before a file appears.
+struct Encoders {
+  std::optional<FrameRasterizer> raster;  // png, gif, webp
   std::optional<GifEncoder> gif;
   std::optional<WebpEncoder> webp;
-  if (raster_frames) {
+  std::optional<std::string> lottie;  // the document
+  std::optional<RgbaImage> sheet;     // contact
+};
+
+absl::StatusOr<Encoders> MakeEncoders(const FrameSet& frames, const ExportOptions& options,
+                                      const Wants& wants, const Rgba8& fill) {
+  Encoders e;
+  if (wants("png") || wants("gif") || wants("webp")) {
     absl::StatusOr<FrameRasterizer> r =
         FrameRasterizer::Create(frames, {.width = options.width,
                                          .fill = options.fill,
@@ -204,45 +225,25 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
                                          .transparent = options.transparent,
                                          .art = options.art});
     if (!r.ok()) return r.status();
-    raster.emplace(*std::move(r));
+    e.raster.emplace(*std::move(r));
   }
   if (wants("gif")) {
     GifOptions gif_options = {.fps = options.fps,
                               .loop_count = 0,
                               .transparent = options.transparent,
-                              .palette_colors = {}};
-    if (!options.transparent) gif_options.palette_colors.push_back(raster->background());
-    if (options.drawing_fills && !frames.fills.empty()) {
-      // Blends of two key fills lie on the ramp between them, which the palette holds.
-      for (const Rgba8& c : frames.fills) {
-        if (std::find(gif_options.palette_colors.begin(), gif_options.palette_colors.end(), c) ==
-            gif_options.palette_colors.end()) {
-          gif_options.palette_colors.push_back(c);
-        }
-      }
-    } else {
-      gif_options.palette_colors.push_back(*fill);
-    }
-    if (options.mesh_overlay) gif_options.palette_colors.push_back(kMeshOverlayColor);
-    if (raster->draws_art()) {
-      std::vector<Rgba8> base;
-      if (!options.transparent) base.push_back(raster->background());
-      if (options.mesh_overlay) base.push_back(kMeshOverlayColor);
-      gif_options.palette_colors = ArtPaletteColors(frames, std::move(base));
-    }
-    absl::StatusOr<GifEncoder> e =
-        GifEncoder::Create(raster->width(), raster->height(), std::move(gif_options));
-    if (!e.ok()) return e.status();
-    gif.emplace(*std::move(e));
+                              .palette_colors = GifPalette(frames, options, fill, *e.raster)};
+    absl::StatusOr<GifEncoder> gif =
+        GifEncoder::Create(e.raster->width(), e.raster->height(), std::move(gif_options));
+    if (!gif.ok()) return gif.status();
+    e.gif.emplace(*std::move(gif));
   }
   if (wants("webp")) {
-    absl::StatusOr<WebpEncoder> e = WebpEncoder::Create(
-        raster->width(), raster->height(),
+    absl::StatusOr<WebpEncoder> webp = WebpEncoder::Create(
+        e.raster->width(), e.raster->height(),
         {.fps = options.fps, .lossless = options.webp_lossless, .quality = options.webp_quality});
-    if (!e.ok()) return e.status();
-    webp.emplace(*std::move(e));
+    if (!webp.ok()) return webp.status();
+    e.webp.emplace(*std::move(webp));
   }
-  std::string lottie;
   if (wants("lottie")) {
     absl::StatusOr<nlohmann::json> doc =
         LottieAnimation(frames, {.width = options.width,
@@ -251,22 +252,47 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
                                  .drawing_fills = options.drawing_fills,
                                  .art = options.art});
     if (!doc.ok()) return doc.status();
-    lottie = doc->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    e.lottie = doc->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   }
-  std::optional<RgbaImage> sheet;
   if (wants("contact")) {
-    absl::StatusOr<RgbaImage> s = RenderContactSheet(frames, SheetOptions(options));
-    if (!s.ok()) return s.status();
-    sheet.emplace(*std::move(s));
+    absl::StatusOr<RgbaImage> sheet = RenderContactSheet(frames, SheetOptions(options));
+    if (!sheet.ok()) return sheet.status();
+    e.sheet.emplace(*std::move(sheet));
   }
-  const auto progress = [&](std::string_view stage, int done, int total) {
-    if (options.progress) options.progress(stage, done, total);
-  };
+  return e;
+}
 
-  // 2. Produce every file in the staging folder.
-  absl::StatusOr<StagingDir> staging = StagingDir::Create(options.dir);
-  if (!staging.ok()) return staging.status();
-  const fs::path& out = staging->path();
+// The raster frames: each rendered once, then written as PNG and added to the GIF and WebP.
+absl::Status WriteRasterFrames(const fs::path& out, const FrameSet& frames, const Wants& wants,
+                               Encoders& e, const Progress& progress) {
+  const int n = static_cast<int>(frames.frames.size());
+  for (int f = 0; f < n; ++f) {
+    const RgbaImage image = e.raster->Render(f);
+    if (wants("png")) {
+      const fs::path path = out / absl::StrFormat("frame_%04d.png", frames.frames[f].index);
+      if (absl::Status s = WritePng(path, image); !s.ok()) return s;
+    }
+    if (e.gif) {
+      if (absl::Status s = e.gif->AddFrame(image); !s.ok()) return s;
+    }
+    if (e.webp) {
+      if (absl::Status s = e.webp->AddFrame(image); !s.ok()) return s;
+    }
+    progress("frames", f + 1, n);
+  }
+  return absl::OkStatus();
+}
+
+// A finished animation's bytes, written atomically as `name`.
+absl::Status WriteAnimation(const fs::path& out, const char* name,
+                            absl::StatusOr<std::string> bytes) {
+  if (!bytes.ok()) return bytes.status();
+  return WriteFileAtomically(out / name, *bytes);
+}
+
+// Every requested file, written into the staging folder `out`.
+absl::Status WriteFiles(const fs::path& out, const FrameSet& frames, const ExportOptions& options,
+                        const Wants& wants, Encoders& e, const Progress& progress) {
   if (wants("json")) {
     if (absl::Status s =
             WriteFileAtomically(out / "frames.json", FrameSetToJson(frames).dump() + "\n");
@@ -286,44 +312,63 @@ absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
     }
     progress("svg", 1, 1);
   }
-  if (raster_frames) {
-    const int n = static_cast<int>(frames.frames.size());
-    for (int f = 0; f < n; ++f) {
-      const RgbaImage image = raster->Render(f);
-      if (wants("png")) {
-        const fs::path path = out / absl::StrFormat("frame_%04d.png", frames.frames[f].index);
-        if (absl::Status s = WritePng(path, image); !s.ok()) return s;
-      }
-      if (gif) {
-        if (absl::Status s = gif->AddFrame(image); !s.ok()) return s;
-      }
-      if (webp) {
-        if (absl::Status s = webp->AddFrame(image); !s.ok()) return s;
-      }
-      progress("frames", f + 1, n);
-    }
+  if (e.raster) {
+    if (absl::Status s = WriteRasterFrames(out, frames, wants, e, progress); !s.ok()) return s;
   }
-  if (gif) {
-    absl::StatusOr<std::string> bytes = gif->Finish();
-    if (!bytes.ok()) return bytes.status();
-    if (absl::Status s = WriteFileAtomically(out / "animation.gif", *bytes); !s.ok()) return s;
+  if (e.gif) {
+    if (absl::Status s = WriteAnimation(out, "animation.gif", e.gif->Finish()); !s.ok()) return s;
     progress("gif", 1, 1);
   }
-  if (webp) {
-    absl::StatusOr<std::string> bytes = webp->Finish();
-    if (!bytes.ok()) return bytes.status();
-    if (absl::Status s = WriteFileAtomically(out / "animation.webp", *bytes); !s.ok()) return s;
+  if (e.webp) {
+    if (absl::Status s = WriteAnimation(out, "animation.webp", e.webp->Finish()); !s.ok()) {
+      return s;
+    }
     progress("webp", 1, 1);
   }
-  if (wants("lottie")) {
-    if (absl::Status s = WriteFileAtomically(out / "animation.lottie.json", lottie); !s.ok()) {
+  if (e.lottie) {
+    if (absl::Status s = WriteFileAtomically(out / "animation.lottie.json", *e.lottie); !s.ok()) {
       return s;
     }
     progress("lottie", 1, 1);
   }
-  if (sheet) {
-    if (absl::Status s = WritePng(out / "contact_sheet.png", *sheet); !s.ok()) return s;
+  if (e.sheet) {
+    if (absl::Status s = WritePng(out / "contact_sheet.png", *e.sheet); !s.ok()) return s;
     progress("contact", 1, 1);
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status ExportFrames(const FrameSet& frames, const ExportOptions& options,
+                          ExportReport* report) {
+  // 1. Validate everything and set up the encoders before touching the file system.
+  absl::StatusOr<std::vector<std::string>> formats = CheckFormats(options.formats);
+  if (!formats.ok()) return formats.status();
+  const Wants wants = [&](std::string_view f) {
+    return std::find(formats->begin(), formats->end(), f) != formats->end();
+  };
+  if (options.dir.empty()) return absl::InvalidArgumentError("no output directory given");
+  if (!(options.fps > 0) || !std::isfinite(options.fps)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("frame rate ", options.fps, " must be positive"));
+  }
+  // The fill also goes verbatim into the SVG, so it is checked for every format.
+  absl::StatusOr<Rgba8> fill = ParseColor(options.fill);
+  if (!fill.ok()) return fill.status();
+  if (absl::Status s = CheckFrameSet(frames); !s.ok()) return s;
+  absl::StatusOr<Encoders> encoders = MakeEncoders(frames, options, wants, *fill);
+  if (!encoders.ok()) return encoders.status();
+  const Progress progress = [&](std::string_view stage, int done, int total) {
+    if (options.progress) options.progress(stage, done, total);
+  };
+
+  // 2. Produce every file in the staging folder.
+  absl::StatusOr<StagingDir> staging = StagingDir::Create(options.dir);
+  if (!staging.ok()) return staging.status();
+  if (absl::Status s = WriteFiles(staging->path(), frames, options, wants, *encoders, progress);
+      !s.ok()) {
+    return s;
   }
 
   // 3. Move the files into place.

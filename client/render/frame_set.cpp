@@ -17,6 +17,19 @@ absl::Status PathError(const std::string& path, const std::string& what) {
 
 absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc);
 
+absl::Status CheckTriangleIndices(const std::vector<std::array<int, 3>>& triangles,
+                                  size_t num_vertices) {
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (int i : triangles[t]) {
+      if (i < 0 || static_cast<size_t>(i) >= num_vertices) {
+        return PathError(absl::StrCat("triangles[", t, "]"),
+                         absl::StrCat("vertex index ", i, " out of range [0, ", num_vertices, ")"));
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
 // The art rules of CheckFrameSet (frames and triangles already checked): what ArtForFrame needs
 // to succeed on every frame, so that renderers can rely on FrameArt.
 absl::Status CheckArt(const FrameSet& frames) {
@@ -90,18 +103,96 @@ absl::Status CheckFrameSet(const FrameSet& frames) {
       }
     }
   }
-  for (size_t t = 0; t < frames.triangles.size(); ++t) {
-    for (int i : frames.triangles[t]) {
-      if (i < 0 || static_cast<size_t>(i) >= num_vertices) {
-        return PathError(absl::StrCat("triangles[", t, "]"),
-                         absl::StrCat("vertex index ", i, " out of range [0, ", num_vertices, ")"));
-      }
-    }
-  }
+  if (absl::Status s = CheckTriangleIndices(frames.triangles, num_vertices); !s.ok()) return s;
   return CheckArt(frames);
 }
 
 namespace {
+
+absl::StatusOr<FrameValidity> ValidityFromJson(const nlohmann::json& v, const std::string& fp) {
+  if (!v.is_object()) return PathError(fp + ".valid", "expected an object");
+  FrameValidity validity;
+  for (const char* key : {"inverted_triangles", "boundary_overlaps"}) {
+    if (!v.contains(key) || !v[key].is_number_integer() || v[key].get<int64_t>() < 0) {
+      return PathError(absl::StrCat(fp, ".valid.", key), "expected a count >= 0");
+    }
+  }
+  for (const char* key : {"min_area_ratio", "max_area_ratio"}) {
+    if (!v.contains(key) || !v[key].is_number()) {
+      return PathError(absl::StrCat(fp, ".valid.", key), "expected a number");
+    }
+  }
+  validity.inverted_triangles = v["inverted_triangles"].get<int>();
+  validity.boundary_overlaps = v["boundary_overlaps"].get<int>();
+  validity.min_area_ratio = v["min_area_ratio"].get<double>();
+  validity.max_area_ratio = v["max_area_ratio"].get<double>();
+  if (v.contains("hold_back")) {  // optional: frames.json files written before it existed
+    if (!v["hold_back"].is_number() || v["hold_back"].get<double>() < 0 ||
+        v["hold_back"].get<double>() > 1) {
+      return PathError(fp + ".valid.hold_back", "expected a number in [0, 1]");
+    }
+    validity.hold_back = v["hold_back"].get<double>();
+  }
+  return validity;
+}
+
+// frames[f]: index (default f), time, weights, valid, vertices.
+absl::StatusOr<FrameData> FrameFromJson(const nlohmann::json& fr, size_t f) {
+  const std::string fp = absl::StrCat("frames[", f, "]");
+  if (!fr.is_object() || !fr.contains("vertices") || !fr["vertices"].is_array()) {
+    return PathError(fp, "expected an object with a vertices array");
+  }
+  FrameData data;
+  data.index = static_cast<int>(f);
+  if (fr.contains("index")) {
+    if (!fr["index"].is_number_integer()) {
+      return PathError(fp + ".index", "expected an integer frame index");
+    }
+    data.index = fr["index"].get<int>();
+  }
+  if (fr.contains("time")) {
+    if (!fr["time"].is_number()) return PathError(fp + ".time", "expected a number");
+    data.time = fr["time"].get<double>();
+  }
+  if (fr.contains("weights")) {
+    if (!fr["weights"].is_array()) return PathError(fp + ".weights", "expected an array");
+    for (size_t w = 0; w < fr["weights"].size(); ++w) {
+      if (!fr["weights"][w].is_number()) {
+        return PathError(absl::StrCat(fp, ".weights[", w, "]"), "expected a number");
+      }
+      data.weights.push_back(fr["weights"][w].get<double>());
+    }
+  }
+  if (fr.contains("valid")) {
+    absl::StatusOr<FrameValidity> validity = ValidityFromJson(fr["valid"], fp);
+    if (!validity.ok()) return validity.status();
+    data.valid = *validity;
+  }
+  const auto& verts = fr["vertices"];
+  for (size_t v = 0; v < verts.size(); ++v) {
+    const auto& p = verts[v];
+    if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number() ||
+        !std::isfinite(p[0].get<double>()) || !std::isfinite(p[1].get<double>())) {
+      return PathError(absl::StrCat(fp, ".vertices[", v, "]"), "expected [x, y] finite numbers");
+    }
+    data.vertices.push_back({p[0].get<double>(), p[1].get<double>()});
+  }
+  return data;
+}
+
+// The optional fills: one colour per key drawing.
+absl::StatusOr<std::vector<Rgba8>> FillsFromJson(const nlohmann::json& fills) {
+  if (!fills.is_array()) return PathError("fills", "expected an array of colours");
+  std::vector<Rgba8> out;
+  for (size_t i = 0; i < fills.size(); ++i) {
+    const std::string fp = absl::StrCat("fills[", i, "]");
+    if (!fills[i].is_string()) return PathError(fp, "expected a colour string");
+    absl::StatusOr<Rgba8> c = ParseColor(fills[i].get<std::string>());
+    if (!c.ok()) return PathError(fp, std::string(c.status().message()));
+    out.push_back(*c);
+  }
+  return out;
+}
 
 absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc) {
   if (!doc.is_object()) return PathError("$", "expected an object");
@@ -129,93 +220,21 @@ absl::StatusOr<FrameSet> FrameSetFromJsonUnchecked(const nlohmann::json& doc) {
   const auto& frames = doc["frames"];
   size_t num_vertices = 0;
   for (size_t f = 0; f < frames.size(); ++f) {
-    const std::string fp = absl::StrCat("frames[", f, "]");
-    const auto& fr = frames[f];
-    if (!fr.is_object() || !fr.contains("vertices") || !fr["vertices"].is_array()) {
-      return PathError(fp, "expected an object with a vertices array");
+    absl::StatusOr<FrameData> data = FrameFromJson(frames[f], f);
+    if (!data.ok()) return data.status();
+    if (f == 0) num_vertices = data->vertices.size();
+    if (data->vertices.size() != num_vertices) {
+      return PathError(absl::StrCat("frames[", f, "]"),
+                       absl::StrCat("has ", data->vertices.size(), " vertices, frames[0] has ",
+                                    num_vertices));
     }
-    FrameData data;
-    data.index = static_cast<int>(f);
-    if (fr.contains("index")) {
-      if (!fr["index"].is_number_integer()) {
-        return PathError(fp + ".index", "expected an integer frame index");
-      }
-      data.index = fr["index"].get<int>();
-    }
-    if (fr.contains("time")) {
-      if (!fr["time"].is_number()) return PathError(fp + ".time", "expected a number");
-      data.time = fr["time"].get<double>();
-    }
-    if (fr.contains("weights")) {
-      if (!fr["weights"].is_array()) return PathError(fp + ".weights", "expected an array");
-      for (size_t w = 0; w < fr["weights"].size(); ++w) {
-        if (!fr["weights"][w].is_number()) {
-          return PathError(absl::StrCat(fp, ".weights[", w, "]"), "expected a number");
-        }
-        data.weights.push_back(fr["weights"][w].get<double>());
-      }
-    }
-    if (fr.contains("valid")) {
-      const auto& v = fr["valid"];
-      if (!v.is_object()) return PathError(fp + ".valid", "expected an object");
-      FrameValidity validity;
-      for (const char* key : {"inverted_triangles", "boundary_overlaps"}) {
-        if (!v.contains(key) || !v[key].is_number_integer() || v[key].get<int64_t>() < 0) {
-          return PathError(absl::StrCat(fp, ".valid.", key), "expected a count >= 0");
-        }
-      }
-      for (const char* key : {"min_area_ratio", "max_area_ratio"}) {
-        if (!v.contains(key) || !v[key].is_number()) {
-          return PathError(absl::StrCat(fp, ".valid.", key), "expected a number");
-        }
-      }
-      validity.inverted_triangles = v["inverted_triangles"].get<int>();
-      validity.boundary_overlaps = v["boundary_overlaps"].get<int>();
-      validity.min_area_ratio = v["min_area_ratio"].get<double>();
-      validity.max_area_ratio = v["max_area_ratio"].get<double>();
-      if (v.contains("hold_back")) {  // optional: frames.json files written before it existed
-        if (!v["hold_back"].is_number() || v["hold_back"].get<double>() < 0 ||
-            v["hold_back"].get<double>() > 1) {
-          return PathError(fp + ".valid.hold_back", "expected a number in [0, 1]");
-        }
-        validity.hold_back = v["hold_back"].get<double>();
-      }
-      data.valid = validity;
-    }
-    const auto& verts = fr["vertices"];
-    for (size_t v = 0; v < verts.size(); ++v) {
-      const auto& p = verts[v];
-      if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number() ||
-          !std::isfinite(p[0].get<double>()) || !std::isfinite(p[1].get<double>())) {
-        return PathError(absl::StrCat(fp, ".vertices[", v, "]"), "expected [x, y] finite numbers");
-      }
-      data.vertices.push_back({p[0].get<double>(), p[1].get<double>()});
-    }
-    if (f == 0) num_vertices = data.vertices.size();
-    if (data.vertices.size() != num_vertices) {
-      return PathError(fp, absl::StrCat("has ", data.vertices.size(), " vertices, frames[0] has ",
-                                        num_vertices));
-    }
-    out.frames.push_back(std::move(data));
+    out.frames.push_back(*std::move(data));
   }
-  for (size_t t = 0; t < out.triangles.size(); ++t) {
-    for (int i : out.triangles[t]) {
-      if (i < 0 || static_cast<size_t>(i) >= num_vertices) {
-        return PathError(absl::StrCat("triangles[", t, "]"),
-                         absl::StrCat("vertex index ", i, " out of range [0, ", num_vertices, ")"));
-      }
-    }
-  }
+  if (absl::Status s = CheckTriangleIndices(out.triangles, num_vertices); !s.ok()) return s;
   if (doc.contains("fills")) {  // optional (added field): one colour per key drawing
-    const auto& fills = doc["fills"];
-    if (!fills.is_array()) return PathError("fills", "expected an array of colours");
-    for (size_t i = 0; i < fills.size(); ++i) {
-      const std::string fp = absl::StrCat("fills[", i, "]");
-      if (!fills[i].is_string()) return PathError(fp, "expected a colour string");
-      absl::StatusOr<Rgba8> c = ParseColor(fills[i].get<std::string>());
-      if (!c.ok()) return PathError(fp, std::string(c.status().message()));
-      out.fills.push_back(*c);
-    }
+    absl::StatusOr<std::vector<Rgba8>> fills = FillsFromJson(doc["fills"]);
+    if (!fills.ok()) return fills.status();
+    out.fills = *std::move(fills);
   }
   if (doc.contains("art")) {  // optional (added field): the key drawings' art in the mesh
     absl::StatusOr<std::vector<solver::EmbeddedArt>> art =
