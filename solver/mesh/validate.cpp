@@ -123,9 +123,9 @@ absl::Status ValidateArt(const Multimesh& mesh) {
   for (size_t k = 0; k < mesh.art.size(); ++k) {
     const EmbeddedArt& art = mesh.art[k];
     if (art.key != static_cast<int>(k) || art.num_vertices != mesh.num_vertices()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "multimesh art ", k, ": key ", art.key, " for ", art.num_vertices,
-          " vertices, expected key ", k, " for ", mesh.num_vertices()));
+      return absl::InvalidArgumentError(
+          absl::StrCat("multimesh art ", k, ": key ", art.key, " for ", art.num_vertices,
+                       " vertices, expected key ", k, " for ", mesh.num_vertices()));
     }
     for (size_t l = 0; l < art.layers.size(); ++l) {
       for (size_t p = 0; p < art.layers[l].paths.size(); ++p) {
@@ -133,8 +133,8 @@ absl::Status ValidateArt(const Multimesh& mesh) {
           if (e.triangle < 0 || e.triangle >= static_cast<int>(mesh.triangles.size()) ||
               e.corners != mesh.triangles[e.triangle] || !e.barycentric.allFinite()) {
             return absl::InvalidArgumentError(
-                absl::StrCat("multimesh art ", k, " layer ", l, " path ", p, ": a point in triangle ",
-                             e.triangle, " of ", mesh.triangles.size(),
+                absl::StrCat("multimesh art ", k, " layer ", l, " path ", p,
+                             ": a point in triangle ", e.triangle, " of ", mesh.triangles.size(),
                              " with other corners or non-finite coordinates"));
           }
         }
@@ -144,10 +144,9 @@ absl::Status ValidateArt(const Multimesh& mesh) {
   return absl::OkStatus();
 }
 
-}  // namespace
-
-absl::Status ValidateMultimesh(const Multimesh& mesh) {
-  if (mesh.shapes.empty()) return absl::InvalidArgumentError("multimesh has no shapes");
+// Every shape has the vertex count of shape 0 and finite positions; every triangle, boundary and
+// pinned index is in range (pinned ascending and distinct).
+absl::Status ValidateIndices(const Multimesh& mesh) {
   const int n = mesh.num_vertices();
   for (int s = 0; s < mesh.num_shapes(); ++s) {
     if (static_cast<int>(mesh.shapes[s].size()) != n) {
@@ -189,31 +188,44 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
           absl::StrCat("multimesh pinned vertices are not ascending and distinct at ", v));
     }
   }
-  // Shared topology: one consistently oriented manifold, so each directed edge belongs to one
-  // triangle (a repeated or overlapping triangle or a non-manifold edge uses one twice).
-  std::vector<std::array<int, 3>> directed;  // {from, to, triangle}, sorted
-  directed.reserve(3 * mesh.triangles.size());
+  return absl::OkStatus();
+}
+
+// Shared topology: one consistently oriented manifold, so each directed edge belongs to one
+// triangle (a repeated or overlapping triangle or a non-manifold edge uses one twice). The
+// directed edges {from, to, triangle}, sorted, go to `directed`.
+absl::Status ValidateManifold(const Multimesh& mesh, std::vector<std::array<int, 3>>* directed) {
+  directed->reserve(3 * mesh.triangles.size());
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const Triangle& tri = mesh.triangles[t];
-    for (int k = 0; k < 3; ++k) directed.push_back({tri[k], tri[(k + 1) % 3], static_cast<int>(t)});
-  }
-  std::sort(directed.begin(), directed.end());
-  for (size_t i = 1; i < directed.size(); ++i) {
-    if (directed[i][0] == directed[i - 1][0] && directed[i][1] == directed[i - 1][1]) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "multimesh triangles ", directed[i - 1][2], " and ", directed[i][2], " both have edge ",
-          directed[i][0], "-", directed[i][1], " (overlapping or non-manifold)"));
+    for (int k = 0; k < 3; ++k) {
+      directed->push_back({tri[k], tri[(k + 1) % 3], static_cast<int>(t)});
     }
   }
-  // Boundary vertices on the boundary: each on an edge with a triangle on one side only.
-  std::vector<bool> on_boundary(n, false);
-  std::vector<std::pair<int, int>> boundary_edges;  // in (from, to) order, for the crossing check
+  std::sort(directed->begin(), directed->end());
+  const std::vector<std::array<int, 3>>& d = *directed;
+  for (size_t i = 1; i < d.size(); ++i) {
+    if (d[i][0] == d[i - 1][0] && d[i][1] == d[i - 1][1]) {
+      return absl::InvalidArgumentError(absl::StrCat("multimesh triangles ", d[i - 1][2], " and ",
+                                                     d[i][2], " both have edge ", d[i][0], "-",
+                                                     d[i][1], " (overlapping or non-manifold)"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// Boundary vertices on the boundary: each on an edge with a triangle on one side only. The
+// boundary edges, in (from, to) order, go to `boundary_edges` for the crossing check.
+absl::Status ValidateBoundary(const Multimesh& mesh,
+                              const std::vector<std::array<int, 3>>& directed,
+                              std::vector<std::pair<int, int>>* boundary_edges) {
+  std::vector<bool> on_boundary(mesh.num_vertices(), false);
   for (const auto& [a, b, t] : directed) {
     const std::array<int, 3> reverse = {b, a, -1};
     auto it = std::lower_bound(directed.begin(), directed.end(), reverse);
     if (it == directed.end() || (*it)[0] != b || (*it)[1] != a) {
       on_boundary[a] = on_boundary[b] = true;
-      boundary_edges.push_back({a, b});
+      boundary_edges->push_back({a, b});
     }
   }
   for (size_t k = 0; k < mesh.boundary.size(); ++k) {
@@ -233,7 +245,12 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
       return absl::InvalidArgumentError("multimesh boundary is not the concatenation of its loops");
     }
   }
-  if (absl::Status s = ValidateCohesiveEdges(mesh); !s.ok()) return s;
+  return absl::OkStatus();
+}
+
+// In every shape every triangle is positively oriented and no two boundary edges cross.
+absl::Status ValidateEmbedding(const Multimesh& mesh,
+                               const std::vector<std::pair<int, int>>& boundary_edges) {
   for (int s = 0; s < mesh.num_shapes(); ++s) {
     for (size_t t = 0; t < mesh.triangles.size(); ++t) {
       const double a = SignedArea2(mesh.triangles[t], mesh.shapes[s]);
@@ -249,6 +266,20 @@ absl::Status ValidateMultimesh(const Multimesh& mesh) {
           absl::StrCat("multimesh shape ", s, ": ", crossing.message()));
     }
   }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status ValidateMultimesh(const Multimesh& mesh) {
+  if (mesh.shapes.empty()) return absl::InvalidArgumentError("multimesh has no shapes");
+  if (absl::Status s = ValidateIndices(mesh); !s.ok()) return s;
+  std::vector<std::array<int, 3>> directed;
+  if (absl::Status s = ValidateManifold(mesh, &directed); !s.ok()) return s;
+  std::vector<std::pair<int, int>> boundary_edges;
+  if (absl::Status s = ValidateBoundary(mesh, directed, &boundary_edges); !s.ok()) return s;
+  if (absl::Status s = ValidateCohesiveEdges(mesh); !s.ok()) return s;
+  if (absl::Status s = ValidateEmbedding(mesh, boundary_edges); !s.ok()) return s;
   return ValidateArt(mesh);
 }
 
