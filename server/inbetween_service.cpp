@@ -227,7 +227,8 @@ std::vector<v1::InbetweenResponse> AddKeyArt(const solver::Multimesh& mesh,
         continue;
       }
       header_full = true;  // later layers of every key follow in order, in art messages
-      if (chunk == nullptr || (chunk_bytes + bytes > kArtMessageBytes && chunk->layers_size() > 0)) {
+      if (chunk == nullptr ||
+          (chunk_bytes + bytes > kArtMessageBytes && chunk->layers_size() > 0)) {
         chunk = more.emplace_back().mutable_art();
         chunk->set_key(static_cast<uint32_t>(art.key));
         chunk_bytes = 16;
@@ -589,11 +590,11 @@ absl::Status CheckSessionQuota(const SessionStore& store, const ServiceOptions& 
   if (!options.tokens) return absl::OkStatus();
   const size_t owned = store.CountOwned(caller.owner);
   if (owned >= options.limits.max_sessions_per_token) {
-    return solver::WithReason(
-        absl::ResourceExhaustedError(absl::StrCat(
-            "this token already has ", owned, " sessions, the limit is ",
-            options.limits.max_sessions_per_token, " (--max-sessions-per-token); delete some first")),
-        solver::kReasonSessionsPerToken);
+    return solver::WithReason(absl::ResourceExhaustedError(absl::StrCat(
+                                  "this token already has ", owned, " sessions, the limit is ",
+                                  options.limits.max_sessions_per_token,
+                                  " (--max-sessions-per-token); delete some first")),
+                              solver::kReasonSessionsPerToken);
   }
   return absl::OkStatus();
 }
@@ -970,6 +971,114 @@ grpc::Status InbetweenService::SetCorrespondences(grpc::ServerContext* context,
 // ---------------------------------------------------------------------------------------------
 // Heavy stages
 
+namespace {
+
+// The meshing parameters BuildMultimesh uses (the request's, else the session's), once the
+// session has two drawings and they are valid and within --max-mesh-vertices.
+absl::StatusOr<const v1::MeshingParameters*> MeshingToBuild(
+    const v1::BuildMultimeshRequest& request, const v1::Session& session,
+    const ServiceLimits& limits) {
+  if (session.drawings_size() < 2) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("BuildMultimesh needs at least 2 drawings, session ", request.session_id(),
+                     " has ", session.drawings_size()));
+  }
+  const bool own_meshing = request.has_meshing();
+  const v1::MeshingParameters& meshing =
+      own_meshing ? request.meshing() : session.parameters().meshing();
+  if (auto s = ValidateMeshing(meshing, own_meshing ? "meshing" : "session parameters.meshing");
+      !s.ok()) {
+    return s;
+  }
+  if (meshing.boundary_vertices() > static_cast<uint32_t>(limits.max_mesh_vertices)) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "meshing.boundary_vertices = ", meshing.boundary_vertices(), " exceeds the limit of ",
+        limits.max_mesh_vertices, " mesh vertices (--max-mesh-vertices)"));
+  }
+  return &meshing;
+}
+
+// The builder's answer as the service's: a vertex-limit failure names --max-mesh-vertices, and a
+// mesh is within it, has one shape per drawing and is valid (the solver promises a valid mesh; a
+// stored multimesh is never silently flipped).
+absl::Status CheckBuiltMesh(const absl::StatusOr<solver::Multimesh>& mesh, int drawings,
+                            const ServiceOptions& options) {
+  // The mesher's refinement stops at --max-mesh-vertices; say which limit it hit.
+  if (solver::ErrorReason(mesh.status()) == solver::kReasonMeshVertexLimit) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        mesh.status().message(), "; the limit is ", options.limits.max_mesh_vertices,
+        " mesh vertices (--max-mesh-vertices): use fewer boundary_vertices or a larger "
+        "max_edge_relative"));
+  }
+  if (!mesh.ok()) return mesh.status();
+  if (absl::Status s = CheckMeshVertices(*mesh, options, "the multimesh"); !s.ok()) return s;
+  if (mesh->num_shapes() != drawings) {
+    return absl::InternalError(absl::StrCat("the multimesh builder returned ", mesh->num_shapes(),
+                                            " shapes for ", drawings, " drawings"));
+  }
+  if (absl::Status s = solver::ValidateMultimesh(*mesh); !s.ok()) {
+    return absl::InternalError(
+        absl::StrCat("the multimesh builder returned an invalid mesh: ", s.message()));
+  }
+  return absl::OkStatus();
+}
+
+// After every topology pass OptimizeComesh stores the checkpoint with the session, at the same
+// version (nothing a client reads changes). A failed write (another writer, or the store is down)
+// cancels the run: its final write would fail the same way.
+class CheckpointSaver {
+ public:
+  CheckpointSaver(SessionStore& store, const SessionState& state, std::string parameters,
+                  solver::CancelToken& token, grpc::ServerContext& context)
+      : store_(store),
+        state_(state),
+        parameters_(std::move(parameters)),
+        token_(token),
+        context_(context) {}
+
+  void Save(const solver::ComeshCheckpoint& c) {
+    if (token_.IsCancelled() || context_.IsCancelled()) return;
+    const uint64_t version = state_.session.version();
+    auto stored = std::make_shared<StoredComeshCheckpoint>();
+    stored->input_version = version;
+    stored->stored_version = version;
+    stored->parameters = parameters_;
+    stored->checkpoint = c;
+    SessionState next = state_;
+    next.comesh_checkpoint = std::move(stored);
+    absl::StatusOr<SessionState> put = store_.PutSameVersion(std::move(next), version);
+    if (!put.ok()) {
+      status_ = put.status();
+      token_.Cancel();
+    }
+  }
+  // OK unless a write failed.
+  const absl::Status& status() const { return status_; }
+
+ private:
+  SessionStore& store_;
+  const SessionState& state_;  // the session as loaded: every checkpoint replaces the last
+  const std::string parameters_;
+  solver::CancelToken& token_;
+  grpc::ServerContext& context_;
+  absl::Status status_;
+};
+
+// A built multimesh's stats: its counts and the build's facts (seconds, corner-matched loops,
+// overlays, vertices per loop, achieved outline tolerance).
+v1::MultimeshStats BuildStats(const solver::Multimesh& mesh, const solver::MultimeshReport& report,
+                              double seconds) {
+  v1::MultimeshStats stats = StatsOf(mesh);
+  stats.set_build_seconds(report.seconds > 0 ? report.seconds : seconds);
+  stats.set_corner_matched_loops(static_cast<uint32_t>(report.corner_matched_loops));
+  stats.set_overlays(static_cast<uint32_t>(report.overlays));
+  for (const int n : report.loop_vertices) stats.add_loop_vertices(static_cast<uint32_t>(n));
+  stats.set_achieved_tolerance(report.achieved_tolerance);
+  return stats;
+}
+
+}  // namespace
+
 grpc::Status InbetweenService::BuildMultimesh(
     grpc::ServerContext* context, const v1::BuildMultimeshRequest* request,
     grpc::ServerWriter<v1::BuildMultimeshResponse>* writer) {
@@ -979,26 +1088,10 @@ grpc::Status InbetweenService::BuildMultimesh(
         absl::StatusOr<SessionState> state =
             LoadForUpdate(*store_, request->session_id(), request->expected_version(), caller);
         if (!state.ok()) return state.status();
-        if (state->session.drawings_size() < 2) {
-          return absl::FailedPreconditionError(
-              absl::StrCat("BuildMultimesh needs at least 2 drawings, session ",
-                           request->session_id(), " has ", state->session.drawings_size()));
-        }
-        const bool own_meshing = request->has_meshing();
-        const v1::MeshingParameters& meshing =
-            own_meshing ? request->meshing() : state->session.parameters().meshing();
-        if (auto s =
-                ValidateMeshing(meshing, own_meshing ? "meshing" : "session parameters.meshing");
-            !s.ok()) {
-          return s;
-        }
-
-        if (meshing.boundary_vertices() >
-            static_cast<uint32_t>(options_.limits.max_mesh_vertices)) {
-          return absl::ResourceExhaustedError(absl::StrCat(
-              "meshing.boundary_vertices = ", meshing.boundary_vertices(), " exceeds the limit of ",
-              options_.limits.max_mesh_vertices, " mesh vertices (--max-mesh-vertices)"));
-        }
+        absl::StatusOr<const v1::MeshingParameters*> chosen =
+            MeshingToBuild(*request, state->session, options_.limits);
+        if (!chosen.ok()) return chosen.status();
+        const v1::MeshingParameters& meshing = **chosen;
         absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
         if (!slot.ok()) return slot.status();
 
@@ -1033,31 +1126,11 @@ grpc::Status InbetweenService::BuildMultimesh(
           return StoppedStatus(*context, "BuildMultimesh");
         }
         if (options_.metrics) options_.metrics->ObserveStage("build", seconds);
-        // The mesher's refinement stops at --max-mesh-vertices; say which limit it hit.
-        if (solver::ErrorReason(mesh.status()) == solver::kReasonMeshVertexLimit) {
-          return absl::ResourceExhaustedError(absl::StrCat(
-              mesh.status().message(), "; the limit is ", options_.limits.max_mesh_vertices,
-              " mesh vertices (--max-mesh-vertices): use fewer boundary_vertices or a larger "
-              "max_edge_relative"));
+        if (absl::Status s = CheckBuiltMesh(mesh, state->session.drawings_size(), options_);
+            !s.ok()) {
+          return s;
         }
-        if (!mesh.ok()) return mesh.status();
-        if (absl::Status s = CheckMeshVertices(*mesh, options_, "the multimesh"); !s.ok()) return s;
-        // The solver promises a valid mesh; a stored multimesh is never silently flipped.
-        if (mesh->num_shapes() != state->session.drawings_size()) {
-          return absl::InternalError(absl::StrCat("the multimesh builder returned ",
-                                                  mesh->num_shapes(), " shapes for ",
-                                                  state->session.drawings_size(), " drawings"));
-        }
-        if (absl::Status s = solver::ValidateMultimesh(*mesh); !s.ok()) {
-          return absl::InternalError(
-              absl::StrCat("the multimesh builder returned an invalid mesh: ", s.message()));
-        }
-        v1::MultimeshStats stats = StatsOf(*mesh);
-        stats.set_build_seconds(report.seconds > 0 ? report.seconds : seconds);
-        stats.set_corner_matched_loops(static_cast<uint32_t>(report.corner_matched_loops));
-        stats.set_overlays(static_cast<uint32_t>(report.overlays));
-        for (const int n : report.loop_vertices) stats.add_loop_vertices(static_cast<uint32_t>(n));
-        stats.set_achieved_tolerance(report.achieved_tolerance);
+        const v1::MultimeshStats stats = BuildStats(*mesh, report, seconds);
 
         v1::BuildMultimeshResponse message;
         v1::BuildMultimeshResult* result = message.mutable_result();
@@ -1134,32 +1207,15 @@ grpc::Status InbetweenService::OptimizeComesh(
           }
           write(iterations.OnProgress(stage, fraction, detail));
         };
-        // After every topology pass the checkpoint is stored with the session, at the same
-        // version (nothing a client reads changes). A failed write (another writer, or the store
-        // is down) ends the run: its final write would fail the same way.
         const uint64_t version = state->session.version();
-        absl::Status checkpoint_status;
-        options.on_checkpoint = [&](const solver::ComeshCheckpoint& c) {
-          if (token.IsCancelled() || context->IsCancelled()) return;
-          auto stored = std::make_shared<StoredComeshCheckpoint>();
-          stored->input_version = version;
-          stored->stored_version = version;
-          stored->parameters = parameters_key;
-          stored->checkpoint = c;
-          SessionState next = *state;
-          next.comesh_checkpoint = std::move(stored);
-          absl::StatusOr<SessionState> put = store_->PutSameVersion(std::move(next), version);
-          if (!put.ok()) {
-            checkpoint_status = put.status();
-            token.Cancel();
-          }
-        };
+        CheckpointSaver saver(*store_, *state, parameters_key, token, *context);
+        options.on_checkpoint = [&saver](const solver::ComeshCheckpoint& c) { saver.Save(c); };
         solver::ComeshReport report;
         absl::StatusOr<solver::Multimesh> mesh = solver::OptimizeComesh(
             *state->multimesh, options, &token, progress, &report, resume_from);
         if (std::optional<v1::OptimizeComeshResponse> last = iterations.Flush()) write(*last);
         if (options_.metrics) options_.metrics->ObserveStage("optimize", report.seconds);
-        if (!checkpoint_status.ok()) return checkpoint_status;
+        if (!saver.status().ok()) return saver.status();
         if (token.IsCancelled() || context->IsCancelled()) {
           return StoppedStatus(*context, "OptimizeComesh");
         }
@@ -1208,9 +1264,8 @@ grpc::Status InbetweenService::Inbetween(grpc::ServerContext* context,
         if (!plan.ok()) return plan.status();
         plan->options.stiffness = StiffnessPerTriangle(mesh, parameters.stiffness());
         plan->options.threads = options_.solver_threads;
-        const absl::StatusOr<solver::Schedule> schedule =
-            ScheduleFrames(parameters, session, plan->frames, request->start_frame(),
-                           options_.limits.max_frames);
+        const absl::StatusOr<solver::Schedule> schedule = ScheduleFrames(
+            parameters, session, plan->frames, request->start_frame(), options_.limits.max_frames);
         if (!schedule.ok()) return schedule.status();
 
         absl::StatusOr<HeavyJobs::Slot> slot = AcquireHeavy(heavy_, context, caller);
