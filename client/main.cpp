@@ -114,6 +114,225 @@ void ApplyInbetweenFlags(const CLI::App& cmd, const InbetweenFlags& f,
   if (cmd.count("--max-iterations")) o->max_iterations = f.max_iterations;
 }
 
+// Options every subcommand takes (they may also follow the subcommand).
+struct GlobalFlags {
+  std::string server, token, tls_ca, progress = "auto";
+  bool quiet = false;
+};
+
+void AddGlobalFlags(CLI::App& app, GlobalFlags* g) {
+  app.add_option("--server", g->server,
+                 "HOST:PORT of an inbetween-server; without it the service runs embedded");
+  app.add_option("--token", g->token, "Bearer token for the server");
+  app.add_option("--tls-ca", g->tls_ca, "PEM file of the CA that signed the server's certificate")
+      ->check(CLI::ExistingFile);
+  app.add_option("--progress", g->progress, "auto (bar on a terminal) | json (one line per event)")
+      ->check(CLI::IsMember({"auto", "json"}));
+  app.add_flag("-q,--quiet", g->quiet, "No progress output");
+}
+
+// --frames and --method, which animate and init both set.
+struct FrameFlags {
+  uint32_t frames = 0;
+  std::string method;
+};
+
+struct AnimateCommand {
+  CLI::App* cmd = nullptr;
+  inbetween::client::AnimateOptions options;
+  std::string formats, fill, render, overlay;
+  int width = 0;
+  double fps = 0;
+  bool mesh = false;
+  InbetweenFlags flags;
+};
+
+void AddAnimate(CLI::App& app, FrameFlags* shared, AnimateCommand* a) {
+  CLI::App* cmd = a->cmd = app.add_subcommand("animate", "Inbetween frames from 2-16 drawings");
+  AddInputs(cmd, &a->options.inputs);
+  cmd->add_option("--out", a->options.out_dir, "Output directory")->required();
+  cmd->add_option("--frames", shared->frames, "Frames including the keys (default 24)")
+      ->check(CLI::Range(2, 100000));
+  cmd->add_option("--method", shared->method, "zhu17 (default) | alexa | linear")
+      ->check(CLI::IsMember({"linear", "alexa", "zhu17"}));
+  cmd->add_option("--format", a->formats,
+                  "Comma list of svg,json,png,gif,webp,lottie,contact (default "
+                  "svg,json,gif)");
+  cmd->add_option("--size", a->width, "Raster width in pixels (default 512)")
+      ->check(CLI::Range(8, 16384));
+  cmd->add_option("--fps", a->fps, "Frames per second of GIF/WebP/Lottie (default 24)")
+      ->check(CLI::Range(0.1, 240.0));
+  AddInbetweenFlags(cmd, &a->flags);
+  cmd->add_option("--fill", a->fill,
+                  "Fill colour (#rrggbb) instead of the drawings' own fill colours");
+  cmd->add_option("--render", a->render,
+                  "art (default): the drawings' art; silhouette: the shape in one colour "
+                  "(the default with --fill)")
+      ->check(CLI::IsMember({"art", "silhouette"}));
+  cmd->add_flag("--mesh", a->mesh, "Draw the triangle mesh over every frame");
+  cmd->add_option("--overlay", a->overlay, "mesh: same as --mesh; none: no overlay")
+      ->check(CLI::IsMember({"mesh", "none"}));
+  cmd->add_flag("--transparent", a->options.transparent, "Transparent background");
+  cmd->add_flag("--optimize", a->options.optimize, "Optimize the comesh before inbetweening");
+  cmd->add_flag("--auto-topology", a->options.auto_topology,
+                "When the drawings' topology differs, propose cuts and write them to "
+                "--project (else OUT/project.json)");
+  cmd->footer(
+      "Examples:\n"
+      "  inbetween animate square.svg hexagon.svg --frames 24 --out out/\n"
+      "  inbetween animate --project walk.json --out out/ --format gif,webp,lottie --size 640\n"
+      "  inbetween --server 127.0.0.1:50051 animate a.svg b.svg c.svg --out out/ --method alexa\n"
+      "  inbetween animate a.svg b.svg c.svg --out out/ --key-times 0,0.3,1 --tau 0.05\n"
+      "  inbetween animate disc.svg ring.svg --out out/ --auto-topology   (cuts -> "
+      "out/project.json)\n"
+      "Writes OUT/frames.json, OUT/frame_NNNN.svg, OUT/animation.gif ...; prints the path of "
+      "frames.json (and the session id when --server is used).");
+}
+
+// The animate options with the flags the user gave applied (drawings or a project given).
+inbetween::client::AnimateOptions AnimateOptionsFor(
+    const AnimateCommand& a, inbetween::client::InbetweenOverrides overrides) {
+  inbetween::client::AnimateOptions out = a.options;
+  if (out.inputs.project.empty() && out.inputs.drawings.empty()) return out;
+  ApplyInbetweenFlags(*a.cmd, a.flags, &overrides);
+  out.overrides = overrides;
+  if (a.cmd->count("--fill")) out.fill = a.fill;
+  if (a.cmd->count("--render")) out.render = a.render;
+  if (!a.formats.empty()) out.formats = a.formats;
+  if (a.width != 0) out.width = a.width;
+  if (a.fps != 0) out.fps = a.fps;
+  if (a.mesh || a.overlay == "mesh") out.mesh_overlay = true;
+  if (a.overlay == "none") out.mesh_overlay = false;
+  return out;
+}
+
+// mesh and optimize: the same inputs and output, optimize also runs comesh optimization.
+CLI::App* AddMeshCommand(CLI::App& app, const char* name, const char* help, const char* footer,
+                         inbetween::client::MeshOptions* mesh) {
+  CLI::App* cmd = app.add_subcommand(name, help);
+  AddInputs(cmd, &mesh->inputs);
+  cmd->add_option("--out", mesh->out_dir, "Output directory")->required();
+  cmd->add_flag("--auto-topology", mesh->auto_topology,
+                "Propose cuts when the topology differs (see animate)");
+  cmd->footer(footer);
+  return cmd;
+}
+
+struct RenderCommand {
+  CLI::App* cmd = nullptr;
+  inbetween::client::RenderOptions options;
+  std::string fill, render, overlay;
+};
+
+void AddRender(CLI::App& app, RenderCommand* r) {
+  CLI::App* cmd = r->cmd = app.add_subcommand("render", "Render a frames.json to images");
+  cmd->add_option("frames", r->options.frames_json, "frames.json")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", r->options.out_dir, "Output directory")->required();
+  cmd->add_option("--format", r->options.formats, "Comma list (see animate)")
+      ->default_val("svg,json,gif");
+  cmd->add_option("--size", r->options.width, "Raster width in pixels")
+      ->default_val(512)
+      ->check(CLI::Range(8, 16384));
+  cmd->add_option("--fps", r->options.fps, "Frames per second")->default_val(24);
+  cmd->add_option("--fill", r->fill,
+                  "Fill colour (#rrggbb); default: the drawings' fills in frames.json, else "
+                  "#3b7dd8");
+  cmd->add_option("--render", r->render,
+                  "art (default, when frames.json has art) | silhouette (see animate)")
+      ->check(CLI::IsMember({"art", "silhouette"}));
+  cmd->add_flag("--mesh", r->options.mesh_overlay, "Draw the triangle mesh");
+  cmd->add_option("--overlay", r->overlay, "mesh: same as --mesh; none: no overlay")
+      ->check(CLI::IsMember({"mesh", "none"}));
+  cmd->add_flag("--transparent", r->options.transparent, "Transparent background");
+  cmd->footer("Examples:\n  inbetween render out/frames.json --out out/ --format png,gif");
+}
+
+struct InspectCommand {
+  CLI::App* cmd = nullptr;
+  std::string session_id;
+  inbetween::client::Inputs project;
+};
+
+void AddInspect(CLI::App& app, InspectCommand* i) {
+  CLI::App* cmd = i->cmd =
+      app.add_subcommand("inspect", "Show a session's state, or list your sessions");
+  cmd->add_option("session", i->session_id, "Session id (omit to list every session)");
+  cmd->add_option("--project", i->project.project,
+                  "Inspect a project file instead: classes, multimesh size and energies")
+      ->check(CLI::ExistingFile)
+      ->excludes(cmd->get_option("session"));
+  AddImportFlags(cmd, &i->project.import_flags);
+  cmd->footer(
+      "Examples:\n  inbetween --server 127.0.0.1:50051 inspect\n"
+      "  inbetween --server 127.0.0.1:50051 inspect 4f2a9c...\n"
+      "  inbetween inspect --project walk.json");
+}
+
+struct InitCommand {
+  CLI::App* cmd = nullptr;
+  inbetween::client::Inputs inputs;
+  std::string out;
+  bool force = false;
+  InbetweenFlags flags;
+};
+
+void AddInit(CLI::App& app, FrameFlags* shared, InitCommand* i) {
+  CLI::App* cmd = i->cmd = app.add_subcommand("init", "Write a project file for some drawings");
+  cmd->add_option("drawings", i->inputs.drawings, "SVG drawings in key order")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out,-o", i->out, "Project file to write")->required();
+  cmd->add_option("--frames", shared->frames, "Frames including the keys");
+  cmd->add_option("--method", shared->method, "zhu17 | alexa | linear")
+      ->check(CLI::IsMember({"linear", "alexa", "zhu17"}));
+  AddInbetweenFlags(cmd, &i->flags);
+  AddImportFlags(cmd, &i->inputs.import_flags);
+  cmd->add_flag("--force", i->force, "Overwrite an existing file");
+  cmd->footer("Examples:\n  inbetween init pose*.svg -o walk.json --frames 48");
+}
+
+// The embedded service (no --server) or a channel to the server; nullopt after printing why the
+// embedded service could not start.
+std::optional<std::shared_ptr<grpc::Channel>> Connect(
+    const GlobalFlags& g, std::unique_ptr<inbetween::server::InbetweenServer>* embedded) {
+  if (!g.server.empty()) {
+    return inbetween::client::CreateChannelForServer(g.server, Credentials(g.tls_ca));
+  }
+  inbetween::server::ServerOptions options;  // no listening port: in-process only
+  auto started = inbetween::server::InbetweenServer::Start(options);
+  if (!started.ok()) {
+    std::fprintf(stderr, "error: cannot start the embedded service: %s\n",
+                 std::string(started.status().message()).c_str());
+    return std::nullopt;
+  }
+  *embedded = std::move(*started);
+  return (*embedded)->InProcessChannel();
+}
+
+// The client options: the token, and unless quiet a line for every retry.
+inbetween::client::ClientOptions ClientOptionsFor(const GlobalFlags& g) {
+  inbetween::client::ClientOptions client_options;
+  client_options.token = g.token;
+  if (!g.quiet) {
+    // A replica went away mid-call (docs/scale-out.md): say what is retried and from where.
+    client_options.on_retry = [](const inbetween::client::RetryEvent& e) {
+      const std::string from =
+          e.method == "Inbetween" ? absl::StrCat(", resuming at frame ", e.resume_frame) : "";
+      std::fprintf(stderr, "retry: %s attempt %d failed (%s); attempt %d in %lld ms%s\n",
+                   e.method.c_str(), e.failed_attempt, e.status.ToString().c_str(),
+                   e.failed_attempt + 1, static_cast<long long>(e.backoff.count()), from.c_str());
+    };
+  }
+  return client_options;
+}
+
+int Report(const absl::Status& status) {
+  if (!status.ok()) std::fprintf(stderr, "error: %s\n", std::string(status.message()).c_str());
+  return ExitCodeFor(status);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -129,141 +348,30 @@ int main(int argc, char** argv) {
   CLI::App app{"inbetween: 2D inbetween animation from a few key drawings"};
   app.require_subcommand(1);
   app.footer(kExitCodes);
-  std::string server, token, tls_ca, progress = "auto";
-  bool quiet = false;
-  app.add_option("--server", server,
-                 "HOST:PORT of an inbetween-server; without it the service runs embedded");
-  app.add_option("--token", token, "Bearer token for the server");
-  app.add_option("--tls-ca", tls_ca, "PEM file of the CA that signed the server's certificate")
-      ->check(CLI::ExistingFile);
-  app.add_option("--progress", progress, "auto (bar on a terminal) | json (one line per event)")
-      ->check(CLI::IsMember({"auto", "json"}));
-  app.add_flag("-q,--quiet", quiet, "No progress output");
-
-  // animate
-  inbetween::client::AnimateOptions animate;
-  std::string method;
-  uint32_t frames = 0;
-  std::string formats;
-  int width = 0;
-  double fps = 0;
-  bool overlay = false;
-  std::string fill;
-  InbetweenFlags animate_flags;
-  CLI::App* animate_cmd = app.add_subcommand("animate", "Inbetween frames from 2-16 drawings");
-  AddInputs(animate_cmd, &animate.inputs);
-  animate_cmd->add_option("--out", animate.out_dir, "Output directory")->required();
-  animate_cmd->add_option("--frames", frames, "Frames including the keys (default 24)")
-      ->check(CLI::Range(2, 100000));
-  animate_cmd->add_option("--method", method, "zhu17 (default) | alexa | linear")
-      ->check(CLI::IsMember({"linear", "alexa", "zhu17"}));
-  animate_cmd->add_option("--format", formats,
-                          "Comma list of svg,json,png,gif,webp,lottie,contact (default "
-                          "svg,json,gif)");
-  animate_cmd->add_option("--size", width, "Raster width in pixels (default 512)")
-      ->check(CLI::Range(8, 16384));
-  animate_cmd->add_option("--fps", fps, "Frames per second of GIF/WebP/Lottie (default 24)")
-      ->check(CLI::Range(0.1, 240.0));
-  AddInbetweenFlags(animate_cmd, &animate_flags);
-  animate_cmd->add_option("--fill", fill,
-                          "Fill colour (#rrggbb) instead of the drawings' own fill colours");
-  std::string animate_render;
-  animate_cmd
-      ->add_option("--render", animate_render,
-                   "art (default): the drawings' art; silhouette: the shape in one colour "
-                   "(the default with --fill)")
-      ->check(CLI::IsMember({"art", "silhouette"}));
-  animate_cmd->add_flag("--mesh", overlay, "Draw the triangle mesh over every frame");
-  std::string animate_overlay;
-  animate_cmd->add_option("--overlay", animate_overlay, "mesh: same as --mesh; none: no overlay")
-      ->check(CLI::IsMember({"mesh", "none"}));
-  animate_cmd->add_flag("--transparent", animate.transparent, "Transparent background");
-  animate_cmd->add_flag("--optimize", animate.optimize, "Optimize the comesh before inbetweening");
-  animate_cmd->add_flag("--auto-topology", animate.auto_topology,
-                        "When the drawings' topology differs, propose cuts and write them to "
-                        "--project (else OUT/project.json)");
-  animate_cmd->footer(
-      "Examples:\n"
-      "  inbetween animate square.svg hexagon.svg --frames 24 --out out/\n"
-      "  inbetween animate --project walk.json --out out/ --format gif,webp,lottie --size 640\n"
-      "  inbetween --server 127.0.0.1:50051 animate a.svg b.svg c.svg --out out/ --method alexa\n"
-      "  inbetween animate a.svg b.svg c.svg --out out/ --key-times 0,0.3,1 --tau 0.05\n"
-      "  inbetween animate disc.svg ring.svg --out out/ --auto-topology   (cuts -> "
-      "out/project.json)\n"
-      "Writes OUT/frames.json, OUT/frame_NNNN.svg, OUT/animation.gif ...; prints the path of "
-      "frames.json (and the session id when --server is used).");
-
-  // mesh / optimize
+  GlobalFlags global;
+  AddGlobalFlags(app, &global);
+  FrameFlags shared;
+  AnimateCommand animate;
+  AddAnimate(app, &shared, &animate);
   inbetween::client::MeshOptions mesh;
-  CLI::App* mesh_cmd = app.add_subcommand("mesh", "Build the multimesh of 2-16 drawings");
-  AddInputs(mesh_cmd, &mesh.inputs);
-  mesh_cmd->add_option("--out", mesh.out_dir, "Output directory")->required();
-  mesh_cmd->add_flag("--auto-topology", mesh.auto_topology,
-                     "Propose cuts when the topology differs (see animate)");
-  mesh_cmd->footer(
-      "Examples:\n  inbetween mesh mouth_closed.svg mouth_open.svg --out mesh/\n"
-      "  inbetween mesh disc.svg ring.svg --out mesh/ --auto-topology   (writes "
-      "mesh/project.json)\n"
-      "Writes OUT/multimesh.json and OUT/shape_N.svg (each shape with its mesh).");
+  CLI::App* mesh_cmd =
+      AddMeshCommand(app, "mesh", "Build the multimesh of 2-16 drawings",
+                     "Examples:\n  inbetween mesh mouth_closed.svg mouth_open.svg --out mesh/\n"
+                     "  inbetween mesh disc.svg ring.svg --out mesh/ --auto-topology   (writes "
+                     "mesh/project.json)\n"
+                     "Writes OUT/multimesh.json and OUT/shape_N.svg (each shape with its mesh).",
+                     &mesh);
   inbetween::client::MeshOptions optimize;
   optimize.optimize = true;
   CLI::App* optimize_cmd =
-      app.add_subcommand("optimize", "Build and optimize the multimesh (comesh optimization)");
-  AddInputs(optimize_cmd, &optimize.inputs);
-  optimize_cmd->add_option("--out", optimize.out_dir, "Output directory")->required();
-  optimize_cmd->add_flag("--auto-topology", optimize.auto_topology,
-                         "Propose cuts when the topology differs (see animate)");
-  optimize_cmd->footer(
-      "Examples:\n  inbetween optimize square.svg hexagon.svg --out mesh/\n"
-      "Writes OUT/multimesh.json, OUT/shape_N.svg and OUT/report.json.");
-
-  // render
-  inbetween::client::RenderOptions render;
-  CLI::App* render_cmd = app.add_subcommand("render", "Render a frames.json to images");
-  render_cmd->add_option("frames", render.frames_json, "frames.json")
-      ->required()
-      ->check(CLI::ExistingFile);
-  render_cmd->add_option("--out", render.out_dir, "Output directory")->required();
-  render_cmd->add_option("--format", render.formats, "Comma list (see animate)")
-      ->default_val("svg,json,gif");
-  render_cmd->add_option("--size", render.width, "Raster width in pixels")
-      ->default_val(512)
-      ->check(CLI::Range(8, 16384));
-  render_cmd->add_option("--fps", render.fps, "Frames per second")->default_val(24);
-  std::string render_fill;
-  render_cmd->add_option("--fill", render_fill,
-                         "Fill colour (#rrggbb); default: the drawings' fills in frames.json, else "
-                         "#3b7dd8");
-  std::string render_render;
-  render_cmd
-      ->add_option("--render", render_render,
-                   "art (default, when frames.json has art) | silhouette (see animate)")
-      ->check(CLI::IsMember({"art", "silhouette"}));
-  render_cmd->add_flag("--mesh", render.mesh_overlay, "Draw the triangle mesh");
-  std::string render_overlay;
-  render_cmd->add_option("--overlay", render_overlay, "mesh: same as --mesh; none: no overlay")
-      ->check(CLI::IsMember({"mesh", "none"}));
-  render_cmd->add_flag("--transparent", render.transparent, "Transparent background");
-  render_cmd->footer("Examples:\n  inbetween render out/frames.json --out out/ --format png,gif");
-
-  // inspect
-  std::string inspect_id;
-  CLI::App* inspect_cmd =
-      app.add_subcommand("inspect", "Show a session's state, or list your sessions");
-  inspect_cmd->add_option("session", inspect_id, "Session id (omit to list every session)");
-  inbetween::client::Inputs inspect_project;
-  inspect_cmd
-      ->add_option("--project", inspect_project.project,
-                   "Inspect a project file instead: classes, multimesh size and energies")
-      ->check(CLI::ExistingFile)
-      ->excludes(inspect_cmd->get_option("session"));
-  AddImportFlags(inspect_cmd, &inspect_project.import_flags);
-  inspect_cmd->footer(
-      "Examples:\n  inbetween --server 127.0.0.1:50051 inspect\n"
-      "  inbetween --server 127.0.0.1:50051 inspect 4f2a9c...\n"
-      "  inbetween inspect --project walk.json");
-
-  // validate
+      AddMeshCommand(app, "optimize", "Build and optimize the multimesh (comesh optimization)",
+                     "Examples:\n  inbetween optimize square.svg hexagon.svg --out mesh/\n"
+                     "Writes OUT/multimesh.json, OUT/shape_N.svg and OUT/report.json.",
+                     &optimize);
+  RenderCommand render;
+  AddRender(app, &render);
+  InspectCommand inspect;
+  AddInspect(app, &inspect);
   inbetween::client::Inputs validate;
   CLI::App* validate_cmd =
       app.add_subcommand("validate", "Check drawings and a project file; report every problem");
@@ -271,27 +379,10 @@ int main(int argc, char** argv) {
   validate_cmd->footer(
       "Examples:\n  inbetween validate --project walk.json\n"
       "  inbetween validate a.svg b.svg");
-
-  // init
-  inbetween::client::Inputs init;
-  std::string init_out;
-  bool force = false;
-  CLI::App* init_cmd = app.add_subcommand("init", "Write a project file for some drawings");
-  init_cmd->add_option("drawings", init.drawings, "SVG drawings in key order")
-      ->required()
-      ->check(CLI::ExistingFile);
-  init_cmd->add_option("--out,-o", init_out, "Project file to write")->required();
-  init_cmd->add_option("--frames", frames, "Frames including the keys");
-  init_cmd->add_option("--method", method, "zhu17 | alexa | linear")
-      ->check(CLI::IsMember({"linear", "alexa", "zhu17"}));
-  InbetweenFlags init_flags;
-  AddInbetweenFlags(init_cmd, &init_flags);
-  AddImportFlags(init_cmd, &init.import_flags);
-  init_cmd->add_flag("--force", force, "Overwrite an existing file");
-  init_cmd->footer("Examples:\n  inbetween init pose*.svg -o walk.json --frames 48");
-
+  InitCommand init;
+  AddInit(app, &shared, &init);
   for (CLI::App* cmd :
-       {animate_cmd, mesh_cmd, optimize_cmd, render_cmd, inspect_cmd, validate_cmd, init_cmd}) {
+       {animate.cmd, mesh_cmd, optimize_cmd, render.cmd, inspect.cmd, validate_cmd, init.cmd}) {
     cmd->fallthrough();  // global options may also follow the subcommand
   }
 
@@ -303,90 +394,51 @@ int main(int argc, char** argv) {
   }
 
   inbetween::client::InbetweenOverrides overrides;
-  if (frames != 0) overrides.frames = frames;
-  if (!method.empty()) overrides.method = method;
-  const auto mode = quiet                ? inbetween::client::ProgressMode::kQuiet
-                    : progress == "json" ? inbetween::client::ProgressMode::kJson
-                                         : inbetween::client::ProgressMode::kAuto;
+  if (shared.frames != 0) overrides.frames = shared.frames;
+  if (!shared.method.empty()) overrides.method = shared.method;
+  const auto mode = global.quiet                ? inbetween::client::ProgressMode::kQuiet
+                    : global.progress == "json" ? inbetween::client::ProgressMode::kJson
+                                                : inbetween::client::ProgressMode::kAuto;
   inbetween::client::ProgressBar bar(mode);
 
-  auto report = [](const absl::Status& status) {
-    if (!status.ok()) std::fprintf(stderr, "error: %s\n", std::string(status.message()).c_str());
-    return ExitCodeFor(status);
-  };
-  if (*render_cmd) {
-    if (render_cmd->count("--fill")) render.fill = render_fill;
-    if (render_cmd->count("--render")) render.render = render_render;
-    if (render_overlay == "mesh") render.mesh_overlay = true;
-    return report(inbetween::client::RunRender(render, bar));
+  // Commands without a service.
+  if (*render.cmd) {
+    if (render.cmd->count("--fill")) render.options.fill = render.fill;
+    if (render.cmd->count("--render")) render.options.render = render.render;
+    if (render.overlay == "mesh") render.options.mesh_overlay = true;
+    return Report(inbetween::client::RunRender(render.options, bar));
   }
-  if (*init_cmd) {
-    ApplyInbetweenFlags(*init_cmd, init_flags, &overrides);
-    return report(inbetween::client::RunInit(init, init_out, overrides, force));
+  if (*init.cmd) {
+    ApplyInbetweenFlags(*init.cmd, init.flags, &overrides);
+    return Report(inbetween::client::RunInit(init.inputs, init.out, overrides, init.force));
   }
 
   std::unique_ptr<inbetween::server::InbetweenServer> embedded;
-  std::shared_ptr<grpc::Channel> channel;
-  if (server.empty()) {
-    inbetween::server::ServerOptions options;  // no listening port: in-process only
-    auto started = inbetween::server::InbetweenServer::Start(options);
-    if (!started.ok()) {
-      std::fprintf(stderr, "error: cannot start the embedded service: %s\n",
-                   std::string(started.status().message()).c_str());
-      return 5;
-    }
-    embedded = std::move(*started);
-    channel = embedded->InProcessChannel();
-  } else {
-    channel = inbetween::client::CreateChannelForServer(server, Credentials(tls_ca));
-  }
-
-  inbetween::client::ClientOptions client_options;
-  client_options.token = token;
-  if (!quiet) {
-    // A replica went away mid-call (docs/scale-out.md): say what is retried and from where.
-    client_options.on_retry = [](const inbetween::client::RetryEvent& e) {
-      const std::string from =
-          e.method == "Inbetween" ? absl::StrCat(", resuming at frame ", e.resume_frame) : "";
-      std::fprintf(stderr, "retry: %s attempt %d failed (%s); attempt %d in %lld ms%s\n",
-                   e.method.c_str(), e.failed_attempt, e.status.ToString().c_str(),
-                   e.failed_attempt + 1, static_cast<long long>(e.backoff.count()), from.c_str());
-    };
-  }
-  inbetween::client::InbetweenClient client(channel, std::move(client_options));
+  const std::optional<std::shared_ptr<grpc::Channel>> channel = Connect(global, &embedded);
+  if (!channel) return 5;
+  inbetween::client::InbetweenClient client(*channel, ClientOptionsFor(global));
   StartSignalThread(&client);
   const inbetween::client::RunContext ctx{
-      .client = &client, .progress = &bar, .remote = !server.empty(), .quiet = quiet};
+      .client = &client, .progress = &bar, .remote = !global.server.empty(), .quiet = global.quiet};
   absl::Status status;
-  if (*animate_cmd) {
-    if (!animate.inputs.project.empty() || !animate.inputs.drawings.empty()) {
-      ApplyInbetweenFlags(*animate_cmd, animate_flags, &overrides);
-      animate.overrides = overrides;
-      if (animate_cmd->count("--fill")) animate.fill = fill;
-      if (animate_cmd->count("--render")) animate.render = animate_render;
-      if (!formats.empty()) animate.formats = formats;
-      if (width != 0) animate.width = width;
-      if (fps != 0) animate.fps = fps;
-      if (overlay || animate_overlay == "mesh") animate.mesh_overlay = true;
-      if (animate_overlay == "none") animate.mesh_overlay = false;
-    }
-    status = inbetween::client::RunAnimate(animate, ctx);
+  if (*animate.cmd) {
+    status = inbetween::client::RunAnimate(AnimateOptionsFor(animate, overrides), ctx);
   } else if (*mesh_cmd) {
     status = inbetween::client::RunMesh(mesh, ctx);
   } else if (*optimize_cmd) {
     status = inbetween::client::RunMesh(optimize, ctx);
-  } else if (*inspect_cmd) {
-    if (!inspect_project.project.empty()) {
-      status = inbetween::client::RunInspectProject(inspect_project, ctx);
-    } else if (inspect_id.empty() && server.empty()) {
+  } else if (*inspect.cmd) {
+    if (!inspect.project.project.empty()) {
+      status = inbetween::client::RunInspectProject(inspect.project, ctx);
+    } else if (inspect.session_id.empty() && global.server.empty()) {
       status = absl::InvalidArgumentError(
           "inspect without a session id lists a server's sessions: give --server HOST:PORT");
     } else {
-      status = inbetween::client::RunInspect(inspect_id, ctx);
+      status = inbetween::client::RunInspect(inspect.session_id, ctx);
     }
   } else if (*validate_cmd) {
     status = inbetween::client::RunValidate(validate, ctx);
   }
   if (embedded) embedded->Shutdown();
-  return report(status);
+  return Report(status);
 }
