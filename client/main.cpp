@@ -333,6 +333,106 @@ int Report(const absl::Status& status) {
   return ExitCodeFor(status);
 }
 
+// Every subcommand with its flags, bound by AddCommands.
+struct Commands {
+  GlobalFlags global;
+  FrameFlags shared;
+  AnimateCommand animate;
+  inbetween::client::MeshOptions mesh, optimize;
+  CLI::App* mesh_cmd = nullptr;
+  CLI::App* optimize_cmd = nullptr;
+  RenderCommand render;
+  InspectCommand inspect;
+  inbetween::client::Inputs validate;
+  CLI::App* validate_cmd = nullptr;
+  InitCommand init;
+};
+
+void AddCommands(CLI::App& app, Commands* c) {
+  AddGlobalFlags(app, &c->global);
+  AddAnimate(app, &c->shared, &c->animate);
+  c->mesh_cmd =
+      AddMeshCommand(app, "mesh", "Build the multimesh of 2-16 drawings",
+                     "Examples:\n  inbetween mesh mouth_closed.svg mouth_open.svg --out mesh/\n"
+                     "  inbetween mesh disc.svg ring.svg --out mesh/ --auto-topology   (writes "
+                     "mesh/project.json)\n"
+                     "Writes OUT/multimesh.json and OUT/shape_N.svg (each shape with its mesh).",
+                     &c->mesh);
+  c->optimize.optimize = true;
+  c->optimize_cmd =
+      AddMeshCommand(app, "optimize", "Build and optimize the multimesh (comesh optimization)",
+                     "Examples:\n  inbetween optimize square.svg hexagon.svg --out mesh/\n"
+                     "Writes OUT/multimesh.json, OUT/shape_N.svg and OUT/report.json.",
+                     &c->optimize);
+  AddRender(app, &c->render);
+  AddInspect(app, &c->inspect);
+  CLI::App* validate_cmd = c->validate_cmd =
+      app.add_subcommand("validate", "Check drawings and a project file; report every problem");
+  AddInputs(validate_cmd, &c->validate);
+  validate_cmd->footer(
+      "Examples:\n  inbetween validate --project walk.json\n"
+      "  inbetween validate a.svg b.svg");
+  AddInit(app, &c->shared, &c->init);
+  for (CLI::App* cmd : {c->animate.cmd, c->mesh_cmd, c->optimize_cmd, c->render.cmd, c->inspect.cmd,
+                        validate_cmd, c->init.cmd}) {
+    cmd->fallthrough();  // global options may also follow the subcommand
+  }
+}
+
+// Runs the parsed subcommand; the exit code.
+int Run(Commands& c) {
+  inbetween::client::InbetweenOverrides overrides;
+  if (c.shared.frames != 0) overrides.frames = c.shared.frames;
+  if (!c.shared.method.empty()) overrides.method = c.shared.method;
+  const auto mode = c.global.quiet                ? inbetween::client::ProgressMode::kQuiet
+                    : c.global.progress == "json" ? inbetween::client::ProgressMode::kJson
+                                                  : inbetween::client::ProgressMode::kAuto;
+  inbetween::client::ProgressBar bar(mode);
+
+  // Commands without a service.
+  if (*c.render.cmd) {
+    if (c.render.cmd->count("--fill")) c.render.options.fill = c.render.fill;
+    if (c.render.cmd->count("--render")) c.render.options.render = c.render.render;
+    if (c.render.overlay == "mesh") c.render.options.mesh_overlay = true;
+    return Report(inbetween::client::RunRender(c.render.options, bar));
+  }
+  if (*c.init.cmd) {
+    ApplyInbetweenFlags(*c.init.cmd, c.init.flags, &overrides);
+    return Report(inbetween::client::RunInit(c.init.inputs, c.init.out, overrides, c.init.force));
+  }
+
+  std::unique_ptr<inbetween::server::InbetweenServer> embedded;
+  const std::optional<std::shared_ptr<grpc::Channel>> channel = Connect(c.global, &embedded);
+  if (!channel) return 5;
+  inbetween::client::InbetweenClient client(*channel, ClientOptionsFor(c.global));
+  StartSignalThread(&client);
+  const inbetween::client::RunContext ctx{.client = &client,
+                                          .progress = &bar,
+                                          .remote = !c.global.server.empty(),
+                                          .quiet = c.global.quiet};
+  absl::Status status;
+  if (*c.animate.cmd) {
+    status = inbetween::client::RunAnimate(AnimateOptionsFor(c.animate, overrides), ctx);
+  } else if (*c.mesh_cmd) {
+    status = inbetween::client::RunMesh(c.mesh, ctx);
+  } else if (*c.optimize_cmd) {
+    status = inbetween::client::RunMesh(c.optimize, ctx);
+  } else if (*c.inspect.cmd) {
+    if (!c.inspect.project.project.empty()) {
+      status = inbetween::client::RunInspectProject(c.inspect.project, ctx);
+    } else if (c.inspect.session_id.empty() && c.global.server.empty()) {
+      status = absl::InvalidArgumentError(
+          "inspect without a session id lists a server's sessions: give --server HOST:PORT");
+    } else {
+      status = inbetween::client::RunInspect(c.inspect.session_id, ctx);
+    }
+  } else if (*c.validate_cmd) {
+    status = inbetween::client::RunValidate(c.validate, ctx);
+  }
+  if (embedded) embedded->Shutdown();
+  return Report(status);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -348,97 +448,13 @@ int main(int argc, char** argv) {
   CLI::App app{"inbetween: 2D inbetween animation from a few key drawings"};
   app.require_subcommand(1);
   app.footer(kExitCodes);
-  GlobalFlags global;
-  AddGlobalFlags(app, &global);
-  FrameFlags shared;
-  AnimateCommand animate;
-  AddAnimate(app, &shared, &animate);
-  inbetween::client::MeshOptions mesh;
-  CLI::App* mesh_cmd =
-      AddMeshCommand(app, "mesh", "Build the multimesh of 2-16 drawings",
-                     "Examples:\n  inbetween mesh mouth_closed.svg mouth_open.svg --out mesh/\n"
-                     "  inbetween mesh disc.svg ring.svg --out mesh/ --auto-topology   (writes "
-                     "mesh/project.json)\n"
-                     "Writes OUT/multimesh.json and OUT/shape_N.svg (each shape with its mesh).",
-                     &mesh);
-  inbetween::client::MeshOptions optimize;
-  optimize.optimize = true;
-  CLI::App* optimize_cmd =
-      AddMeshCommand(app, "optimize", "Build and optimize the multimesh (comesh optimization)",
-                     "Examples:\n  inbetween optimize square.svg hexagon.svg --out mesh/\n"
-                     "Writes OUT/multimesh.json, OUT/shape_N.svg and OUT/report.json.",
-                     &optimize);
-  RenderCommand render;
-  AddRender(app, &render);
-  InspectCommand inspect;
-  AddInspect(app, &inspect);
-  inbetween::client::Inputs validate;
-  CLI::App* validate_cmd =
-      app.add_subcommand("validate", "Check drawings and a project file; report every problem");
-  AddInputs(validate_cmd, &validate);
-  validate_cmd->footer(
-      "Examples:\n  inbetween validate --project walk.json\n"
-      "  inbetween validate a.svg b.svg");
-  InitCommand init;
-  AddInit(app, &shared, &init);
-  for (CLI::App* cmd :
-       {animate.cmd, mesh_cmd, optimize_cmd, render.cmd, inspect.cmd, validate_cmd, init.cmd}) {
-    cmd->fallthrough();  // global options may also follow the subcommand
-  }
-
+  Commands commands;
+  AddCommands(app, &commands);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kUsageError;
   }
-
-  inbetween::client::InbetweenOverrides overrides;
-  if (shared.frames != 0) overrides.frames = shared.frames;
-  if (!shared.method.empty()) overrides.method = shared.method;
-  const auto mode = global.quiet                ? inbetween::client::ProgressMode::kQuiet
-                    : global.progress == "json" ? inbetween::client::ProgressMode::kJson
-                                                : inbetween::client::ProgressMode::kAuto;
-  inbetween::client::ProgressBar bar(mode);
-
-  // Commands without a service.
-  if (*render.cmd) {
-    if (render.cmd->count("--fill")) render.options.fill = render.fill;
-    if (render.cmd->count("--render")) render.options.render = render.render;
-    if (render.overlay == "mesh") render.options.mesh_overlay = true;
-    return Report(inbetween::client::RunRender(render.options, bar));
-  }
-  if (*init.cmd) {
-    ApplyInbetweenFlags(*init.cmd, init.flags, &overrides);
-    return Report(inbetween::client::RunInit(init.inputs, init.out, overrides, init.force));
-  }
-
-  std::unique_ptr<inbetween::server::InbetweenServer> embedded;
-  const std::optional<std::shared_ptr<grpc::Channel>> channel = Connect(global, &embedded);
-  if (!channel) return 5;
-  inbetween::client::InbetweenClient client(*channel, ClientOptionsFor(global));
-  StartSignalThread(&client);
-  const inbetween::client::RunContext ctx{
-      .client = &client, .progress = &bar, .remote = !global.server.empty(), .quiet = global.quiet};
-  absl::Status status;
-  if (*animate.cmd) {
-    status = inbetween::client::RunAnimate(AnimateOptionsFor(animate, overrides), ctx);
-  } else if (*mesh_cmd) {
-    status = inbetween::client::RunMesh(mesh, ctx);
-  } else if (*optimize_cmd) {
-    status = inbetween::client::RunMesh(optimize, ctx);
-  } else if (*inspect.cmd) {
-    if (!inspect.project.project.empty()) {
-      status = inbetween::client::RunInspectProject(inspect.project, ctx);
-    } else if (inspect.session_id.empty() && global.server.empty()) {
-      status = absl::InvalidArgumentError(
-          "inspect without a session id lists a server's sessions: give --server HOST:PORT");
-    } else {
-      status = inbetween::client::RunInspect(inspect.session_id, ctx);
-    }
-  } else if (*validate_cmd) {
-    status = inbetween::client::RunValidate(validate, ctx);
-  }
-  if (embedded) embedded->Shutdown();
-  return Report(status);
+  return Run(commands);
 }
