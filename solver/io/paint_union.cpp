@@ -210,8 +210,12 @@ std::vector<Points> DashPolyline(const Points& points, bool closed,
   return out;
 }
 
-absl::StatusOr<PaintRegion> UnionOfPaint(const std::vector<const ArtLayer*>& layers,
-                                         const PaintUnionOptions& options) {
+namespace {
+
+// The fixed-point frame of the paint: its bounding box grown by the widest stroke's reach (a
+// miter reaches at most miter_limit half widths from its vertex, a square cap sqrt(2)) and the gap
+// width; INVALID_ARGUMENT when nothing is painted.
+absl::StatusOr<Quantizer> PaintFrame(const std::vector<const ArtLayer*>& layers, double gap_width) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   Point lo(kInf, kInf), hi(-kInf, -kInf);
   double margin = 0;
@@ -220,38 +224,36 @@ absl::StatusOr<PaintRegion> UnionOfPaint(const std::vector<const ArtLayer*>& lay
       for (const Point& p : path.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     }
     if (layer->stroke) {
-      // A miter reaches at most miter_limit half widths from its vertex; a square cap sqrt(2).
       margin = std::max(margin, 0.5 * layer->stroke->width *
                                     std::max({std::sqrt(2.0), layer->stroke->miter_limit, 2.0}));
     }
   }
   if (!(lo.x() <= hi.x())) return absl::InvalidArgumentError("nothing is painted");
-  margin += options.gap_width;
+  margin += gap_width;
   const Point pad(margin, margin);
-  const Quantizer q(lo - pad, hi + pad);
+  return Quantizer(lo - pad, hi + pad);
+}
 
-  std::vector<cl::Paths> pieces;
-  double layers_area = 0;
-  for (const ArtLayer* layer : layers) {
-    cl::Paths fill, stroke;
-    if (layer->fill) fill = FillArea(*layer, q);
-    if (layer->stroke && layer->stroke->width > 0) {
-      stroke = StrokeArea(*layer, q, options.arc_tolerance);
-    }
-    if (!fill.empty() && !stroke.empty()) {  // the layer's own paint, for its area
-      cl::Clipper clipper;
-      clipper.AddPaths(fill, cl::ptSubject, true);
-      clipper.AddPaths(stroke, cl::ptSubject, true);
-      clipper.Execute(cl::ctUnion, fill, cl::pftPositive, cl::pftPositive);
-    } else if (fill.empty()) {
-      fill = std::move(stroke);
-    }
-    for (const cl::Path& p : fill) layers_area += cl::Area(p);
-    if (!fill.empty()) pieces.push_back(std::move(fill));
+// One layer's paint: its fill and its stroke's area, united.
+cl::Paths LayerPaint(const ArtLayer& layer, const Quantizer& q, double arc_tolerance) {
+  cl::Paths fill, stroke;
+  if (layer.fill) fill = FillArea(layer, q);
+  if (layer.stroke && layer.stroke->width > 0) stroke = StrokeArea(layer, q, arc_tolerance);
+  if (!fill.empty() && !stroke.empty()) {  // the layer's own paint, for its area
+    cl::Clipper clipper;
+    clipper.AddPaths(fill, cl::ptSubject, true);
+    clipper.AddPaths(stroke, cl::ptSubject, true);
+    clipper.Execute(cl::ctUnion, fill, cl::pftPositive, cl::pftPositive);
+  } else if (fill.empty()) {
+    fill = std::move(stroke);
   }
-  // Cascaded union: neighbours in paint order united pairwise, level by level, so that edges
-  // hidden under later paint leave early instead of crossing every other layer's in one sweep
-  // (benchmark "import" in docs/benchmarks.md).
+  return fill;
+}
+
+// Cascaded union: neighbours in paint order united pairwise, level by level, so that edges
+// hidden under later paint leave early instead of crossing every other layer's in one sweep
+// (benchmark "import" in docs/benchmarks.md).
+cl::Paths CascadedUnion(std::vector<cl::Paths> pieces) {
   while (pieces.size() > 1) {
     std::vector<cl::Paths> next((pieces.size() + 1) / 2);
     for (size_t i = 0; i < next.size(); ++i) {
@@ -266,7 +268,59 @@ absl::StatusOr<PaintRegion> UnionOfPaint(const std::vector<const ArtLayer*>& lay
     }
     pieces = std::move(next);
   }
-  const cl::Paths united = pieces.empty() ? cl::Paths() : std::move(pieces[0]);
+  return pieces.empty() ? cl::Paths() : std::move(pieces[0]);
+}
+
+// Walks the tree into region->outlines: an outer loop below `min_area` goes with everything
+// inside it; a hole below it is filled, and so covers whatever lies in it.
+void CollectOutlines(const cl::PolyTree& tree, const Quantizer& q, double min_area,
+                     PaintRegion* region) {
+  std::vector<const cl::PolyNode*> stack;
+  for (const cl::PolyNode* n : tree.Childs) stack.push_back(n);
+  while (!stack.empty()) {
+    const cl::PolyNode* node = stack.back();
+    stack.pop_back();
+    const double area = std::abs(cl::Area(node->Contour));
+    const bool small = area < min_area;
+    if (node->IsHole()) {
+      if (small) {
+        ++region->cleaning.holes_dropped;
+        continue;
+      }
+      Outline hole;
+      for (const cl::IntPoint& p : node->Contour) hole.points.push_back(q.ToPoint(p));
+      if (PolygonSignedArea(hole.points) > 0) std::reverse(hole.points.begin(), hole.points.end());
+      region->outlines.push_back(std::move(hole));
+      for (const cl::PolyNode* child : node->Childs) stack.push_back(child);
+      continue;
+    }
+    if (small) {
+      ++region->cleaning.islands_dropped;
+      continue;  // with its holes and whatever lies in them
+    }
+    Outline outer;
+    for (const cl::IntPoint& p : node->Contour) outer.points.push_back(q.ToPoint(p));
+    if (PolygonSignedArea(outer.points) < 0) std::reverse(outer.points.begin(), outer.points.end());
+    region->outlines.push_back(std::move(outer));
+    for (const cl::PolyNode* child : node->Childs) stack.push_back(child);
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<PaintRegion> UnionOfPaint(const std::vector<const ArtLayer*>& layers,
+                                         const PaintUnionOptions& options) {
+  absl::StatusOr<Quantizer> frame = PaintFrame(layers, options.gap_width);
+  if (!frame.ok()) return frame.status();
+  const Quantizer& q = *frame;
+  std::vector<cl::Paths> pieces;
+  double layers_area = 0;
+  for (const ArtLayer* layer : layers) {
+    cl::Paths paint = LayerPaint(*layer, q, options.arc_tolerance);
+    for (const cl::Path& p : paint) layers_area += cl::Area(p);
+    if (!paint.empty()) pieces.push_back(std::move(paint));
+  }
+  const cl::Paths united = CascadedUnion(std::move(pieces));
   double united_area = 0;
   for (const cl::Path& p : united) united_area += cl::Area(p);
   if (!(std::abs(united_area) > 0)) {
@@ -294,39 +348,7 @@ absl::StatusOr<PaintRegion> UnionOfPaint(const std::vector<const ArtLayer*>& lay
     region.cleaning.gaps_closed = std::max(0, before.outers - after.outers);
     region.cleaning.slits_closed = std::max(0, before.holes - after.holes);
   }
-
-  // Walk the tree: an outer loop below the threshold goes with everything inside it; a hole
-  // below it is filled, and so covers whatever lies in it.
-  const double min_area = q.Length(1.0) * q.Length(1.0) * options.min_area;
-  std::vector<const cl::PolyNode*> stack;
-  for (const cl::PolyNode* n : tree.Childs) stack.push_back(n);
-  while (!stack.empty()) {
-    const cl::PolyNode* node = stack.back();
-    stack.pop_back();
-    const double area = std::abs(cl::Area(node->Contour));
-    const bool small = area < min_area;
-    if (node->IsHole()) {
-      if (small) {
-        ++region.cleaning.holes_dropped;
-        continue;
-      }
-      Outline hole;
-      for (const cl::IntPoint& p : node->Contour) hole.points.push_back(q.ToPoint(p));
-      if (PolygonSignedArea(hole.points) > 0) std::reverse(hole.points.begin(), hole.points.end());
-      region.outlines.push_back(std::move(hole));
-      for (const cl::PolyNode* child : node->Childs) stack.push_back(child);
-      continue;
-    }
-    if (small) {
-      ++region.cleaning.islands_dropped;
-      continue;  // with its holes and whatever lies in them
-    }
-    Outline outer;
-    for (const cl::IntPoint& p : node->Contour) outer.points.push_back(q.ToPoint(p));
-    if (PolygonSignedArea(outer.points) < 0) std::reverse(outer.points.begin(), outer.points.end());
-    region.outlines.push_back(std::move(outer));
-    for (const cl::PolyNode* child : node->Childs) stack.push_back(child);
-  }
+  CollectOutlines(tree, q, q.Length(1.0) * q.Length(1.0) * options.min_area, &region);
   return region;
 }
 
