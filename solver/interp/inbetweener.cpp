@@ -243,6 +243,9 @@ struct Inbetweener::Impl {
   absl::StatusOr<bool> EnforceNonOverlap(Problem* p, Coords* x, const CancelToken* cancel,
                                          FrameReport* report,
                                          std::vector<OverlapContact> seed = {});
+  absl::Status SetupGaugeGroups(const Multimesh& mesh);
+  void SetupMasses(const Multimesh& mesh);
+  absl::Status FactorMatrices(const Multimesh& mesh);
   absl::StatusOr<Frame> Solve(const ExampleWeights& weights, const Frame& previous,
                               const Frame& before_previous, const CancelToken* cancel,
                               FrameReport* report);
@@ -263,9 +266,15 @@ absl::Status Inbetweener::Impl::Setup(const Multimesh& mesh) {
   if (!coh.ok()) return coh.status();
   cohesive = *std::move(coh);
   overlap.emplace(triangles, mesh.cohesive_edges, n);
+  if (absl::Status s = SetupGaugeGroups(mesh); !s.ok()) return s;
+  SetupMasses(mesh);
+  return FactorMatrices(mesh);
+}
 
-  // Gauge groups: connected by shared triangle vertices or cohesive pairs (union-find, roots =
-  // lowest index).
+// Gauge groups: connected by shared triangle vertices or cohesive pairs (union-find, roots =
+// lowest index); each group's root is pinned, the other vertices are numbered free.
+absl::Status Inbetweener::Impl::SetupGaugeGroups(const Multimesh& mesh) {
+  const int n = mesh.num_vertices();
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&](int v) {
@@ -313,7 +322,14 @@ absl::Status Inbetweener::Impl::Setup(const Multimesh& mesh) {
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
     group_triangles[group[triangles[t][0]]].push_back(t);
   }
+  return absl::OkStatus();
+}
 
+// Lumped vertex masses (a third of each triangle's mean area over the shapes), the mesh's size
+// and mean stiffness, each group's mass and its centroid in every shape.
+void Inbetweener::Impl::SetupMasses(const Multimesh& mesh) {
+  const int n = mesh.num_vertices();
+  const int num_shapes = mesh.num_shapes();
   mass.assign(n, 0.0);
   double total_area = 0.0, kappa_area = 0.0;
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
@@ -335,7 +351,13 @@ absl::Status Inbetweener::Impl::Setup(const Multimesh& mesh) {
     for (int v = 0; v < n; ++v) centroids[i][group[v]] += mass[v] * shapes[i].row(v).transpose();
     for (int g = 0; g < num_groups; ++g) centroids[i][g] /= group_mass[g];
   }
+}
 
+// The factorizations the method solves with: alexa's ARAP matrix of example 0; zhu17's blended
+// ARAP plus cohesive matrix, and with dynamics (epsilon > 0) that matrix plus the largest mass
+// term.
+absl::Status Inbetweener::Impl::FactorMatrices(const Multimesh& mesh) {
+  const int n = mesh.num_vertices();
   if (options.method == InterpMethod::kAlexa) {
     absl::StatusOr<ArapEnergy> e = ArapEnergy::Create(triangles, mesh.shapes[0], options.stiffness);
     if (!e.ok()) return e.status();
