@@ -243,6 +243,19 @@ struct Inbetweener::Impl {
   absl::StatusOr<bool> EnforceNonOverlap(Problem* p, Coords* x, const CancelToken* cancel,
                                          FrameReport* report,
                                          std::vector<OverlapContact> seed = {});
+  // Zhu17's steps. The start: the cold start (Alexa targets) or the previous frame, whichever
+  // has the lower energy (the cold start skipped when sequential playback trusts the warm one).
+  absl::Status StartPoint(const Problem& p, const Frame& previous,
+                          const std::optional<Coords>& prev, Coords* x, Coords* rhs, double* energy,
+                          FrameReport* report);
+  // prevent_overlap: pushes boundary vertices out of the shape, else holds the frame back where
+  // the motion from a clean previous frame first meets an overlap; sets known_validity.
+  absl::Status ResolveOverlaps(Problem* p, const std::optional<Coords>& prev, Coords* x,
+                               const CancelToken* cancel, FrameReport* report);
+  // The dynamics solve (S-eq.28/29) from Phi = x; Phi itself when the dynamics would overlap.
+  absl::StatusOr<Coords> Dynamics(Problem* p, Coords x, const Coords& x1,
+                                  const Frame& before_previous, const CancelToken* cancel,
+                                  FrameReport* report);
   absl::Status SetupGaugeGroups(const Multimesh& mesh);
   void SetupMasses(const Multimesh& mesh);
   absl::Status FactorMatrices(const Multimesh& mesh);
@@ -673,16 +686,10 @@ double Inbetweener::Impl::HoldBack(const Coords& from, Coords* to, Coords* first
   return good;
 }
 
-absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const Frame& previous,
-                                                const Frame& before_previous,
-                                                const CancelToken* cancel, FrameReport* report) {
-  Problem p;
-  p.w = &w;
-  p.group_centroids = BlendedCentroids(w);
-  std::optional<Coords> prev;
-  if (!previous.vertices.empty()) prev = ToCoords(previous.vertices);
-  p.thresholds = cohesive->Thresholds(prev ? &*prev : nullptr);
-
+absl::Status Inbetweener::Impl::StartPoint(const Problem& p, const Frame& previous,
+                                           const std::optional<Coords>& prev, Coords* x,
+                                           Coords* rhs, double* energy, FrameReport* report) {
+  const ExampleWeights& w = *p.w;
   // Sequential playback: `previous` is the frame returned last and the weights moved little, so
   // the warm start is the continuation of the last solve and the cold-start check is skipped.
   bool trusted = false;
@@ -692,8 +699,7 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
     for (size_t i = 0; i < w.size(); ++i) moved += std::abs(w[i] - last_weights[i]);
     trusted = 0.5 * moved <= options.warm_start_trust_radius;
   }
-  Coords x, rhs;
-  double energy = std::numeric_limits<double>::infinity();
+  *energy = std::numeric_limits<double>::infinity();
   // Start (a): the Alexa targets solved with the kZhu17 matrix (cohesive jumps pulled to 0).
   auto cold_start = [&]() -> absl::Status {
     std::vector<Eigen::Matrix2d> targets;
@@ -702,8 +708,8 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
     arap->AddRhs(targets, &b, options.threads);
     absl::StatusOr<Coords> cold = GlobalSolve(solver, true, b, p.group_centroids);
     if (!cold.ok()) return cold.status();
-    x = *std::move(cold);
-    energy = Evaluate(x, p, &rhs, nullptr);
+    *x = *std::move(cold);
+    *energy = Evaluate(*x, p, rhs, nullptr);
     return absl::OkStatus();
   };
   if (!trusted) {
@@ -716,15 +722,96 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
     Translate(p.group_centroids, &warm);
     Coords warm_rhs;
     const double warm_energy = Evaluate(warm, p, &warm_rhs, nullptr);
-    if (warm_energy <= energy) {
-      x = std::move(warm);
-      rhs = std::move(warm_rhs);
-      energy = warm_energy;
+    if (warm_energy <= *energy) {
+      *x = std::move(warm);
+      *rhs = std::move(warm_rhs);
+      *energy = warm_energy;
       report->warm_started = true;
     }
   }
-  if (x.rows() == 0) {  // a trusted warm start that is not finite
+  if (x->rows() == 0) {  // a trusted warm start that is not finite
     if (absl::Status s = cold_start(); !s.ok()) return s;
+  }
+  return absl::OkStatus();
+}
+
+absl::Status Inbetweener::Impl::ResolveOverlaps(Problem* p, const std::optional<Coords>& prev,
+                                                Coords* x, const CancelToken* cancel,
+                                                FrameReport* report) {
+  const Coords unpushed = *x;
+  absl::StatusOr<bool> inside_free = EnforceNonOverlap(p, x, cancel, report);
+  if (!inside_free.ok()) return inside_free.status();
+  Validity checked = Check(*x, *inside_free);
+  if (!checked.clean()) {
+    // The push-out left an overlap (or folded a triangle to make room): the frame stops where
+    // the motion from the previous frame first meets one instead, when that frame is clean.
+    if (checked.inverted > 0 && CountInverted(triangles, unpushed) == 0) {
+      *x = unpushed;
+      checked = Check(*x);
+    }
+    if (prev && Check(*prev).clean()) {
+      Coords first_bad;
+      report->hold_back = 1.0 - HoldBack(*prev, x, &first_bad);
+      checked = Validity{};  // HoldBack's point is clean, and so is a resumed push kept
+      // Continue from the clean frame where the motion met the overlap, with the contacts of
+      // that meeting: the push then starts on the right side of every contact instead of
+      // from deep inside. Kept when it comes out clean.
+      Coords resumed = *x;
+      absl::StatusOr<bool> resumed_free =
+          EnforceNonOverlap(p, &resumed, cancel, report, overlap->Contacts(first_bad));
+      if (!resumed_free.ok()) return resumed_free.status();
+      if (Check(resumed).clean()) {
+        *x = std::move(resumed);
+        report->hold_back = 0.0;
+      }
+    }
+  }
+  known_validity = checked;
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Coords> Inbetweener::Impl::Dynamics(Problem* p, Coords x, const Coords& x1,
+                                                   const Frame& before_previous,
+                                                   const CancelToken* cancel, FrameReport* report) {
+  const ExampleWeights& w = *p->w;
+  const Coords x2 = before_previous.vertices.empty() ? x1 : ToCoords(before_previous.vertices);
+  p->dynamic = true;
+  p->rest.resize(triangles.size());
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
+    p->rest[t] = arap->DeformationGradient(x, t);
+  }
+  std::vector<Eigen::Matrix2d> scratch;
+  const double delta = arap->LocalStepToRest(x1, p->rest, &scratch);
+  p->beta_max = 0.5 * options.epsilon * mean_kappa;
+  p->beta = p->beta_max / (delta + 1.0);
+  report->xi = options.epsilon * options.h * options.h * mean_kappa / (options.rho * (delta + 1.0));
+  p->pred = 2.0 * x1 - x2;
+  Rotate(w, &p->pred);
+  Translate(p->group_centroids, &p->pred);
+  const Coords phi = x;
+  Coords rhs;
+  const double energy = Evaluate(x, *p, &rhs, nullptr);
+  absl::StatusOr<Coords> solved = Iterate(*p, std::move(x), energy, std::move(rhs), cancel, report);
+  if (!solved.ok()) return solved.status();
+  x = *std::move(solved);
+  p->dynamic = false;
+  if (options.prevent_overlap && overlap->Count(x) > 0) return phi;  // keep the valid Phi
+  return x;
+}
+
+absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const Frame& previous,
+                                                const Frame& before_previous,
+                                                const CancelToken* cancel, FrameReport* report) {
+  Problem p;
+  p.w = &w;
+  p.group_centroids = BlendedCentroids(w);
+  std::optional<Coords> prev;
+  if (!previous.vertices.empty()) prev = ToCoords(previous.vertices);
+  p.thresholds = cohesive->Thresholds(prev ? &*prev : nullptr);
+  Coords x, rhs;
+  double energy = 0.0;
+  if (absl::Status s = StartPoint(p, previous, prev, &x, &rhs, &energy, report); !s.ok()) {
+    return s;
   }
   absl::StatusOr<Coords> solved = Iterate(p, std::move(x), energy, std::move(rhs), cancel, report);
   if (!solved.ok()) return solved.status();
@@ -732,63 +819,12 @@ absl::StatusOr<Coords> Inbetweener::Impl::Zhu17(const ExampleWeights& w, const F
   Rotate(w, &x);
   Translate(p.group_centroids, &x);
   if (options.prevent_overlap) {
-    const Coords unpushed = x;
-    absl::StatusOr<bool> inside_free = EnforceNonOverlap(&p, &x, cancel, report);
-    if (!inside_free.ok()) return inside_free.status();
-    Validity checked = Check(x, *inside_free);
-    if (!checked.clean()) {
-      // The push-out left an overlap (or folded a triangle to make room): the frame stops where
-      // the motion from the previous frame first meets one instead, when that frame is clean.
-      if (checked.inverted > 0 && CountInverted(triangles, unpushed) == 0) {
-        x = unpushed;
-        checked = Check(x);
-      }
-      if (prev && Check(*prev).clean()) {
-        Coords first_bad;
-        report->hold_back = 1.0 - HoldBack(*prev, &x, &first_bad);
-        checked = Validity{};  // HoldBack's point is clean, and so is a resumed push kept
-        // Continue from the clean frame where the motion met the overlap, with the contacts of
-        // that meeting: the push then starts on the right side of every contact instead of
-        // from deep inside. Kept when it comes out clean.
-        Coords resumed = x;
-        absl::StatusOr<bool> resumed_free =
-            EnforceNonOverlap(&p, &resumed, cancel, report, overlap->Contacts(first_bad));
-        if (!resumed_free.ok()) return resumed_free.status();
-        if (Check(resumed).clean()) {
-          x = std::move(resumed);
-          report->hold_back = 0.0;
-        }
-      }
-    }
-    known_validity = checked;
+    if (absl::Status s = ResolveOverlaps(&p, prev, &x, cancel, report); !s.ok()) return s;
   }
   if (options.epsilon <= 0.0 || !prev) return x;
   known_validity.reset();
-
   // Dynamics (S-eq.28/29): x is Phi.
-  const Coords& x1 = *prev;
-  const Coords x2 = before_previous.vertices.empty() ? x1 : ToCoords(before_previous.vertices);
-  p.dynamic = true;
-  p.rest.resize(triangles.size());
-  for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
-    p.rest[t] = arap->DeformationGradient(x, t);
-  }
-  std::vector<Eigen::Matrix2d> scratch;
-  const double delta = arap->LocalStepToRest(x1, p.rest, &scratch);
-  p.beta_max = 0.5 * options.epsilon * mean_kappa;
-  p.beta = p.beta_max / (delta + 1.0);
-  report->xi = options.epsilon * options.h * options.h * mean_kappa / (options.rho * (delta + 1.0));
-  p.pred = 2.0 * x1 - x2;
-  Rotate(w, &p.pred);
-  Translate(p.group_centroids, &p.pred);
-  const Coords phi = x;
-  energy = Evaluate(x, p, &rhs, nullptr);
-  solved = Iterate(p, std::move(x), energy, std::move(rhs), cancel, report);
-  if (!solved.ok()) return solved.status();
-  x = *std::move(solved);
-  p.dynamic = false;
-  if (options.prevent_overlap && overlap->Count(x) > 0) return phi;  // keep the valid Phi
-  return x;
+  return Dynamics(&p, std::move(x), *prev, before_previous, cancel, report);
 }
 
 absl::StatusOr<Frame> Inbetweener::Impl::Solve(const ExampleWeights& weights, const Frame& previous,
