@@ -204,6 +204,126 @@ std::vector<Segment> LoopSegments(const BoundaryGraph& g) {
   return out;
 }
 
+// Splits drawing d (its graph `*g`) at its narrowest necks, largest piece first, until it has
+// `num_components` pieces; the cuts and notes go to `result`. `most` is the drawing with the most
+// pieces (named in the error when no straight cut splits a piece).
+absl::Status SplitToComponents(size_t d, const Drawing& drawing, int num_components, size_t most,
+                               const BoundaryGraph& most_graph, const AutoTopologyOptions& options,
+                               BoundaryGraph* g, AutoTopologyResult* result) {
+  Drawing edited = drawing;
+  while (g->equivalence.components < num_components) {
+    const Components comps = ComponentsOf(*g);
+    int largest = -1;
+    double largest_area = 0;
+    for (int c = 0; c < g->equivalence.components; ++c) {
+      if (comps.outer_loop[c] < 0) continue;
+      const double area = PolygonSignedArea(g->loops[comps.outer_loop[c]].points);
+      if (largest < 0 || area > largest_area) largest = c, largest_area = area;
+    }
+    std::vector<const Points*> holes;
+    std::optional<Segment> cut;
+    if (largest >= 0) {
+      for (int h : comps.hole_loops[largest]) holes.push_back(&g->loops[h].points);
+      cut = SplitCut(*g, comps.outer_loop[largest], holes, LoopSegments(*g), options.min_split_part,
+                     options);
+    }
+    if (!cut) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "auto-topology: drawing ", d + 1, " has ", g->equivalence.ToString(), ", drawing ",
+          most + 1, " has ", most_graph.equivalence.ToString(),
+          "; no straight cut splits a piece of drawing ", d + 1,
+          " into two parts: draw a cut (a polyline across it) in its \"cuts\" in the project "
+          "file"));
+    }
+    Points drawn = CrossOutline(*cut, g->loops[comps.outer_loop[largest]].points);
+    edited.cuts.push_back(drawn);
+    result->cuts[d].push_back(std::move(drawn));
+    result->notes.push_back(absl::StrFormat(
+        "drawing %d: cut across the piece from (%.6g, %.6g) to (%.6g, %.6g), length %.6g", d + 1,
+        cut->a.x(), cut->a.y(), cut->b.x(), cut->b.y(), (cut->b - cut->a).norm()));
+    const int before = g->equivalence.components;
+    absl::StatusOr<BoundaryGraph> rebuilt = BuildBoundaries(edited, static_cast<int>(d) + 1);
+    if (!rebuilt.ok() || rebuilt->equivalence.components <= before) {
+      return absl::InternalError(absl::StrCat(
+          "auto-topology: the cut proposed to split drawing ", d + 1, " does not split it (",
+          rebuilt.ok() ? rebuilt->equivalence.ToString() : rebuilt.status().message(), ")"));
+    }
+    *g = *std::move(rebuilt);
+  }
+  return absl::OkStatus();
+}
+
+// The class every drawing can reach by cutting holes open: the split drawings' components, per
+// component rank as many holes as the drawing with fewest there.
+EquivalenceClass TargetClass(const std::vector<BoundaryGraph>& graphs, size_t most,
+                             int num_components) {
+  EquivalenceClass target = graphs[most].equivalence;
+  for (int k = 0; k < num_components; ++k) {
+    for (const BoundaryGraph& g : graphs) {
+      target.holes_per_component[k] =
+          std::min(target.holes_per_component[k], g.equivalence.holes_per_component[k]);
+    }
+  }
+  target.holes =
+      std::accumulate(target.holes_per_component.begin(), target.holes_per_component.end(), 0);
+  return target;
+}
+
+// Cuts drawing d's extra holes open (the smallest first, per component rank) to reach
+// result->target, then checks the proposal the way the multimesh builder will read it.
+absl::Status OpenExtraHoles(size_t d, const Drawing& drawing, const BoundaryGraph& g,
+                            int num_components, const AutoTopologyOptions& options,
+                            AutoTopologyResult* result) {
+  const Components comps = ComponentsOf(g);
+  std::vector<Segment> obstacles = LoopSegments(g);
+  for (int k = 0; k < num_components; ++k) {
+    const int c = comps.by_rank[k];
+    std::vector<int> holes = comps.hole_loops[c];
+    const int extra = static_cast<int>(holes.size()) - result->target.holes_per_component[k];
+    if (extra <= 0) continue;
+    // The smallest holes are the ones the other drawings lack most likely (a hole that opens).
+    std::stable_sort(holes.begin(), holes.end(), [&](int a, int b) {
+      return std::abs(PolygonSignedArea(g.loops[a].points)) <
+             std::abs(PolygonSignedArea(g.loops[b].points));
+    });
+    std::vector<const Points*> hole_points;
+    for (int h : comps.hole_loops[c]) hole_points.push_back(&g.loops[h].points);
+    const Points& outer = g.loops[comps.outer_loop[c]].points;
+    for (int i = 0; i < extra; ++i) {
+      const Points& hole = g.loops[holes[i]].points;
+      std::optional<Segment> cut = ShortestCut(hole, outer, obstacles, hole_points, options);
+      if (!cut) {
+        const Point at = hole[0];
+        return absl::FailedPreconditionError(absl::StrFormat(
+            "auto-topology: drawing %d: no straight cut from the hole at (%.6g, %.6g) to the "
+            "outline stays inside the shape; draw one (a polyline) in the project file's "
+            "\"cuts\" of drawing %d",
+            d + 1, at.x(), at.y(), d + 1));
+      }
+      obstacles.push_back(*cut);
+      result->cuts[d].push_back(CrossBothEnds(*cut, hole, outer));
+      result->notes.push_back(absl::StrFormat(
+          "drawing %d: cut from the hole at (%.6g, %.6g) to the outline at (%.6g, %.6g), "
+          "length %.6g",
+          d + 1, cut->a.x(), cut->a.y(), cut->b.x(), cut->b.y(), (cut->b - cut->a).norm()));
+    }
+  }
+  Drawing edited = drawing;
+  for (const Points& cut : result->cuts[d]) edited.cuts.push_back(cut);
+  absl::StatusOr<BoundaryGraph> rebuilt = BuildBoundaries(edited, static_cast<int>(d) + 1);
+  if (!rebuilt.ok()) {
+    return absl::InternalError(absl::StrCat("auto-topology: the proposed cuts of drawing ", d + 1,
+                                            " do not apply: ", rebuilt.status().message()));
+  }
+  if (!(rebuilt->equivalence == result->target)) {
+    return absl::InternalError(
+        absl::StrCat("auto-topology: drawing ", d + 1, " has ", rebuilt->equivalence.ToString(),
+                     " after the proposed cuts, expected ", result->target.ToString(), " (",
+                     absl::StrJoin(result->notes, "; "), ")"));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::StatusOr<AutoTopologyResult> ProposeTopology(const std::vector<Drawing>& drawings,
@@ -227,109 +347,21 @@ absl::StatusOr<AutoTopologyResult> ProposeTopology(const std::vector<Drawing>& d
     }
   }
   for (size_t d = 0; d < graphs.size(); ++d) {
-    Drawing edited = drawings[d];
-    while (graphs[d].equivalence.components < num_components) {
-      const Components comps = ComponentsOf(graphs[d]);
-      int largest = -1;
-      double largest_area = 0;
-      for (int c = 0; c < graphs[d].equivalence.components; ++c) {
-        if (comps.outer_loop[c] < 0) continue;
-        const double area = PolygonSignedArea(graphs[d].loops[comps.outer_loop[c]].points);
-        if (largest < 0 || area > largest_area) largest = c, largest_area = area;
-      }
-      std::vector<const Points*> holes;
-      std::optional<Segment> cut;
-      if (largest >= 0) {
-        for (int h : comps.hole_loops[largest]) holes.push_back(&graphs[d].loops[h].points);
-        cut = SplitCut(graphs[d], comps.outer_loop[largest], holes, LoopSegments(graphs[d]),
-                       options.min_split_part, options);
-      }
-      if (!cut) {
-        return absl::FailedPreconditionError(absl::StrCat(
-            "auto-topology: drawing ", d + 1, " has ", graphs[d].equivalence.ToString(),
-            ", drawing ", most + 1, " has ", graphs[most].equivalence.ToString(),
-            "; no straight cut splits a piece of drawing ", d + 1,
-            " into two parts: draw a cut (a polyline across it) in its \"cuts\" in the project "
-            "file"));
-      }
-      Points drawn = CrossOutline(*cut, graphs[d].loops[comps.outer_loop[largest]].points);
-      edited.cuts.push_back(drawn);
-      result.cuts[d].push_back(std::move(drawn));
-      result.notes.push_back(absl::StrFormat(
-          "drawing %d: cut across the piece from (%.6g, %.6g) to (%.6g, %.6g), length %.6g", d + 1,
-          cut->a.x(), cut->a.y(), cut->b.x(), cut->b.y(), (cut->b - cut->a).norm()));
-      const int before = graphs[d].equivalence.components;
-      absl::StatusOr<BoundaryGraph> rebuilt = BuildBoundaries(edited, static_cast<int>(d) + 1);
-      if (!rebuilt.ok() || rebuilt->equivalence.components <= before) {
-        return absl::InternalError(absl::StrCat(
-            "auto-topology: the cut proposed to split drawing ", d + 1, " does not split it (",
-            rebuilt.ok() ? rebuilt->equivalence.ToString() : rebuilt.status().message(), ")"));
-      }
-      graphs[d] = *std::move(rebuilt);
+    if (absl::Status s = SplitToComponents(d, drawings[d], num_components, most, graphs[most],
+                                           options, &graphs[d], &result);
+        !s.ok()) {
+      return s;
     }
   }
 
   // 2. Holes, per component rank.
-  result.target = graphs[most].equivalence;
-  for (int k = 0; k < num_components; ++k) {
-    for (const BoundaryGraph& g : graphs) {
-      result.target.holes_per_component[k] =
-          std::min(result.target.holes_per_component[k], g.equivalence.holes_per_component[k]);
-    }
-  }
-  result.target.holes = std::accumulate(result.target.holes_per_component.begin(),
-                                        result.target.holes_per_component.end(), 0);
-
+  result.target = TargetClass(graphs, most, num_components);
   for (size_t d = 0; d < graphs.size(); ++d) {
-    const BoundaryGraph& g = graphs[d];
-    if (g.equivalence == result.target) continue;
-    const Components comps = ComponentsOf(g);
-    std::vector<Segment> obstacles = LoopSegments(g);
-    for (int k = 0; k < num_components; ++k) {
-      const int c = comps.by_rank[k];
-      std::vector<int> holes = comps.hole_loops[c];
-      const int extra = static_cast<int>(holes.size()) - result.target.holes_per_component[k];
-      if (extra <= 0) continue;
-      // The smallest holes are the ones the other drawings lack most likely (a hole that opens).
-      std::stable_sort(holes.begin(), holes.end(), [&](int a, int b) {
-        return std::abs(PolygonSignedArea(g.loops[a].points)) <
-               std::abs(PolygonSignedArea(g.loops[b].points));
-      });
-      std::vector<const Points*> hole_points;
-      for (int h : comps.hole_loops[c]) hole_points.push_back(&g.loops[h].points);
-      const Points& outer = g.loops[comps.outer_loop[c]].points;
-      for (int i = 0; i < extra; ++i) {
-        const Points& hole = g.loops[holes[i]].points;
-        std::optional<Segment> cut = ShortestCut(hole, outer, obstacles, hole_points, options);
-        if (!cut) {
-          const Point at = hole[0];
-          return absl::FailedPreconditionError(absl::StrFormat(
-              "auto-topology: drawing %d: no straight cut from the hole at (%.6g, %.6g) to the "
-              "outline stays inside the shape; draw one (a polyline) in the project file's "
-              "\"cuts\" of drawing %d",
-              d + 1, at.x(), at.y(), d + 1));
-        }
-        obstacles.push_back(*cut);
-        result.cuts[d].push_back(CrossBothEnds(*cut, hole, outer));
-        result.notes.push_back(absl::StrFormat(
-            "drawing %d: cut from the hole at (%.6g, %.6g) to the outline at (%.6g, %.6g), "
-            "length %.6g",
-            d + 1, cut->a.x(), cut->a.y(), cut->b.x(), cut->b.y(), (cut->b - cut->a).norm()));
-      }
-    }
-    // Check the proposal the way the multimesh builder will read it.
-    Drawing edited = drawings[d];
-    for (const Points& cut : result.cuts[d]) edited.cuts.push_back(cut);
-    absl::StatusOr<BoundaryGraph> rebuilt = BuildBoundaries(edited, static_cast<int>(d) + 1);
-    if (!rebuilt.ok()) {
-      return absl::InternalError(absl::StrCat("auto-topology: the proposed cuts of drawing ", d + 1,
-                                              " do not apply: ", rebuilt.status().message()));
-    }
-    if (!(rebuilt->equivalence == result.target)) {
-      return absl::InternalError(
-          absl::StrCat("auto-topology: drawing ", d + 1, " has ", rebuilt->equivalence.ToString(),
-                       " after the proposed cuts, expected ", result.target.ToString(), " (",
-                       absl::StrJoin(result.notes, "; "), ")"));
+    if (graphs[d].equivalence == result.target) continue;
+    if (absl::Status s =
+            OpenExtraHoles(d, drawings[d], graphs[d], num_components, options, &result);
+        !s.ok()) {
+      return s;
     }
   }
   return result;
