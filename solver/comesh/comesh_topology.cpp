@@ -322,55 +322,20 @@ class Editor {
   // every shape where b is not straight (CoincidentAlong): a slider that slid onto its neighbour.
   bool TryCollapse(int a, int b, bool by_quality = false) {
     if (removed_[a] || removed_[b] || locked_[a] || locked_[b]) return false;
-    const bool coincident = by_quality && !MergeableAlong(a, b) && CoincidentAlong(a, b);
-    const bool along_boundary = coincident || MergeableAlong(a, b);
-    if (protected_[b] && !along_boundary) return false;
-    int t1 = -1, t2 = -1;
-    const int on_edge = EdgeTriangleCount(a, b, &t1, &t2);
-    if (on_edge != (along_boundary ? 1 : 2)) return false;
-    // Link condition: the common neighbours of a and b are exactly the opposite vertices.
-    const std::vector<int> na = Neighbours(a), nb = Neighbours(b);
-    std::vector<int> common;
-    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
-    if (static_cast<int>(common.size()) != on_edge) return false;
-    // Affected triangles: the one-rings of a and b (those on edge ab disappear).
-    std::vector<int> affected = incident_[a];
-    for (int t : incident_[b]) {
-      if (t != t1 && t != t2) affected.push_back(t);
-    }
-    std::vector<Triangle> old_tris, new_tris;
-    for (int t : affected) {
-      old_tris.push_back(triangles_[t]);
-      if (t == t1 || t == t2) continue;
-      Triangle tri = triangles_[t];
-      for (int k = 0; k < 3; ++k) {
-        if (tri[k] == b) tri[k] = a;
-      }
-      new_tris.push_back(tri);
-    }
+    Collapse c;
+    c.coincident = by_quality && !MergeableAlong(a, b) && CoincidentAlong(a, b);
+    c.along_boundary = c.coincident || MergeableAlong(a, b);
+    if (protected_[b] && !c.along_boundary) return false;
+    if (!CollapseLinks(a, b, &c)) return false;
     double odt_old, mips_old;
-    Terms(old_tris, &odt_old, &mips_old);
+    Terms(c.old_tris, &odt_old, &mips_old);
     const double before = Objective();
-    // Candidate places for the merged vertex: a's own, or (a free) the midpoint, in every shape.
     const int num_shapes = static_cast<int>(shapes_.size());
-    std::vector<Point> original(num_shapes), saved(num_shapes);
-    for (int s = 0; s < num_shapes; ++s) {
-      original[s] = saved[s] = shapes_[s][a];
-      // Along the boundary, a shape where b is a corner keeps b's place (see above). A
-      // coincident pair keeps a fixed a's place, else the place that is an anchor (an input
-      // boundary point: a corner that never moved, not the slider that slid onto it), else the
-      // place of the one whose removal changes the shape's boundary polygon more.
-      if (along_boundary && !(straight_[b] >> s & 1)) {
-        bool keep_b = true;
-        if (coincident) {
-          const bool anchor_a = Anchor(s, a), anchor_b = Anchor(s, b);
-          keep_b =
-              !fixed_[a] && (anchor_a != anchor_b ? anchor_b : DropArea2(s, a) < DropArea2(s, b));
-        }
-        if (keep_b) saved[s] = shapes_[s][b];
-      }
-    }
-    // Minimized: the objective, or (by_quality) minus the worst quality.
+    std::vector<Point> original(num_shapes);
+    for (int s = 0; s < num_shapes; ++s) original[s] = shapes_[s][a];
+    const std::vector<Point> saved = MergedPlaces(a, b, c);
+    // Minimized: the objective, or (by_quality) minus the worst quality. Candidate places for
+    // the merged vertex: `saved`, or (a free) its midpoint with b, in every shape.
     double best = std::numeric_limits<double>::infinity();
     int best_place = -1;
     double best_odt = 0.0, best_mips = 0.0;
@@ -379,12 +344,12 @@ class Editor {
         shapes_[s][a] = place == 0 ? saved[s] : Point(0.5 * (saved[s] + shapes_[s][b]));
       }
       bool ok = true;
-      for (const Triangle& tri : new_tris) ok = ok && Positive(tri);
+      for (const Triangle& tri : c.new_tris) ok = ok && Positive(tri);
       if (ok) {
         double odt_new, mips_new;
-        Terms(new_tris, &odt_new, &mips_new);
-        const double after = by_quality ? -WorstQuality(new_tris)
-                                        : Objective(t_ - on_edge, odt_sum_ - odt_old + odt_new,
+        Terms(c.new_tris, &odt_new, &mips_new);
+        const double after = by_quality ? -WorstQuality(c.new_tris)
+                                        : Objective(t_ - c.on_edge, odt_sum_ - odt_old + odt_new,
                                                     mips_sum_ - mips_old + mips_new);
         if (after < best) {
           best = after;
@@ -397,14 +362,82 @@ class Editor {
     for (int s = 0; s < num_shapes; ++s) {
       shapes_[s][a] = best_place == 1 ? Point(0.5 * (saved[s] + shapes_[s][b])) : saved[s];
     }
-    const double limit = by_quality ? -WorstQuality(old_tris) : before;
+    const double limit = by_quality ? -WorstQuality(c.old_tris) : before;
     if (best_place < 0 || (by_quality ? !(best < limit) : !(best <= limit))) {
       for (int s = 0; s < num_shapes; ++s) shapes_[s][a] = original[s];
       return false;
     }
-    // Apply.
-    Kill(t1);
-    if (on_edge == 2) Kill(t2);
+    ApplyCollapse(a, b, c);
+    odt_sum_ += best_odt;
+    mips_sum_ += best_mips;
+    return true;
+  }
+
+  // What a collapse of b into a changes, once its links allow it.
+  struct Collapse {
+    bool coincident = false;            // b slid onto its boundary neighbour a (CoincidentAlong)
+    bool along_boundary = false;        // ab is a boundary edge (or coincident)
+    int on_edge = 0, t1 = -1, t2 = -1;  // the triangles on edge ab (1 along the boundary)
+    std::vector<int> na, nb;            // the neighbours of a and b
+    std::vector<Triangle> old_tris, new_tris;  // the one-rings before and after
+  };
+
+  // Whether b may merge into a by the edge and link conditions (the common neighbours of a and b
+  // are exactly the opposite vertices); fills c's triangles and neighbours.
+  bool CollapseLinks(int a, int b, Collapse* c) const {
+    c->on_edge = EdgeTriangleCount(a, b, &c->t1, &c->t2);
+    if (c->on_edge != (c->along_boundary ? 1 : 2)) return false;
+    c->na = Neighbours(a);
+    c->nb = Neighbours(b);
+    std::vector<int> common;
+    std::set_intersection(c->na.begin(), c->na.end(), c->nb.begin(), c->nb.end(),
+                          std::back_inserter(common));
+    if (static_cast<int>(common.size()) != c->on_edge) return false;
+    // Affected triangles: the one-rings of a and b (those on edge ab disappear).
+    std::vector<int> affected = incident_[a];
+    for (int t : incident_[b]) {
+      if (t != c->t1 && t != c->t2) affected.push_back(t);
+    }
+    for (int t : affected) {
+      c->old_tris.push_back(triangles_[t]);
+      if (t == c->t1 || t == c->t2) continue;
+      Triangle tri = triangles_[t];
+      for (int k = 0; k < 3; ++k) {
+        if (tri[k] == b) tri[k] = a;
+      }
+      c->new_tris.push_back(tri);
+    }
+    return true;
+  }
+
+  // The merged vertex's place in each shape before the midpoint is tried: a's own, except along
+  // the boundary where b is a corner, which keeps b's place. A coincident pair keeps a fixed a's
+  // place, else the place that is an anchor (an input boundary point: a corner that never
+  // moved, not the slider that slid onto it), else the place of the one whose removal changes
+  // the shape's boundary polygon more.
+  std::vector<Point> MergedPlaces(int a, int b, const Collapse& c) const {
+    const int num_shapes = static_cast<int>(shapes_.size());
+    std::vector<Point> saved(num_shapes);
+    for (int s = 0; s < num_shapes; ++s) {
+      saved[s] = shapes_[s][a];
+      if (c.along_boundary && !(straight_[b] >> s & 1)) {
+        bool keep_b = true;
+        if (c.coincident) {
+          const bool anchor_a = Anchor(s, a), anchor_b = Anchor(s, b);
+          keep_b =
+              !fixed_[a] && (anchor_a != anchor_b ? anchor_b : DropArea2(s, a) < DropArea2(s, b));
+        }
+        if (keep_b) saved[s] = shapes_[s][b];
+      }
+    }
+    return saved;
+  }
+
+  // Removes b (a at its chosen place): the triangles on ab die, b's others take a, the boundary
+  // neighbours and straightness follow, and a, b and their neighbours are locked for the pass.
+  void ApplyCollapse(int a, int b, const Collapse& c) {
+    Kill(c.t1);
+    if (c.on_edge == 2) Kill(c.t2);
     const std::vector<int> moved = incident_[b];
     for (int t : moved) {
       Triangle tri = triangles_[t];
@@ -417,11 +450,11 @@ class Editor {
       for (int v : triangles_[t]) MarkDirty(v);
     }
     removed_[b] = 1;
-    t_ -= on_edge;
-    corner_swaps_ += along_boundary && !coincident && straight_[b] != all_straight_;
-    if (along_boundary) {  // a and b's other boundary neighbour c become neighbours
-      const int c = boundary_nbrs_[b][0] == a ? boundary_nbrs_[b][1] : boundary_nbrs_[b][0];
-      for (auto [v, old_nbr, new_nbr] : {std::tuple(a, b, c), std::tuple(c, b, a)}) {
+    t_ -= c.on_edge;
+    corner_swaps_ += c.along_boundary && !c.coincident && straight_[b] != all_straight_;
+    if (c.along_boundary) {  // a and b's other boundary neighbour n become neighbours
+      const int n = boundary_nbrs_[b][0] == a ? boundary_nbrs_[b][1] : boundary_nbrs_[b][0];
+      for (auto [v, old_nbr, new_nbr] : {std::tuple(a, b, n), std::tuple(n, b, a)}) {
         std::array<int, 2>& nbrs = boundary_nbrs_[v];
         (nbrs[0] == old_nbr ? nbrs[0] : nbrs[1]) = new_nbr;
         // As b lay on the straight line of its neighbours (or a took its place), only a
@@ -432,12 +465,9 @@ class Editor {
       straight_[a] &= straight_[b];
       straight_[b] = 0;
     }
-    odt_sum_ += best_odt;
-    mips_sum_ += best_mips;
     locked_[a] = locked_[b] = 1;
-    for (int v : na) locked_[v] = 1;
-    for (int v : nb) locked_[v] = 1;
-    return true;
+    for (int v : c.na) locked_[v] = 1;
+    for (int v : c.nb) locked_[v] = 1;
   }
 
   // Inserts a new vertex at the midpoint of edge (a, b) in every shape: an interior edge, or a
