@@ -273,6 +273,115 @@ void SparseCholesky::Impl::Extract() {
   }
 }
 
+namespace {
+
+// Columns of a supernode handled side by side (kGroup at a time); every entry of y and of the
+// scratch still sees its operations in the same order as one column at a time, so the result is
+// bit-identical to that.
+constexpr int kGroup = 4;
+
+// One supernode of a supernodal factor: its first column k1, nscol columns, nsrow rows (the
+// diagonal block's nscol, then nbelow rows listed in `rows`), values column-major in `block`.
+template <typename T>
+struct Supernode {
+  int k1, nscol, nsrow, nbelow;
+  const int* rows;
+  const T* block;
+};
+
+// L z = y on one supernode: the diagonal block in place, then the rows below through `below`
+// (`columns` right-hand sides interleaved), gathered once and scattered into y.
+template <int kColumns, typename T>
+void ForwardSupernode(const Supernode<T>& sn, double* y, int columns, double* below) {
+  const int c = kColumns > 0 ? kColumns : columns;  // a constant where the caller's is
+  const int nscol = sn.nscol, nsrow = sn.nsrow, nbelow = sn.nbelow;
+  double* ys = y + static_cast<size_t>(sn.k1) * c;
+  std::fill(below, below + static_cast<size_t>(nbelow) * c, 0.0);
+  for (int j0 = 0; j0 < nscol; j0 += kGroup) {
+    const int group = std::min(kGroup, nscol - j0);
+    for (int j = j0; j < j0 + group; ++j) {
+      const T* col = sn.block + static_cast<size_t>(j) * nsrow;
+      double* yj = ys + static_cast<size_t>(j) * c;
+      const double inv = 1.0 / col[j];
+      for (int q = 0; q < c; ++q) yj[q] *= inv;
+      for (int i = j + 1; i < nscol; ++i) {
+        for (int q = 0; q < c; ++q) ys[static_cast<size_t>(i) * c + q] -= col[i] * yj[q];
+      }
+    }
+    // below += lower_j * y_j for the group's columns in column order, one pass over `below`.
+    const T* lower = sn.block + static_cast<size_t>(j0) * nsrow + nscol;
+    const double* yg = ys + static_cast<size_t>(j0) * c;
+    if (group == kGroup) {
+      for (int r = 0; r < nbelow; ++r) {
+        for (int q = 0; q < c; ++q) {
+          double acc = below[static_cast<size_t>(r) * c + q];
+          for (int g = 0; g < kGroup; ++g) acc += lower[r + g * nsrow] * yg[g * c + q];
+          below[static_cast<size_t>(r) * c + q] = acc;
+        }
+      }
+      continue;
+    }
+    for (int g = 0; g < group; ++g) {
+      for (int r = 0; r < nbelow; ++r) {
+        for (int q = 0; q < c; ++q) {
+          below[static_cast<size_t>(r) * c + q] += lower[r + g * nsrow] * yg[g * c + q];
+        }
+      }
+    }
+  }
+  for (int r = 0; r < nbelow; ++r) {
+    double* yr = y + static_cast<size_t>(sn.rows[r]) * c;
+    for (int q = 0; q < c; ++q) yr[q] -= below[static_cast<size_t>(r) * c + q];
+  }
+}
+
+// L^T x = z on one supernode: the rows below gathered into `below`, then the diagonal block from
+// its last column back, each column's dot product with `below` first.
+template <int kColumns, typename T>
+void BackwardSupernode(const Supernode<T>& sn, double* y, int columns, double* below) {
+  const int c = kColumns > 0 ? kColumns : columns;  // a constant where the caller's is
+  const int nscol = sn.nscol, nsrow = sn.nsrow, nbelow = sn.nbelow;
+  double* ys = y + static_cast<size_t>(sn.k1) * c;
+  for (int r = 0; r < nbelow; ++r) {
+    const double* yr = y + static_cast<size_t>(sn.rows[r]) * c;
+    for (int q = 0; q < c; ++q) below[static_cast<size_t>(r) * c + q] = yr[q];
+  }
+  for (int j1 = nscol; j1 > 0; j1 -= kGroup) {
+    const int group = std::min(kGroup, j1), j0 = j1 - group;
+    const T* lower = sn.block + static_cast<size_t>(j0) * nsrow + nscol;
+    const size_t stride = static_cast<size_t>(nsrow);
+    for (int q = 0; q < c; ++q) {  // right-hand sides are independent
+      // Each column's dot product with `below` (one sum per column, in row order), the
+      // group's columns side by side: independent sums, one pass over `below`.
+      double sums[kGroup] = {0.0, 0.0, 0.0, 0.0};
+      if (group == kGroup) {
+        for (int r = 0; r < nbelow; ++r) {
+          const double b = below[static_cast<size_t>(r) * c + q];
+          sums[0] += lower[r] * b;
+          sums[1] += lower[r + stride] * b;
+          sums[2] += lower[r + 2 * stride] * b;
+          sums[3] += lower[r + 3 * stride] * b;
+        }
+      } else {
+        for (int g = 0; g < group; ++g) {
+          for (int r = 0; r < nbelow; ++r) {
+            sums[g] += lower[r + g * stride] * below[static_cast<size_t>(r) * c + q];
+          }
+        }
+      }
+      for (int j = j1 - 1; j >= j0; --j) {
+        const T* col = sn.block + static_cast<size_t>(j) * nsrow;
+        double sum = sums[j - j0];
+        for (int i = j + 1; i < nscol; ++i) sum += col[i] * ys[static_cast<size_t>(i) * c + q];
+        double& yj = ys[static_cast<size_t>(j) * c + q];
+        yj = (yj - sum) / col[j];
+      }
+    }
+  }
+}
+
+}  // namespace
+
 // The supernodal twin of Substitute (L L^T, no D): per supernode, the dense diagonal block in
 // place, and the rows below it through a dense scratch (gathered or scattered once per supernode,
 // so the inner loops run over contiguous memory); no BLAS, so solves on several threads never
@@ -282,10 +391,6 @@ template <int kColumns, typename T>
 bool SparseCholesky::Impl::SubstituteSupernodal(const T* values, double* y, int columns,
                                                 double* below, const CancelToken* cancel) const {
   const int c = kColumns > 0 ? kColumns : columns;
-  // Columns of a supernode handled side by side (kGroup at a time); every entry of y and of
-  // `below` still sees its operations in the same order as one column at a time, so the result
-  // is bit-identical to that.
-  constexpr int kGroup = 4;
   constexpr size_t kSolvePollEntries = size_t{1} << 18;  // ~2 MB of L: about a millisecond
   // Polled every kSolveCancelStride supernodes and, in between, whenever kSolvePollEntries of
   // L's entries were read since the last poll (the supernodes near the root are large).
@@ -296,94 +401,20 @@ bool SparseCholesky::Impl::SubstituteSupernodal(const T* values, double* y, int 
     entries = 0;
     return Cancelled(cancel);
   };
-  for (int s = 0; s < nsuper; ++s) {  // L z = y
+  auto supernode = [&](int s) {
     const int k1 = super[s], nscol = super[s + 1] - k1;
-    const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
-    if (poll(s, nsrow, nscol)) return false;
-    const int* rows = s_i + s_pi[s] + nscol;
-    const T* block = values + s_px[s];
-    double* ys = y + static_cast<size_t>(k1) * c;
-    std::fill(below, below + static_cast<size_t>(nbelow) * c, 0.0);
-    for (int j0 = 0; j0 < nscol; j0 += kGroup) {
-      const int group = std::min(kGroup, nscol - j0);
-      for (int j = j0; j < j0 + group; ++j) {
-        const T* col = block + static_cast<size_t>(j) * nsrow;
-        double* yj = ys + static_cast<size_t>(j) * c;
-        const double inv = 1.0 / col[j];
-        for (int q = 0; q < c; ++q) yj[q] *= inv;
-        for (int i = j + 1; i < nscol; ++i) {
-          for (int q = 0; q < c; ++q) ys[static_cast<size_t>(i) * c + q] -= col[i] * yj[q];
-        }
-      }
-      // below += lower_j * y_j for the group's columns in column order, one pass over `below`.
-      const T* lower = block + static_cast<size_t>(j0) * nsrow + nscol;
-      const double* yg = ys + static_cast<size_t>(j0) * c;
-      if (group == kGroup) {
-        for (int r = 0; r < nbelow; ++r) {
-          for (int q = 0; q < c; ++q) {
-            double acc = below[static_cast<size_t>(r) * c + q];
-            for (int g = 0; g < kGroup; ++g) acc += lower[r + g * nsrow] * yg[g * c + q];
-            below[static_cast<size_t>(r) * c + q] = acc;
-          }
-        }
-        continue;
-      }
-      for (int g = 0; g < group; ++g) {
-        for (int r = 0; r < nbelow; ++r) {
-          for (int q = 0; q < c; ++q) {
-            below[static_cast<size_t>(r) * c + q] += lower[r + g * nsrow] * yg[g * c + q];
-          }
-        }
-      }
-    }
-    for (int r = 0; r < nbelow; ++r) {
-      double* yr = y + static_cast<size_t>(rows[r]) * c;
-      for (int q = 0; q < c; ++q) yr[q] -= below[static_cast<size_t>(r) * c + q];
-    }
+    const int nsrow = s_pi[s + 1] - s_pi[s];
+    return Supernode<T>{k1, nscol, nsrow, nsrow - nscol, s_i + s_pi[s] + nscol, values + s_px[s]};
+  };
+  for (int s = 0; s < nsuper; ++s) {  // L z = y
+    const Supernode<T> sn = supernode(s);
+    if (poll(s, sn.nsrow, sn.nscol)) return false;
+    ForwardSupernode<kColumns>(sn, y, c, below);
   }
   for (int s = nsuper - 1; s >= 0; --s) {  // L^T x = z
-    const int k1 = super[s], nscol = super[s + 1] - k1;
-    const int nsrow = s_pi[s + 1] - s_pi[s], nbelow = nsrow - nscol;
-    if (poll(s, nsrow, nscol)) return false;
-    const int* rows = s_i + s_pi[s] + nscol;
-    const T* block = values + s_px[s];
-    double* ys = y + static_cast<size_t>(k1) * c;
-    for (int r = 0; r < nbelow; ++r) {
-      const double* yr = y + static_cast<size_t>(rows[r]) * c;
-      for (int q = 0; q < c; ++q) below[static_cast<size_t>(r) * c + q] = yr[q];
-    }
-    for (int j1 = nscol; j1 > 0; j1 -= kGroup) {
-      const int group = std::min(kGroup, j1), j0 = j1 - group;
-      const T* lower = block + static_cast<size_t>(j0) * nsrow + nscol;
-      const size_t stride = static_cast<size_t>(nsrow);
-      for (int q = 0; q < c; ++q) {  // right-hand sides are independent
-        // Each column's dot product with `below` (one sum per column, in row order), the
-        // group's columns side by side: independent sums, one pass over `below`.
-        double sums[kGroup] = {0.0, 0.0, 0.0, 0.0};
-        if (group == kGroup) {
-          for (int r = 0; r < nbelow; ++r) {
-            const double b = below[static_cast<size_t>(r) * c + q];
-            sums[0] += lower[r] * b;
-            sums[1] += lower[r + stride] * b;
-            sums[2] += lower[r + 2 * stride] * b;
-            sums[3] += lower[r + 3 * stride] * b;
-          }
-        } else {
-          for (int g = 0; g < group; ++g) {
-            for (int r = 0; r < nbelow; ++r) {
-              sums[g] += lower[r + g * stride] * below[static_cast<size_t>(r) * c + q];
-            }
-          }
-        }
-        for (int j = j1 - 1; j >= j0; --j) {
-          const T* col = block + static_cast<size_t>(j) * nsrow;
-          double sum = sums[j - j0];
-          for (int i = j + 1; i < nscol; ++i) sum += col[i] * ys[static_cast<size_t>(i) * c + q];
-          double& yj = ys[static_cast<size_t>(j) * c + q];
-          yj = (yj - sum) / col[j];
-        }
-      }
-    }
+    const Supernode<T> sn = supernode(s);
+    if (poll(s, sn.nsrow, sn.nscol)) return false;
+    BackwardSupernode<kColumns>(sn, y, c, below);
   }
   return true;
 }
