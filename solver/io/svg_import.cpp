@@ -178,15 +178,15 @@ bool HasClass(xmlNode* node, const std::string& token) {
 }
 
 // The value of a presentation property: its attribute, or its declaration in style="" (which
-// takes precedence, as CSS does over presentation attributes).
+// takes precedence, as CSS does over presentation attributes), split by SVG++'s own style
+// tokenizer, the one its attribute traversal reads style="" with.
 std::optional<std::string> Property(xmlNode* node, const char* name) {
   std::optional<std::string> value = Attribute(node, name);
   if (std::optional<std::string> style = Attribute(node, "style")) {
-    for (absl::string_view declaration : absl::StrSplit(*style, ';')) {
-      const size_t colon = declaration.find(':');
-      if (colon == absl::string_view::npos) continue;
-      if (absl::StripAsciiWhitespace(declaration.substr(0, colon)) == name) {
-        value = std::string(absl::StripAsciiWhitespace(declaration.substr(colon + 1)));
+    for (sv::css_style_iterator<std::string::const_iterator> it(style->cbegin(), style->cend());
+         !it.eof(); ++it) {
+      if (std::string(it->first.begin(), it->first.end()) == name) {
+        value = std::string(it->second.begin(), it->second.end());
       }
     }
   }

@@ -218,6 +218,16 @@ TEST(SvgImportPaintTest, GradientIsItsMeanColourWithAWarning) {
   EXPECT_THAT(im.info.warnings[0], HasSubstr("mean colour"));
 }
 
+// style="" wins over the presentation attribute, whatever its spacing and other declarations.
+TEST(SvgImportPaintTest, StyleDeclarationsOverrideStopAttributes) {
+  Imported im =
+      ImportOk(Svg(R"svg(<defs><linearGradient id="g"><stop offset="0" stop-color="#000000"/>
+      <stop offset="1" stop-color="#000000" style=" stop-opacity : 1 ;stop-color :  #ffffff ;"/>
+      </linearGradient></defs><rect width="50" height="50" fill="url(#g)"/>)svg"));
+  ASSERT_EQ(im.drawing.art.size(), 1u);
+  EXPECT_NEAR(static_cast<int>((im.drawing.art[0].fill->rgb >> 16) & 0xff), 128, 1);
+}
+
 // A gradient without stops paints nothing (SVG's rule), said in a warning.
 TEST(SvgImportPaintTest, GradientWithoutStopsPaintsNothing) {
   Imported im = ImportOk(Svg(R"svg(<defs><linearGradient id="empty"/></defs>
