@@ -8,13 +8,13 @@
 
 #include <atomic>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <string>
 #include <string_view>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "nlohmann/json.hpp"
 
 namespace inbetween::server {
 namespace {
@@ -28,81 +28,22 @@ std::atomic<bool> json_lines{false};
 // thread within the spdlog call that set them.
 thread_local const std::string* json_fields = nullptr;
 
-// Length of the valid UTF-8 sequence at the start of `s` (1 to 4), or 0 when it is not one.
-size_t Utf8SequenceLength(std::string_view s) {
-  const auto byte = [&](size_t i) { return static_cast<unsigned char>(s[i]); };
-  const unsigned char lead = byte(0);
-  size_t length;
-  unsigned char low = 0x80, high = 0xbf;  // allowed range of the second byte
-  if (lead < 0x80) return 1;
-  if (lead >= 0xc2 && lead <= 0xdf) {
-    length = 2;
-  } else if (lead >= 0xe0 && lead <= 0xef) {
-    length = 3;
-    if (lead == 0xe0) low = 0xa0;   // no overlong forms
-    if (lead == 0xed) high = 0x9f;  // no surrogates
-  } else if (lead >= 0xf0 && lead <= 0xf4) {
-    length = 4;
-    if (lead == 0xf0) low = 0x90;   // no overlong forms
-    if (lead == 0xf4) high = 0x8f;  // nothing above U+10FFFF
-  } else {
-    return 0;
-  }
-  if (s.size() < length || byte(1) < low || byte(1) > high) return 0;
-  for (size_t i = 2; i < length; ++i) {
-    if (byte(i) < 0x80 || byte(i) > 0xbf) return 0;
-  }
-  return length;
-}
-
-// `s` as the inside of a JSON string: quote, backslash and control characters escaped, bytes that
-// are not UTF-8 replaced by U+FFFD (a JSON text is UTF-8), everything else unchanged. Out is
-// std::string or spdlog's memory buffer.
-template <typename Out>
-void AppendJsonEscaped(std::string_view s, Out& out) {
-  const auto append = [&out](std::string_view piece) {
-    out.append(piece.data(), piece.data() + piece.size());
-  };
-  for (size_t i = 0; i < s.size();) {
-    const char c = s[i];
-    switch (c) {
-      case '"':
-        append("\\\"");
-        break;
-      case '\\':
-        append("\\\\");
-        break;
-      case '\n':
-        append("\\n");
-        break;
-      case '\r':
-        append("\\r");
-        break;
-      case '\t':
-        append("\\t");
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(c));
-          append(buf);
-        } else if (const size_t n = Utf8SequenceLength(s.substr(i)); n == 0) {
-          append("\\ufffd");
-        } else {
-          append(s.substr(i, n));
-          i += n;
-          continue;
-        }
-    }
-    ++i;
-  }
+// `s` as the inside of a JSON string, escaped by nlohmann::json (bytes that are not UTF-8 become
+// U+FFFD: a JSON text is UTF-8).
+std::string JsonEscaped(std::string_view s) {
+  const std::string quoted =
+      nlohmann::json(std::string(s))
+          .dump(-1, ' ', /*ensure_ascii=*/false, nlohmann::json::error_handler_t::replace);
+  return quoted.substr(1, quoted.size() - 2);
 }
 
 class JsonEscapedMessage final : public spdlog::custom_flag_formatter {
  public:
   void format(const spdlog::details::log_msg& msg, const std::tm&,
               spdlog::memory_buf_t& dest) override {
-    AppendJsonEscaped(std::string_view(msg.payload.data(), msg.payload.size()), dest);
+    const std::string escaped =
+        JsonEscaped(std::string_view(msg.payload.data(), msg.payload.size()));
+    dest.append(escaped.data(), escaped.data() + escaped.size());
   }
   std::unique_ptr<custom_flag_formatter> clone() const override {
     return std::make_unique<JsonEscapedMessage>();
@@ -125,8 +66,7 @@ class JsonFields final : public spdlog::custom_flag_formatter {
 // ,"key":"value" with the value JSON-escaped.
 void AppendJsonString(std::string& out, std::string_view key, std::string_view value) {
   out.append(",\"").append(key).append("\":\"");
-  AppendJsonEscaped(value, out);
-  out += '"';
+  out.append(JsonEscaped(value)).append("\"");
 }
 
 }  // namespace
