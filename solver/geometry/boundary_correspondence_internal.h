@@ -67,23 +67,25 @@ struct Param {
   std::vector<double> t, a;
   double length = 1;
   double Forward(double u) const {  // u may be in [0, 1]
-    const size_t m = t.size();
-    size_t j = std::upper_bound(t.begin(), t.end(), u) - t.begin();
-    j = std::max<size_t>(j, 1) - 1;
-    const double t1 = j + 1 < m ? t[j + 1] : 1.0;
-    const double a1 = j + 1 < m ? a[j + 1] : a[0] + length;
-    const double f = t1 > t[j] ? (u - t[j]) / (t1 - t[j]) : 0.0;
-    return a[j] + f * (a1 - a[j]);
+    return Interpolate(t, a, u, 1.0, a[0] + length);
   }
   double Inverse(double arc) const {
     arc = a[0] + std::fmod(std::fmod(arc - a[0], length) + length, length);
-    const size_t m = a.size();
-    size_t j = std::upper_bound(a.begin(), a.end(), arc) - a.begin();
+    return Wrap01(Interpolate(a, t, arc, a[0] + length, 1.0));
+  }
+
+ private:
+  // The map through knots (from[j], to[j]) and the closing knot (from_end, to_end), linear
+  // between them, at x: Forward reads it one way, Inverse the other.
+  static double Interpolate(const std::vector<double>& from, const std::vector<double>& to,
+                            double x, double from_end, double to_end) {
+    const size_t m = from.size();
+    size_t j = std::upper_bound(from.begin(), from.end(), x) - from.begin();
     j = std::max<size_t>(j, 1) - 1;
-    const double t1 = j + 1 < m ? t[j + 1] : 1.0;
-    const double a1 = j + 1 < m ? a[j + 1] : a[0] + length;
-    const double f = a1 > a[j] ? (arc - a[j]) / (a1 - a[j]) : 0.0;
-    return Wrap01(t[j] + f * (t1 - t[j]));
+    const double x1 = j + 1 < m ? from[j + 1] : from_end;
+    const double y1 = j + 1 < m ? to[j + 1] : to_end;
+    const double f = x1 > from[j] ? (x - from[j]) / (x1 - from[j]) : 0.0;
+    return to[j] + f * (y1 - to[j]);
   }
 };
 
