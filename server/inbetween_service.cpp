@@ -616,7 +616,8 @@ absl::StatusOr<HeavyJobs::Slot> AcquireHeavy(HeavyJobs& heavy, grpc::ServerConte
   absl::StatusOr<HeavyJobs::Slot> slot =
       heavy.Acquire(caller.owner, [context] { return context->IsCancelled(); });
   if (slot.status().code() == absl::StatusCode::kResourceExhausted) {
-    context->AddTrailingMetadata("retry-after-ms", absl::StrCat(kBusyRetryAfterSeconds * 1000));
+    context->AddTrailingMetadata("retry-after-ms",
+                                 absl::StrCat(solver::RetryAfterMs(slot.status())));
   }
   if (slot.status().code() == absl::StatusCode::kCancelled) {
     return StoppedStatus(*context, "the call");
