@@ -162,7 +162,7 @@ bool InnerLoop::SetUp() {
   if (!objective.ok()) return Stop(objective.status());
   objective_.emplace(*std::move(objective));
   if (!Checkpoint()) return false;
-  layout_.emplace(*mesh_, options_.slide_boundary, context_.outlines, cancel_);
+  layout_.emplace(*mesh_, options_.slide_boundary, context_.outlines, context_.pairing, cancel_);
   if (layout_->cancelled()) return Cancel();
   if (!Checkpoint()) return false;
   std::vector<Points> grad_shapes;
@@ -355,7 +355,8 @@ bool InnerLoop::Relax() {
   const std::vector<int> picked = PickRelaxVars(*layout_, g_new_, options_);
   std::vector<RelaxTarget> targets;
   for (int i : picked) {
-    targets.push_back({vars[i].shape, vars[i].vertex, vars[i].slider, vars[i].direction});
+    const ComeshLayout::Var& var = vars[i];
+    targets.push_back({var.shape, var.vertex, var.slider, var.direction, var.base, var.lo, var.hi});
   }
   if (relaxer_->Relax(targets, options_.relax_steps, &trial_, &trial_grad_, &trial_energies_) > 0) {
     if (!Checkpoint()) return false;

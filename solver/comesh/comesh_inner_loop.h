@@ -28,6 +28,7 @@
 #include "solver/comesh/comesh_objective.h"
 #include "solver/comesh/comesh_optimizer.h"
 #include "solver/comesh/comesh_outline.h"
+#include "solver/comesh/comesh_pairing.h"
 #include "solver/comesh/comesh_preconditioner.h"
 #include "solver/core/cancel.h"
 #include "solver/mesh/multimesh.h"
@@ -72,6 +73,8 @@ struct InnerRunContext {
   const std::vector<ShapeOutline>* outlines = nullptr;
   // With `outlines`: the outline guard's references and bounds, or null for no guard.
   const OutlineGuardBounds* bounds = nullptr;
+  // The input's boundary pairing the sliders keep to (ComeshOptions::slide_window), or null.
+  const BoundaryPairing* pairing = nullptr;
   const CancelToken* cancel = nullptr;
   const ProgressFn* progress = nullptr;  // called once per accepted iteration if set
   // Accepted iterations before this run: callbacks and messages number iterations globally.

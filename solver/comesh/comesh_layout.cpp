@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <optional>
+#include <limits>
 #include <tuple>
 
 #include "solver/comesh/comesh_topology.h"
@@ -47,7 +48,9 @@ bool FindMovable(const Multimesh& mesh, const CancelToken* cancel, std::vector<c
 // Makes *var (boundary vertex v at x[v], neighbours `nbrs`) a slider; false if it stays fixed.
 // `outline`: the shape's reference outline when it slides along it, else null.
 bool MakeBoundarySlider(const Points& x, int v, const std::vector<int>& nbrs, bool slide_boundary,
-                        const ShapeOutline* outline, double tolerance, ComeshLayout::Var* var) {
+                        const ShapeOutline* outline, double tolerance,
+                        const std::optional<BoundaryPairing::Window>& window,
+                        const ShapeOutline* pairing_outline, ComeshLayout::Var* var) {
   if (!slide_boundary || nbrs.size() != 2) return false;
   // On the reference outline: it slides along it, or stays at a hard point. (A straight slider
   // there could follow its line off the outline once a neighbour has moved along a curve.)
@@ -63,6 +66,11 @@ bool MakeBoundarySlider(const Points& x, int v, const std::vector<int>& nbrs, bo
     var->prev = nbrs[0];
     var->next = nbrs[1];
     std::tie(var->lo, var->hi) = outline->Stretch(at->loop, at->u);
+    if (window && window->loop == at->loop) {
+      // The pairing's frame and the sliding outline are both the input's outline.
+      var->lo = std::max(var->lo, at->u + (window->lo - window->u));
+      var->hi = std::min(var->hi, at->u + (window->hi - window->u));
+    }
     return true;
   }
   // Otherwise (no outlines, or a vertex off them): along the straight segment of its neighbours
@@ -71,13 +79,22 @@ bool MakeBoundarySlider(const Points& x, int v, const std::vector<int>& nbrs, bo
   if (!StrictlyInsideSegment(a, b, x[v])) return false;
   var->slider = true;
   var->direction = (b - a).normalized();
+  var->lo = -std::numeric_limits<double>::infinity();
+  var->hi = std::numeric_limits<double>::infinity();
+  if (window && pairing_outline != nullptr) {
+    // z runs along `direction`, which may run against the outline's orientation.
+    const bool along = var->direction.dot(pairing_outline->Tangent(window->loop, window->u)) >= 0.0;
+    var->lo = along ? window->lo - window->u : window->u - window->hi;
+    var->hi = along ? window->hi - window->u : window->u - window->lo;
+  }
   return true;
 }
 
 }  // namespace
 
 ComeshLayout::ComeshLayout(const Multimesh& mesh, bool slide_boundary,
-                           const std::vector<ShapeOutline>* outlines, const CancelToken* cancel) {
+                           const std::vector<ShapeOutline>* outlines,
+                           const BoundaryPairing* pairing, const CancelToken* cancel) {
   const int n = mesh.num_vertices();
   num_vertices_ = n;
   num_shapes_ = mesh.num_shapes();
@@ -92,21 +109,30 @@ ComeshLayout::ComeshLayout(const Multimesh& mesh, bool slide_boundary,
     // A shape without soft corners keeps the straight sliders (ShapeOutline::curved).
     const ShapeOutline* outline =
         outlines != nullptr && (*outlines)[s].curved() ? &(*outlines)[s] : nullptr;
-    AddShape(s, mesh.shapes[s], movable, boundary_nbrs, slide_boundary, outline);
+    AddShape(s, mesh.shapes, movable, boundary_nbrs, slide_boundary, outline, pairing);
   }
   outlines_ = num_outline_ > 0 ? outlines : nullptr;
 }
 
-void ComeshLayout::AddShape(int s, const Points& x, const std::vector<char>& movable,
+void ComeshLayout::AddShape(int s, const std::vector<Points>& shapes,
+                            const std::vector<char>& movable,
                             const std::vector<std::vector<int>>& boundary_nbrs, bool slide_boundary,
-                            const ShapeOutline* outline) {
+                            const ShapeOutline* outline, const BoundaryPairing* pairing) {
+  const Points& x = shapes[s];
   const double tolerance = outline != nullptr ? outline->tolerance() : 0.0;
   for (int v = 0; v < num_vertices_; ++v) {
     if (!movable[v]) continue;
     Var var{s, v, size_, false, Point::Zero(), x[v]};
-    if (!boundary_nbrs[v].empty() &&
-        !MakeBoundarySlider(x, v, boundary_nbrs[v], slide_boundary, outline, tolerance, &var)) {
-      continue;
+    const std::vector<int>& nbrs = boundary_nbrs[v];
+    if (!nbrs.empty()) {
+      const std::optional<BoundaryPairing::Window> window =
+          pairing != nullptr && slide_boundary && nbrs.size() == 2
+              ? pairing->WindowOf(shapes, s, v, nbrs[0], nbrs[1])
+              : std::nullopt;
+      if (!MakeBoundarySlider(x, v, nbrs, slide_boundary, outline, tolerance, window,
+                              pairing != nullptr ? &pairing->outline(s) : nullptr, &var)) {
+        continue;
+      }
     }
     index_[s][v] = static_cast<int>(vars_.size());
     size_ += var.slider ? 1 : 2;
@@ -167,7 +193,7 @@ void ComeshLayout::Scatter(const VectorXd& z, std::vector<Points>* shapes) const
     if (var.outline >= 0) {
       p = OutlinePoint(var, z[var.offset]);
     } else {
-      p = var.slider ? Point(var.base + z[var.offset] * var.direction)
+      p = var.slider ? Point(var.base + std::clamp(z[var.offset], var.lo, var.hi) * var.direction)
                      : Point(z.segment<2>(var.offset));
     }
   }

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "solver/comesh/comesh_outline.h"
+#include "solver/comesh/comesh_pairing.h"
 #include "solver/core/cancel.h"
 #include "solver/core/types.h"
 #include "solver/mesh/multimesh.h"
@@ -29,8 +30,11 @@ class ComeshLayout {
  public:
   // With a `cancel` token (may be null) the edge list polls it (~0.1 s at 311k vertices); if it
   // was set, cancelled() is true and the layout is empty.
+  // With `pairing` (may be null), every boundary slider stays within its window
+  // (BoundaryPairing::WindowOf).
   ComeshLayout(const Multimesh& mesh, bool slide_boundary,
-               const std::vector<ShapeOutline>* outlines, const CancelToken* cancel = nullptr);
+               const std::vector<ShapeOutline>* outlines, const BoundaryPairing* pairing = nullptr,
+               const CancelToken* cancel = nullptr);
 
   struct Var {
     int shape;
@@ -40,7 +44,8 @@ class ComeshLayout {
     Point direction;  // unit, sliders only; for outline sliders the tangent where the run began
     Point base;       // position at the start, sliders only
     // Outline sliders: the loop of the shape's outline, the arc length where the run began (the
-    // unknown is the arc length itself) and the stretch between hard points it stays in.
+    // unknown is the arc length itself) and the stretch between hard points it stays in (within
+    // its pairing window). Straight sliders: lo <= z <= hi, the pairing window (else infinite).
     int outline = -1;
     double u0 = 0.0, lo = 0.0, hi = 0.0;
     int prev = -1, next = -1;  // outline sliders: the two boundary neighbours
@@ -73,9 +78,9 @@ class ComeshLayout {
 
  private:
   // Adds shape s's unknowns (`outline`: its reference outline if it slides along it, else null).
-  void AddShape(int s, const Points& x, const std::vector<char>& movable,
+  void AddShape(int s, const std::vector<Points>& shapes, const std::vector<char>& movable,
                 const std::vector<std::vector<int>>& boundary_nbrs, bool slide_boundary,
-                const ShapeOutline* outline);
+                const ShapeOutline* outline, const BoundaryPairing* pairing);
   // Outline slider i's tangent and sides at arc length u of its loop of `outline`.
   void UpdateTangents(const ShapeOutline& outline, size_t i, double u);
 

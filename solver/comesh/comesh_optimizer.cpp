@@ -84,12 +84,13 @@ absl::Status ValidateOptions(const ComeshOptions& options, const Multimesh& mesh
       std::isnan(options.relax_fraction) || !(options.relax_over_mean >= 0.0) ||
       options.relax_max_vertices < 0 || options.relax_steps < 0 ||
       !(options.outline_corner_degrees >= 0.0 && options.outline_corner_degrees <= 180.0) ||
-      !(options.outline_tolerance >= 0.0 && std::isfinite(options.outline_tolerance))) {
+      !(options.outline_tolerance >= 0.0 && std::isfinite(options.outline_tolerance)) ||
+      !(options.slide_window >= 0.0 && std::isfinite(options.slide_window))) {
     return absl::InvalidArgumentError(
         "comesh options: max_iterations, history, max_outer, relax_max_vertices and relax_steps "
         "must be >= 0, max_step_fraction in (0, 1), cure_keep in [0, 1), blend and "
         "relax_over_mean >= 0, mips_damping finite and >= 0, relax_fraction a number, "
-        "outline_corner_degrees in [0, 180], outline_tolerance finite and >= 0");
+        "outline_corner_degrees in [0, 180], outline_tolerance and slide_window finite and >= 0");
   }
   if (!options.outline_reference.empty() &&
       static_cast<int>(options.outline_reference.size()) != mesh.num_shapes()) {
@@ -167,6 +168,7 @@ class OuterLoop {
   std::vector<ShapeOutline> outlines_;
   std::vector<ShapeOutline> drawn_;  // ComeshOptions::outline_reference, as outlines
   std::optional<OutlineGuardBounds> bounds_;
+  std::optional<BoundaryPairing> pairing_;  // ComeshOptions::slide_window, from the input
   // What every inner run takes (its max_iterations aside); the drawings' outlines are in
   // bounds_, so the runs' copies leave them out.
   ComeshOptions per_run_;
@@ -179,6 +181,9 @@ absl::StatusOr<Multimesh> OuterLoop::Run(const ComeshCheckpoint* resume) {
   pass_start_objective_ = rep_.objective_before;
   if (resume != nullptr) Resume(*resume);
   SetUpOutlines();
+  if (options_.slide_boundary && options_.slide_window > 0.0) {
+    pairing_.emplace(input_, options_.slide_window);
+  }
   per_run_ = options_;
   per_run_.outline_reference.clear();
   // Stage 0 is the run without outline sliding, to convergence; stage 1 (curved outlines with
@@ -263,6 +268,7 @@ absl::Status OuterLoop::InnerRun(int max_iterations,
   const InnerRunContext context{.threads = threads_,
                                 .outlines = stage_outlines,
                                 .bounds = bounds_ ? &*bounds_ : nullptr,
+                                .pairing = pairing_ ? &*pairing_ : nullptr,
                                 .cancel = cancel_,
                                 .progress = &progress_,
                                 .iteration_base = stats_.iterations,

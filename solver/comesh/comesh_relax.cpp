@@ -110,7 +110,10 @@ bool VertexRelaxer::RelaxOne(const RelaxTarget& target, int steps,
     if (target.slider) {
       const double c = target.direction.dot(hess * target.direction);
       if (!(c > 0.0)) return moved;
-      d = -(target.direction.dot(g) / c) * target.direction;
+      const double z = (x - target.base).dot(target.direction);
+      const double move = std::clamp(-target.direction.dot(g) / c, target.lo - z, target.hi - z);
+      if (move == 0.0) return moved;
+      d = move * target.direction;
     } else {
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(hess);
       Eigen::Vector2d lambda = eig.eigenvalues();

@@ -16,6 +16,7 @@
 // given order, each seeing the moves before it; results do not depend on threads.
 #pragma once
 
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -29,6 +30,10 @@ struct RelaxTarget {
   int vertex = 0;
   bool slider = false;              // moves along `direction` only
   Point direction = Point::Zero();  // unit, sliders only
+  // Sliders: the vertex stays at base + z * direction with lo <= z <= hi.
+  Point base = Point::Zero();
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
 };
 
 class VertexRelaxer {

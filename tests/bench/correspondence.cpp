@@ -423,6 +423,12 @@ struct Result {
 
 Result RunOnce(const Case& c, const MultimeshOptions& options, bool optimize);
 
+// The comesh options every run starts from (switches on the command line change them).
+ComeshOptions& BaseComeshOptions() {
+  static ComeshOptions options;
+  return options;
+}
+
 Result Run(const Case& c, const MultimeshOptions& options, bool optimize) {
   const auto start = std::chrono::steady_clock::now();
   Result r;
@@ -442,7 +448,7 @@ Result RunOnce(const Case& c, const MultimeshOptions& options, bool optimize) {
   absl::StatusOr<Multimesh> mesh = BuildMultimesh({c.a, c.b}, options, nullptr, nullptr, &report);
   r.fallback = report.corner_matched_loops > 0 || report.overlays > 0;
   if (mesh.ok() && optimize) {
-    ComeshOptions co;
+    ComeshOptions co = BaseComeshOptions();
     co.threads = 1;
     // The guard measures against the drawings, as the server's OptimizeComesh does; the legacy
     // row (boundary_tolerance 0) runs without it, as before the guard.
@@ -571,10 +577,27 @@ int main(int argc, char** argv) {
       synthetic = false;
     } else if (arg == "--no-optimize") {
       optimize = false;
+    } else if (arg == "--no-boundary-sliding") {
+      BaseComeshOptions().slide_boundary = false;
+    } else if (arg == "--no-outline-sliding") {
+      BaseComeshOptions().slide_outline = false;
+    } else if (arg == "--no-boundary-collapses") {
+      BaseComeshOptions().topology.boundary_collapses = false;
+    } else if (arg == "--no-boundary-splits") {
+      BaseComeshOptions().topology.boundary_splits = false;
+    } else if (arg == "--no-corner-swaps") {
+      BaseComeshOptions().topology.corner_swaps = false;
+    } else if (arg == "--slide-window" && a + 1 < argc) {
+      BaseComeshOptions().slide_window = std::atof(argv[++a]);
+    } else if (arg == "--map-weight" && a + 1 < argc) {
+      BaseComeshOptions().map_weight = std::atof(argv[++a]);
+    } else if (arg == "--no-topology") {
+      BaseComeshOptions().max_outer = 0;
     } else {
       std::fprintf(stderr,
                    "usage: %s [--json FILE] [--no-examples] [--no-synthetic] [--only NAME] "
-                   "[--no-optimize] [--icons DIR] [--pairs N]\n",
+                   "[--no-optimize] [--no-boundary-sliding] [--no-outline-sliding] [--icons DIR] "
+                   "[--pairs N]\n",
                    argv[0]);
       return 2;
     }

@@ -17,6 +17,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "solver/comesh/comesh_objective.h"
+#include "solver/comesh/comesh_pairing.h"
 #include "solver/mesh/build_multimesh.h"
 #include "solver/mesh/validate.h"
 #include "tests/unit/solver/comesh/comesh_boundary_expect.h"
@@ -575,10 +576,12 @@ void ExpectResumedFrom(const Multimesh& m, ComeshOptions options,
 // `guard`: ComeshOptions::outline_tolerance and outline_reference (else the guard is off).
 void ExpectResumedRunEqualsUninterrupted(const absl::StatusOr<Multimesh>& m,
                                          bool slide_outline = false,
-                                         const ComeshOptions* guard = nullptr) {
+                                         const ComeshOptions* guard = nullptr,
+                                         double slide_window = ComeshOptions{}.slide_window) {
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
   options.slide_outline = slide_outline;
+  options.slide_window = slide_window;
   options.outline_tolerance = guard != nullptr ? guard->outline_tolerance : 0.0;
   if (guard != nullptr) options.outline_reference = guard->outline_reference;
   // Short runs between passes and no outer tolerance: several passes, so that a checkpoint in
@@ -704,7 +707,9 @@ TEST(ComeshOptimizerTest, ResumedFromAMiddleCheckpointEqualsTheUninterruptedRun)
 // outlines (not the checkpoint's boundary, whose vertices have already left some polyline
 // points).
 TEST(ComeshOptimizerTest, ResumedRunSlidesAlongTheInputOutlines) {
-  ExpectResumedRunEqualsUninterrupted(CircleToEllipse(48), /*slide_outline=*/true);
+  // Unbounded sliding: the circle's vertices travel far, so the sliding stage has passes.
+  ExpectResumedRunEqualsUninterrupted(CircleToEllipse(48), /*slide_outline=*/true, nullptr,
+                                      /*slide_window=*/0.0);
 }
 
 TEST(ComeshOptimizerTest, RejectsAnInvalidCheckpoint) {
@@ -729,8 +734,10 @@ TEST(ComeshOptimizerTest, CurvedOutlinesSlideAlongTheirPolylines) {
   ComeshOptions options;
   options.slide_outline = true;
   // The sliding itself, on a fixed 48-vertex outline whose vertices must travel far along the
-  // circle: the outline guard (tested below) would hold them to chords within 0.1%.
+  // circle: the outline guard (tested below) would hold them to chords within 0.1%, the pairing
+  // windows (tested below) to where the build paired them.
   options.outline_tolerance = 0.0;
+  options.slide_window = 0.0;
   ComeshReport on, off;
   absl::StatusOr<Multimesh> slid = OptimizeComesh(*m, options, nullptr, nullptr, &on);
   ASSERT_TRUE(slid.ok()) << slid.status();
@@ -779,6 +786,7 @@ TEST(ComeshOptimizerTest, RemovesTheSliversInnerRunsLeave) {
   absl::StatusOr<Multimesh> m = CircleToHalfDisk(48);
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
+  options.slide_window = 0.0;  // the long slides that press triangles flat
   ComeshReport with, without;
   absl::StatusOr<Multimesh> cleaned = OptimizeComesh(*m, options, nullptr, nullptr, &with);
   ASSERT_TRUE(cleaned.ok()) << cleaned.status();
@@ -998,6 +1006,7 @@ TEST(ComeshOptimizerTest, OutlineGuardKeepsTheKeysWithinTheBuildTolerance) {
 
   ComeshOptions options;
   options.max_outer = 6;
+  options.slide_window = 0.0;  // the long slides whose chords cut the tip
   for (const Drawing& d : drawings) options.outline_reference.push_back({d.outlines[0].points});
   ComeshOptions unguarded = options;
   unguarded.outline_tolerance = 0.0;
@@ -1015,6 +1024,53 @@ TEST(ComeshOptimizerTest, OutlineGuardKeepsTheKeysWithinTheBuildTolerance) {
   EXPECT_GT(free_worst, 1.5 * tolerance);  // the case needs the guard
   EXPECT_LT(report.objective_after, report.objective_before);
   EXPECT_TRUE(ValidateMultimesh(*guarded).ok());
+}
+
+// The largest distance (arc length on shape 1's outline) between where `out` puts a boundary
+// vertex in shape 1 and where `input`'s boundary correspondence pairs its place in shape 0, in
+// mean boundary edge lengths of shape 1.
+double PairingDrift(const Multimesh& input, const Multimesh& out) {
+  const BoundaryPairing pairing(input, 1e-12);
+  double drift = 0.0, edges = 0.0;
+  int count = 0;
+  for (const std::vector<int>& loop : out.boundary_loops) {
+    const int n = static_cast<int>(loop.size());
+    for (int k = 0; k < n; ++k) {
+      const int prev = loop[(k + n - 1) % n], v = loop[k], next = loop[(k + 1) % n];
+      edges += (out.shapes[1][next] - out.shapes[1][v]).norm();
+      ++count;
+      const std::optional<BoundaryPairing::Window> w =
+          pairing.WindowOf(out.shapes, 1, v, prev, next);
+      EXPECT_TRUE(w.has_value()) << "vertex " << v << " left the input's outline";
+      if (w) drift = std::max(drift, w->hi - w->lo);
+    }
+  }
+  return drift / (edges / count);
+}
+
+// Sliders keep the pairing the build made (ComeshOptions::slide_window): an arrow whose right
+// part is stretched, paired corner to corner by the build. Unbounded, the map energy slides
+// vertices about an edge away from their paired places (toward a conformal but area-distorting
+// pairing; measured 1.06 edges); with the windows none ends up half an edge away (0.17).
+TEST(ComeshOptimizerTest, SlidersKeepTheBuiltPairing) {
+  auto arrow = [](double stretch) {
+    Points p = {{0, 40}, {220, 40}, {220, 0}, {320, 70}, {220, 140}, {220, 100}, {0, 100}};
+    for (Point& q : p) q.x() = q.x() < 160 ? q.x() : 160 + stretch * (q.x() - 160);
+    return Drawing{{Outline{p}}};
+  };
+  absl::StatusOr<Multimesh> m = BuildMultimesh({arrow(1.0), arrow(1.8)}, MultimeshOptions{});
+  ASSERT_TRUE(m.ok()) << m.status();
+  ComeshOptions options;
+  options.threads = 1;
+  absl::StatusOr<Multimesh> kept = OptimizeComesh(*m, options, nullptr, nullptr, nullptr);
+  options.slide_window = 0.0;
+  absl::StatusOr<Multimesh> free = OptimizeComesh(*m, options, nullptr, nullptr, nullptr);
+  ASSERT_TRUE(kept.ok()) << kept.status();
+  ASSERT_TRUE(free.ok()) << free.status();
+  const double kept_drift = PairingDrift(*m, *kept), free_drift = PairingDrift(*m, *free);
+  EXPECT_LT(kept_drift, 0.5) << free_drift;
+  EXPECT_GT(free_drift, 0.75) << kept_drift;
+  EXPECT_TRUE(ValidateMultimesh(*kept).ok()) << ValidateMultimesh(*kept);
 }
 
 // A run with the guard resumed from a checkpoint of its sliding stage is the uninterrupted run.
