@@ -29,6 +29,9 @@
 // counts, and the keys' outline tolerance (measured on the built multimesh).
 // Usage: correspondence [--json FILE] [--no-examples] [--no-synthetic] [--only NAME]
 //                       [--no-optimize] [--icons DIR] [--pairs N]
+// and, to diagnose the comesh run: [--slide-window W] [--map-weight W] [--no-boundary-sliding]
+// [--no-outline-sliding] [--no-topology] [--no-boundary-collapses] [--no-boundary-splits]
+// [--no-corner-swaps]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
