@@ -304,9 +304,10 @@ absl::Status ParameterizeGroup(const GroupedLoops& loops, int g,
     // explains (kCarriedMisfit) keeps arc length from the carried start; one it does not (a bend)
     // is aligned as carried (AlignFeatures).
     const std::optional<Affine>& carry = loops.groups.carry[g][d];
-    const bool carried = d > 0 && carry.has_value() &&
-                         CarriedMisfit(loops.curve(0, g), loops.curve(d, g), *carry, start[d]) <
-                             kCarriedMisfit;
+    const bool carried =
+        d > 0 && carry.has_value() &&
+        (!options.align_carried ||
+         CarriedMisfit(loops.curve(0, g), loops.curve(d, g), *carry, start[d]) < kCarriedMisfit);
     if (pins.empty() && d > 0 && !carried &&
         options.alignment == BoundaryCorrespondenceOptions::Alignment::kFeatures) {
       AlignFeatures(loops, g, d, start[d], options.corner_angle_degrees, &p);
