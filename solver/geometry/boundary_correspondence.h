@@ -43,10 +43,6 @@ struct BoundaryCorrespondenceOptions {
   // 1's loop carried into the other drawing's frame as for the start.
   enum class Alignment { kArcLength, kFeatures };
   Alignment alignment = Alignment::kArcLength;
-  // With kFeatures: a loop its component's affine map carried (components with holes) is aligned
-  // too where the map leaves it more than 2% of its length off (a bend); false: such loops keep
-  // arc length from the carried start.
-  bool align_carried = true;
   // Outline tolerance, relative to each drawing's bounding-box diagonal: the vertices per
   // interval between breakpoints (spread evenly in the common parameter, `vertices` or the
   // automatic budget) are refined, every drawing at once, until in every drawing the polyline

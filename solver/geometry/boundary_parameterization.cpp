@@ -19,11 +19,6 @@
 namespace inbetween::solver::boundary_internal {
 namespace {
 
-// Below this misfit (CarriedMisfit) the component's affine map explains a carried loop, and arc
-// length from the carried start pairs it (a sheared flower: arc length 0.5-0.7 units off the
-// affine correspondence, the alignment 1.5-2.8); above it the loop is aligned.
-constexpr double kCarriedMisfit = 0.02;
-
 // A mark computed by a program lands a hair off the drawn corner (an SVG written with four
 // decimals puts it 5e-5 units, 1e-7 of the diagonal, from an arrow's corner); pinned there it
 // splits the boundary next to the corner's own breakpoint into a sliver interval that every
@@ -218,33 +213,15 @@ std::vector<double> AlignedStarts(const GroupedLoops& loops, int g) {
   return start;
 }
 
-// The mean distance, relative to the loop's length, between drawing 1's loop carried by its
-// component's affine map and drawing d's loop at arc length from the carried start `start`.
-double CarriedMisfit(const Curve& a, const Curve& b, const Affine& carry, double start) {
-  constexpr int kSamples = 64;
-  double sum = 0.0;
-  for (int k = 0; k < kSamples; ++k) {
-    sum += (carry(a.At(a.length() * k / kSamples)) - b.At(start + b.length() * k / kSamples)).norm();
-  }
-  return sum / kSamples / b.length();
-}
-
 // Group g's loop in drawing d paired with drawing 1's by the feature alignment
 // (loop_alignment.h), the aligned start `start` one of the starts it tries; `p` holds the loop's
 // length and receives the knots.
 void AlignFeatures(const GroupedLoops& loops, int g, int d, double start,
                    double corner_angle_degrees, Param* p) {
   const NormalisedLoops& n = loops.normalised;
-  // Both loops in their drawings' normalised frames, for the alignment's position term. A loop
-  // its component's affine map carried (MatchHoles) is aligned as carried into drawing d, in
-  // drawing d's frame: the map then changes no turn the alignment weighs (a sheared flower), and
-  // what it leaves unexplained (a bend) is what the alignment pairs by features.
-  const std::optional<Affine>& carry = loops.groups.carry[g][d];
+  // Both loops in their drawings' normalised frames, for the alignment's position term.
   Points a = loops.curve(0, g).p, b = loops.curve(d, g).p;
-  for (Point& q : a) {
-    q = carry.has_value() ? Point(((*carry)(q) - n.centre[d]) / n.scale[d])
-                          : Point((q - n.centre[0]) / n.scale[0]);
-  }
+  for (Point& q : a) q = (q - n.centre[0]) / n.scale[0];
   for (Point& q : b) q = (q - n.centre[d]) / n.scale[d];
   LoopAlignmentOptions align;
   align.corner_angle_degrees = corner_angle_degrees;
@@ -300,15 +277,12 @@ absl::Status ParameterizeGroup(const GroupedLoops& loops, int g,
   for (int d = 0; d < num_shapes; ++d) {
     Param& p = out->param[d][g];
     p.length = loops.curve(d, g).length();
-    // A loop its component's affine map carried (components with holes) and that the map
-    // explains (kCarriedMisfit) keeps arc length from the carried start; one it does not (a bend)
-    // is aligned as carried (AlignFeatures).
-    const std::optional<Affine>& carry = loops.groups.carry[g][d];
-    const bool carried =
-        d > 0 && carry.has_value() &&
-        (!options.align_carried ||
-         CarriedMisfit(loops.curve(0, g), loops.curve(d, g), *carry, start[d]) < kCarriedMisfit);
-    if (pins.empty() && d > 0 && !carried &&
+    // A loop that its component's affine map carried (components with holes, MatchHoles)
+    // keeps arc length from the carried start: that map already pairs the loops point by
+    // point, and an affine map changes the turns the alignment weighs (a sheared flower's
+    // outline: arc length 0.5-0.7 units off the affine correspondence, the alignment
+    // 1.4-2.8).
+    if (pins.empty() && d > 0 && !loops.groups.carry[g][d].has_value() &&
         options.alignment == BoundaryCorrespondenceOptions::Alignment::kFeatures) {
       AlignFeatures(loops, g, d, start[d], options.corner_angle_degrees, &p);
     } else if (pins.empty()) {

@@ -406,9 +406,6 @@ struct AttemptMode {
   bool match_corners = false;  // the correspondence matches corners to corners
   bool require_match = false;  // ABORTED (no answer) unless some loop's corners matched
   bool overlay = false;        // overlay the mesh where a component cannot be mapped
-  // Loops carried by their component's affine map keep arc length from the carried start even
-  // where the map leaves them far off (BoundaryCorrespondenceOptions::align_carried off).
-  bool carried_by_arc_length = false;
 };
 
 // One attempt's parameters besides the drawings and the caller's options.
@@ -466,10 +463,8 @@ absl::StatusOr<std::vector<BoundaryGraph>> DrawingBoundaries(const std::vector<D
 absl::StatusOr<BoundaryCorrespondence> Correspond(const std::vector<Drawing>& drawings,
                                                   const std::vector<BoundaryGraph>& graphs,
                                                   const MultimeshOptions& options,
-                                                  const AttemptMode& mode) {
+                                                  bool match_corners) {
   BoundaryCorrespondenceOptions correspondence_options;
-  const bool match_corners = mode.match_corners;
-  correspondence_options.align_carried = !mode.carried_by_arc_length;
   correspondence_options.vertices = options.boundary_vertices;
   correspondence_options.corner_angle_degrees = options.corner_angle_degrees;
   correspondence_options.match_corners = match_corners;
@@ -912,7 +907,7 @@ absl::StatusOr<Multimesh> BuildOnce(const std::vector<Drawing>& drawings,
   Notify(attempt.progress, "correspondence", 0.05,
          absl::StrCat((*graphs)[0].loops.size(), " boundary loops"));
   absl::StatusOr<BoundaryCorrespondence> bc =
-      Correspond(drawings, *graphs, options, attempt.mode);
+      Correspond(drawings, *graphs, options, attempt.mode.match_corners);
   if (!bc.ok()) return bc.status();
   if (attempt.mode.require_match && bc->corner_matched_loops == 0) {
     return absl::AbortedError("no loop has corners to match");
@@ -969,8 +964,8 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
     int meshed = -1;
     auto attempt = [&](AttemptMode mode) -> std::optional<absl::StatusOr<Multimesh>> {
       // The first attempt (rank 0, the first correspondence) is the one the overlay repeats.
-      const bool first_attempt = rank == 0 && mode.match_corners == !arc_length &&
-                                 !mode.require_match && !mode.carried_by_arc_length;
+      const bool first_attempt =
+          rank == 0 && mode.match_corners == !arc_length && !mode.require_match;
       const AttemptOptions attempt_options{
           .mode = mode,
           .rank = rank,
@@ -991,14 +986,6 @@ absl::StatusOr<Multimesh> BuildMultimesh(const std::vector<Drawing>& drawings,
       if (auto built = attempt({.match_corners = false})) return *built;
       if (rank == 0 && !absl::IsInvalidArgument(first) && !absl::IsFailedPrecondition(first)) {
         return first;
-      }
-      // The feature alignment of loops their component's map carried can pair holes' corners
-      // that the map pairs better (icons: 79 of 200 Remix Icon pairs then fell back further,
-      // to larger overlays); the correspondence before it, before corner matching.
-      if (options.correspondence == MultimeshOptions::Correspondence::kFeatures && meshed >= 0) {
-        if (auto built = attempt({.match_corners = false, .carried_by_arc_length = true})) {
-          return *built;
-        }
       }
       if (rank > 0 && meshed < 0) break;  // no drawing of this rank
       if (corners) {
