@@ -74,8 +74,12 @@ struct BoundaryCorrespondenceOptions {
 // right map. Without marks, each loop gets the cyclic shift that best matches drawing
 // 1's loop in normalised turning angle and position over arc length, its component's map (if
 // any) carrying drawing 1's loop first (orientation is fixed: the drawing is on the left of
-// every loop); with Alignment::kFeatures, loops that no component's map carried are then paired
-// by the feature alignment (loop_alignment.h), that start one of the starts it tries.
+// every loop); with Alignment::kFeatures, loops are then paired by the feature alignment
+// (loop_alignment.h), that start one of the starts it tries. In a component with holes the
+// outline is aligned as carried by the component's map where that map leaves it more than 2% of
+// its length off (a bend) and the aligned outline carries every hole onto its match; each hole
+// then follows: carried through the outline's correspondence (mean value coordinates) and
+// aligned as carried. Otherwise the component's loops keep arc length from the carried starts.
 struct BoundaryCorrespondence {
   // Loop g's vertices are the global indices loop_start[g] .. loop_start[g + 1] - 1; edge e joins
   // vertex e to the next vertex of its loop.

@@ -144,6 +144,8 @@ struct Parameterization {
   std::vector<std::pair<int, double>> mark_at;  // per mark: its loop group, arc in drawing 1
   // Per group: the common parameters that marks (or matched corners) pin, each a breakpoint.
   std::vector<std::vector<double>> pinned_t;
+  // aligned[d][g]: paired by the feature alignment or by matched corners (not marks).
+  std::vector<std::vector<bool>> aligned;
   int corner_matched_loops = 0;
 };
 

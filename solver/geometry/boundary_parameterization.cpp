@@ -4,6 +4,7 @@
 // (BoundaryCorrespondenceOptions::match_corners), else the feature alignment (loop_alignment.h)
 // or arc length from the automatically aligned start.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -18,6 +19,15 @@
 
 namespace inbetween::solver::boundary_internal {
 namespace {
+
+// Below this misfit (CarriedMisfit) the component's affine map explains a carried loop, and arc
+// length from the carried start pairs it (a sheared flower: arc length 0.5-0.7 units off the
+// affine correspondence, the alignment 1.5-2.8); above it the loop is aligned.
+constexpr double kCarriedMisfit = 0.02;
+// A hole that the outline's correspondence carries within this mean distance (relative to the
+// hole's length) of the other drawing's hole is aligned by features (AlignCarriedOutline,
+// AlignCarriedHole).
+constexpr double kHoleMisfit = 0.05;
 
 // A mark computed by a program lands a hair off the drawn corner (an SVG written with four
 // decimals puts it 5e-5 units, 1e-7 of the diagonal, from an arrow's corner); pinned there it
@@ -213,21 +223,107 @@ std::vector<double> AlignedStarts(const GroupedLoops& loops, int g) {
   return start;
 }
 
+// The mean distance, relative to the loop's length, between drawing 1's loop carried by its
+// component's affine map and drawing d's loop at arc length from the carried start `start`.
+double CarriedMisfit(const Curve& a, const Curve& b, const Affine& carry, double start) {
+  constexpr int kSamples = 64;
+  double sum = 0.0;
+  for (int k = 0; k < kSamples; ++k) {
+    sum += (carry(a.At(a.length() * k / kSamples)) - b.At(start + b.length() * k / kSamples)).norm();
+  }
+  return sum / kSamples / b.length();
+}
+
+// Drawing d's image of a point of drawing 1 inside a component, through the correspondence of
+// the component's outline: the point's mean value coordinates (Floater 2003) in drawing 1's
+// outline, sampled at kSamples common parameters, applied to drawing d's outline at the same
+// parameters. It reproduces an affine map and follows a bend, which no one affine map does; it
+// carries a hole of a bent drawing onto that drawing's hole.
+class OutlineMap {
+ public:
+  OutlineMap(const Curve& c0, const Param& p0, const Curve& cd, const Param& pd) {
+    for (int k = 0; k < kSamples; ++k) {
+      const double t = static_cast<double>(k) / kSamples;
+      from_.push_back(c0.At(p0.Forward(t)));
+      to_.push_back(cd.At(pd.Forward(t)));
+    }
+  }
+
+  Point operator()(const Point& q) const {
+    std::array<double, kSamples> r;
+    std::array<Point, kSamples> e;
+    for (int k = 0; k < kSamples; ++k) {
+      e[k] = from_[k] - q;
+      r[k] = e[k].norm();
+      if (r[k] < 1e-12) return to_[k];
+    }
+    // tan(alpha_k / 2) of the angle at q between samples k and k + 1.
+    std::array<double, kSamples> half;
+    for (int k = 0; k < kSamples; ++k) {
+      const int k1 = (k + 1) % kSamples;
+      const double denominator = r[k] * r[k1] + e[k].dot(e[k1]);
+      half[k] = denominator > 0 ? Cross(e[k], e[k1]) / denominator : 0.0;
+    }
+    Point sum = Point::Zero();
+    double total = 0.0;
+    for (int k = 0; k < kSamples; ++k) {
+      const double w = (half[(k + kSamples - 1) % kSamples] + half[k]) / r[k];
+      sum += w * to_[k], total += w;
+    }
+    return std::abs(total) > 0 ? Point(sum / total) : q;
+  }
+
+ private:
+  static constexpr int kSamples = 256;
+  Points from_, to_;
+};
+
+// The mean distance from drawing 1's loop carried point by point into drawing d (`carried`) to
+// drawing d's loop `b`, relative to b's length.
+double CarriedDistance(const Points& carried, const Curve& b) {
+  const Curve c = MakeCurve(carried);
+  constexpr int kSamples = 64;
+  double sum = 0.0;
+  for (int k = 0; k < kSamples; ++k) {
+    double dist;
+    b.Project(c.At(c.length() * k / kSamples), &dist);
+    sum += dist;
+  }
+  return sum / kSamples / b.length();
+}
+
 // Group g's loop in drawing d paired with drawing 1's by the feature alignment
 // (loop_alignment.h), the aligned start `start` one of the starts it tries; `p` holds the loop's
-// length and receives the knots.
+// length and receives the knots. `carried`, when given: drawing 1's loop carried vertex by
+// vertex into drawing d, aligned in drawing d's frame instead of drawing 1's loop in its own (a
+// map that explains part of the deformation then changes no turn the alignment weighs; what it
+// leaves unexplained is what the alignment pairs by features). Its knots are read back onto
+// drawing 1's loop through the vertices.
 void AlignFeatures(const GroupedLoops& loops, int g, int d, double start,
-                   double corner_angle_degrees, Param* p) {
+                   double corner_angle_degrees, const Points* carried, Param* p) {
   const NormalisedLoops& n = loops.normalised;
   // Both loops in their drawings' normalised frames, for the alignment's position term.
-  Points a = loops.curve(0, g).p, b = loops.curve(d, g).p;
-  for (Point& q : a) q = (q - n.centre[0]) / n.scale[0];
+  const Curve& c0 = loops.curve(0, g);
+  Points a = carried != nullptr ? *carried : c0.p, b = loops.curve(d, g).p;
+  const int frame = carried != nullptr ? d : 0;
+  for (Point& q : a) q = (q - n.centre[frame]) / n.scale[frame];
   for (Point& q : b) q = (q - n.centre[d]) / n.scale[d];
   LoopAlignmentOptions align;
   align.corner_angle_degrees = corner_angle_degrees;
   const LoopAlignment al = AlignLoops(a, b, start / p->length, align);
+  const std::vector<double> cum = CumulativeLength(a);
   for (size_t k = 0; k < al.a.size(); ++k) {
-    p->t.push_back(al.a[k]);
+    double t = al.a[k];
+    if (carried != nullptr) {  // the fraction of a's length, as a fraction of drawing 1's loop
+      const double arc = t * cum.back();
+      const size_t i = std::min<size_t>(
+          std::upper_bound(cum.begin(), cum.end(), arc) - cum.begin() - 1, a.size() - 1);
+      const double len = cum[i + 1] - cum[i];
+      const double f = len > 0 ? (arc - cum[i]) / len : 0.0;
+      t = (c0.cum[i] + f * (c0.cum[i + 1] - c0.cum[i])) / c0.length();
+      if (!p->t.empty() && !(t > p->t.back())) continue;
+    }
+    p->t.push_back(t);
     p->a.push_back(al.b[k] * p->length);
   }
 }
@@ -249,6 +345,73 @@ absl::Status KnotsAtPins(const std::vector<ArcPin>& pins, int d, double len0, Pa
     p->a.push_back(based + a);
   }
   return absl::OkStatus();
+}
+
+// Drawing 1's loop of group g carried into drawing d point by point by `map`.
+template <typename Map>
+Points Carried(const GroupedLoops& loops, int g, const Map& map) {
+  Points out;
+  for (const Point& q : loops.curve(0, g).p) out.push_back(map(q));
+  return out;
+}
+
+// The holes of outline group g's component: the groups after it up to the next outline.
+std::vector<int> HoleGroups(const GroupedLoops& loops, int g) {
+  std::vector<int> holes;
+  for (int h = g + 1; h < loops.num_groups() && !loops.groups.outer[h] &&
+                      loops.groups.component[h] == loops.groups.component[g];
+       ++h) {
+    holes.push_back(h);
+  }
+  return holes;
+}
+
+// The outline of hole group h's component.
+int OutlineGroup(const GroupedLoops& loops, int h) {
+  int g = h;
+  while (g > 0 && !loops.groups.outer[g]) --g;
+  return g;
+}
+
+// Outline group g of a component with holes, in drawing d, aligned by features as carried by
+// the component's affine map (AlignFeatures) into `p`; false, leaving `p` to arc length from
+// the carried start, where that map explains the outline (kCarriedMisfit: it already pairs the
+// loops point by point, and an affine map changes the turns the alignment weighs) or where the
+// aligned outline does not carry every hole onto its match (OutlineMap, kHoleMisfit). The holes
+// follow the outline's correspondence (AlignCarriedHole); one it does not carry onto its match
+// would be paired against it, and between unrelated drawings (icon pairs) such pairings build
+// maps that fold and fall back to larger overlays (docs/benchmarks.md, "Boundary
+// correspondence": aligning those outlines anyway made the icon builds slower).
+bool AlignCarriedOutline(const GroupedLoops& loops, int g, int d, double start,
+                         double corner_angle_degrees, const Parameterization& param, Param* p) {
+  const Affine& carry = *loops.groups.carry[g][d];
+  if (CarriedMisfit(loops.curve(0, g), loops.curve(d, g), carry, start) < kCarriedMisfit) {
+    return false;
+  }
+  Param trial;
+  trial.length = p->length;
+  const Points carried = Carried(loops, g, carry);
+  AlignFeatures(loops, g, d, start, corner_angle_degrees, &carried, &trial);
+  const OutlineMap map(loops.curve(0, g), param.param[0][g], loops.curve(d, g), trial);
+  for (int h : HoleGroups(loops, g)) {
+    if (!(CarriedDistance(Carried(loops, h, map), loops.curve(d, h)) < kHoleMisfit)) return false;
+  }
+  *p = std::move(trial);
+  return true;
+}
+
+// Hole group h in drawing d aligned by features as carried by its outline's correspondence
+// (OutlineMap) into `p`, where the outline was aligned or matched by corners and carries the
+// hole onto its match (kHoleMisfit); false otherwise (arc length from the carried start).
+bool AlignCarriedHole(const GroupedLoops& loops, int h, int d, double start,
+                      double corner_angle_degrees, const Parameterization& param, Param* p) {
+  const int g = OutlineGroup(loops, h);
+  if (!param.aligned[d][g]) return false;
+  const OutlineMap map(loops.curve(0, g), param.param[0][g], loops.curve(d, g), param.param[d][g]);
+  const Points carried = Carried(loops, h, map);
+  if (!(CarriedDistance(carried, loops.curve(d, h)) < kHoleMisfit)) return false;
+  AlignFeatures(loops, h, d, start, corner_angle_degrees, &carried, p);
+  return true;
 }
 
 // Group g's parameterization in every drawing (out->param[d][g]) and its pinned parameters.
@@ -277,15 +440,19 @@ absl::Status ParameterizeGroup(const GroupedLoops& loops, int g,
   for (int d = 0; d < num_shapes; ++d) {
     Param& p = out->param[d][g];
     p.length = loops.curve(d, g).length();
-    // A loop that its component's affine map carried (components with holes, MatchHoles)
-    // keeps arc length from the carried start: that map already pairs the loops point by
-    // point, and an affine map changes the turns the alignment weighs (a sheared flower's
-    // outline: arc length 0.5-0.7 units off the affine correspondence, the alignment
-    // 1.4-2.8).
-    if (pins.empty() && d > 0 && !loops.groups.carry[g][d].has_value() &&
-        options.alignment == BoundaryCorrespondenceOptions::Alignment::kFeatures) {
-      AlignFeatures(loops, g, d, start[d], options.corner_angle_degrees, &p);
-    } else if (pins.empty()) {
+    const bool carried = loops.groups.carry[g][d].has_value();
+    bool align = pins.empty() && d > 0 &&
+                 options.alignment == BoundaryCorrespondenceOptions::Alignment::kFeatures;
+    if (align && !carried) {
+      AlignFeatures(loops, g, d, start[d], options.corner_angle_degrees, nullptr, &p);
+    } else if (align && loops.groups.outer[g]) {
+      align = AlignCarriedOutline(loops, g, d, start[d], options.corner_angle_degrees, *out, &p);
+    } else if (align) {
+      align = AlignCarriedHole(loops, g, d, start[d], options.corner_angle_degrees, *out, &p);
+    }
+    out->aligned[d][g] = align || (d > 0 && !corner_pairs.empty());
+    if (align) continue;
+    if (pins.empty()) {
       p.t = {0.0};
       p.a = {start[d]};
     } else if (absl::Status s = KnotsAtPins(pins, d, len0, &p); !s.ok()) {
@@ -304,6 +471,7 @@ absl::StatusOr<Parameterization> ParameterizeGroups(const GroupedLoops& loops,
   out.param.assign(loops.num_shapes(), std::vector<Param>(num_groups));
   out.marks.resize(num_groups);
   out.pinned_t.resize(num_groups);
+  out.aligned.assign(loops.num_shapes(), std::vector<bool>(num_groups, false));
   for (size_t m = 0; m < options.marks.size(); ++m) {
     absl::StatusOr<PlacedMark> placed =
         PlaceMark(loops, options.marks[m], m, options.corner_angle_degrees);

@@ -177,7 +177,9 @@ class BandedAlignment {
         step_(std::max(1, options.max_step)),
         width_(n_ + 1),
         ua_(FractionsFrom(sa, a0)),
+        a_(Rotated(sa, a0)),
         cost_((m_ + 1) * width_),
+        row_min_(m_ + 1),
         back_((m_ + 1) * width_) {}
 
   // The cheapest path's cost from b's start j0, or a value not below `bound` once no path can
@@ -191,77 +193,99 @@ class BandedAlignment {
 
  private:
   double RowsMin(int i) const;
-  void Relax(int i, int j, int j0, const std::vector<double>& ub);
+  void Relax(int i, int j);
+
+  // A loop's samples in path order from a start (index k: the start's k-th successor, k up to
+  // the sample count, which is the start again): turn, squared turn, position.
+  struct FromStart {
+    std::vector<double> turn, turn2;
+    Points p;
+  };
+  static FromStart Rotated(const Sampled& l, int start);
 
   const Sampled& sa_;
   const Sampled& sb_;
   const LoopAlignmentOptions& options_;
   const int a0_, m_, n_, step_, width_;
   const std::vector<double> ua_;  // a's arc fractions from its start
-  std::vector<double> cost_;
+  const FromStart a_;             // a from its start
+  FromStart b_;                   // b from the current Run's start
+  std::vector<double> ub_;        // b's arc fractions from the current Run's start
+  std::vector<double> cost_, row_min_;
   std::vector<uint8_t> back_;
 };
+
+BandedAlignment::FromStart BandedAlignment::Rotated(const Sampled& l, int start) {
+  const int n = static_cast<int>(l.s.size());
+  FromStart out;
+  for (int k = 0; k <= n; ++k) {
+    const int i = (start + k) % n;
+    out.turn.push_back(l.turn[i]);
+    out.turn2.push_back(l.turn[i] * l.turn[i]);
+    out.p.push_back(l.p[i]);
+  }
+  return out;
+}
 
 // The least cost in rows i .. i + step - 1. Costs only grow along a path, and every path to the
 // end passes through one of these rows (whose cells rows before i have all reached): once none
 // holds a cell below the best start's total, this start cannot win (the result is the same; a
 // bad start is left after a few rows).
 double BandedAlignment::RowsMin(int i) const {
-  double row_min = kInf;
-  for (int r = i; r < std::min(m_ + 1, i + step_); ++r) {
-    for (int j = 0; j <= n_; ++j) row_min = std::min(row_min, cost_[r * width_ + j]);
-  }
-  return row_min;
+  double rows_min = kInf;
+  for (int r = i; r < std::min(m_ + 1, i + step_); ++r) rows_min = std::min(rows_min, row_min_[r]);
+  return rows_min;
 }
 
 // Every step of 1..step samples of both loops out of cell (i, j), priced as in the header;
 // samples a step skips add their squared turns.
-void BandedAlignment::Relax(int i, int j, int j0, const std::vector<double>& ub) {
-  auto ia = [&](int k) { return (a0_ + k) % m_; };
-  auto jb = [&](int k) { return (j0 + k) % n_; };
+void BandedAlignment::Relax(int i, int j) {
   const double here = cost_[i * width_ + j];
   double skipped_a = 0.0;
   for (int di = 1; di <= step_ && i + di <= m_; ++di) {
     const int i1 = i + di;
     const double la = ua_[i1] - ua_[i];
-    const Point& pa = sa_.p[ia(i1)];
-    const double ta = sa_.turn[ia(i1)];
+    const Point& pa = a_.p[i1];
+    const double ta = a_.turn[i1];
     double skipped_b = 0.0;
     for (int dj = 1; dj <= step_ && j + dj <= n_; ++dj) {
       const int j1 = j + dj;
-      // Both ends of the loops are reached together (the path closes on the start pair).
-      if ((i1 == m_) != (j1 == n_)) {
-        skipped_b += sb_.turn[jb(j1)] * sb_.turn[jb(j1)];
+      // Both ends of the loops are reached together (the path closes on the start pair), and
+      // b's sample stays within the band of a's.
+      if ((i1 == m_) != (j1 == n_) || (std::abs(ub_[j1] - ua_[i1]) > options_.band && j1 != n_)) {
+        skipped_b += b_.turn2[j1];
         continue;
       }
-      if (std::abs(ub[j1] - ua_[i1]) > options_.band && j1 != n_) {
-        skipped_b += sb_.turn[jb(j1)] * sb_.turn[jb(j1)];
-        continue;
-      }
-      const double lb = ub[j1] - ub[j];
-      const double tb = sb_.turn[jb(j1)];
+      const double lb = ub_[j1] - ub_[j];
+      const double tb = b_.turn[j1];
       const double stretch = (la - lb) * (la - lb) / (la + lb);
       const double turn = (ta - tb) * (ta - tb) + skipped_a + skipped_b;
-      const double position = (pa - sb_.p[jb(j1)]).squaredNorm() * 0.5 * (la + lb);
+      const double position = (pa - b_.p[j1]).squaredNorm() * 0.5 * (la + lb);
       const double c = here + options_.stretch_weight * stretch + options_.turn_weight * turn +
                        options_.position_weight * position;
       double& there = cost_[i1 * width_ + j1];
-      if (c < there) there = c, back_[i1 * width_ + j1] = static_cast<uint8_t>(di * 16 + dj);
-      skipped_b += tb * tb;
+      if (c < there) {
+        there = c, back_[i1 * width_ + j1] = static_cast<uint8_t>(di * 16 + dj);
+        row_min_[i1] = std::min(row_min_[i1], c);
+      }
+      skipped_b += b_.turn2[j1];
     }
-    skipped_a += ta * ta;
+    skipped_a += a_.turn2[i1];
   }
 }
 
 double BandedAlignment::Run(int j0, double bound) {
-  const std::vector<double> ub = FractionsFrom(sb_, j0);
+  ub_ = FractionsFrom(sb_, j0);
+  b_ = Rotated(sb_, j0);
   std::fill(cost_.begin(), cost_.end(), kInf);
-  cost_[0] = 0.0;
+  std::fill(row_min_.begin(), row_min_.end(), kInf);
+  cost_[0] = row_min_[0] = 0.0;
   for (int i = 0; i < m_; ++i) {
     if (!(RowsMin(i) < bound)) break;
     for (int j = 0; j < n_; ++j) {
-      if (cost_[i * width_ + j] == kInf) continue;
-      Relax(i, j, j0, ub);
+      // Costs only grow along a path: a cell at or above the bound leads to no cheaper end.
+      if (!(cost_[i * width_ + j] < bound)) continue;
+      Relax(i, j);
     }
   }
   return cost_[m_ * width_ + n_];
@@ -344,6 +368,45 @@ void RebaseOntoA(const ArcPath& path, const Sampled& sa, const Sampled& sb, doub
   for (double& b : out->b) b = (b - shift) / sb.length;
 }
 
+// The starts worth the full DP (StartsOnB, in their order): where there are more than
+// kFullStarts, each is first priced by the same DP on both loops sampled kCoarsening times
+// more sparsely (corners are kept), and the kFullStarts cheapest go on (ties: the earlier).
+// Corners decide the start, and the coarse samples keep every one; the coarse pass costs about
+// 1/16 of a full one per start.
+std::vector<int> FinestStarts(const Points& a_loop, const Points& b_loop, const Sampled& sa,
+                              int a0, const Sampled& sb, double hint,
+                              const LoopAlignmentOptions& options) {
+  constexpr int kFullStarts = 12, kCoarsening = 4;
+  std::vector<int> starts = StartsOnB(sa, a0, sb, hint, options);
+  if (static_cast<int>(starts.size()) <= kFullStarts) return starts;
+  LoopAlignmentOptions coarse = options;
+  coarse.max_samples = std::max(16, options.max_samples / kCoarsening);
+  const Sampled ca = SampleLoop(a_loop, coarse), cb = SampleLoop(b_loop, coarse);
+  // a's start on the coarse loop: the coarse sample nearest a's start.
+  const int ca0 = NearestSample(ca, sa.s[a0] / sa.length);
+  BandedAlignment dp(ca, cb, ca0, coarse);
+  std::vector<std::pair<double, int>> priced;  // (coarse cost, position in `starts`)
+  double bound = kInf;                         // the kFullStarts-th cheapest so far
+  for (size_t k = 0; k < starts.size(); ++k) {
+    const double cost = dp.Run(NearestSample(cb, sb.s[starts[k]] / sb.length), bound);
+    priced.push_back({cost, static_cast<int>(k)});
+    if (static_cast<int>(priced.size()) >= kFullStarts) {
+      std::vector<double> costs;
+      for (const auto& [c, unused] : priced) costs.push_back(c);
+      std::nth_element(costs.begin(), costs.begin() + kFullStarts - 1, costs.end());
+      bound = costs[kFullStarts - 1];
+    }
+  }
+  std::stable_sort(priced.begin(), priced.end(),
+                   [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::vector<int> keep;
+  for (int k = 0; k < kFullStarts; ++k) keep.push_back(priced[k].second);
+  std::sort(keep.begin(), keep.end());
+  std::vector<int> out;
+  for (int k : keep) out.push_back(starts[k]);
+  return out;
+}
+
 }  // namespace
 
 LoopAlignment AlignLoops(const Points& a_loop, const Points& b_loop, double hint,
@@ -351,12 +414,12 @@ LoopAlignment AlignLoops(const Points& a_loop, const Points& b_loop, double hint
   const Sampled sa = SampleLoop(a_loop, options);
   const Sampled sb = SampleLoop(b_loop, options);
   const int a0 = MostTurningSample(sa);
-  // Every start's DP; the cheapest wins (ties: the earliest tried).
+  // The starts' DPs; the cheapest wins (ties: the earliest tried).
   BandedAlignment dp(sa, sb, a0, options);
   std::vector<uint8_t> best_back;
   int best_start = -1;
   double best_cost = kInf;
-  for (const int j0 : StartsOnB(sa, a0, sb, hint, options)) {
+  for (const int j0 : FinestStarts(a_loop, b_loop, sa, a0, sb, hint, options)) {
     const double total = dp.Run(j0, best_cost);
     if (total < best_cost) best_cost = total, best_start = j0, best_back = dp.back();
   }
