@@ -51,7 +51,7 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
-                 "[--no-corner-swaps] [--no-boundary-splits] [--no-outline-sliding] "
+                 "[--no-corner-swaps] [--no-boundary-splits] [--no-outline-sliding] [--slide-window W] "
                  "[--outline-corner DEGREES] [--min-quality Q] "
                  "[--cure-keep C] [--double-substitutions] [--mips-damping D] [--step-fraction F] "
                  "[--outer-inner K] "
@@ -117,6 +117,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
       args.options.topology.corner_swaps = false;
     } else if (a == "--no-outline-sliding") {
       args.options.slide_outline = false;
+    } else if (a == "--slide-window") {
+      args.options.slide_window = std::atof(next());
     } else if (a == "--outline-corner") {
       args.options.outline_corner_degrees = std::atof(next());
     } else if (a == "--no-boundary-splits") {

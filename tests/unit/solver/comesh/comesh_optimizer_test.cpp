@@ -1062,6 +1062,7 @@ TEST(ComeshOptimizerTest, SlidersKeepTheBuiltPairing) {
   ASSERT_TRUE(m.ok()) << m.status();
   ComeshOptions options;
   options.threads = 1;
+  options.slide_window = 0.15;
   absl::StatusOr<Multimesh> kept = OptimizeComesh(*m, options, nullptr, nullptr, nullptr);
   options.slide_window = 0.0;
   absl::StatusOr<Multimesh> free = OptimizeComesh(*m, options, nullptr, nullptr, nullptr);
@@ -1073,13 +1074,17 @@ TEST(ComeshOptimizerTest, SlidersKeepTheBuiltPairing) {
   EXPECT_TRUE(ValidateMultimesh(*kept).ok()) << ValidateMultimesh(*kept);
 }
 
-// A run with the guard resumed from a checkpoint of its sliding stage is the uninterrupted run.
+// A run with the guard resumed from a checkpoint of its sliding stage is the uninterrupted run,
+// with the sliders unbounded and kept to the built pairing (ComeshOptions::slide_window).
 TEST(ComeshOptimizerTest, ResumedRunWithTheOutlineGuardEqualsTheUninterruptedRun) {
   const std::vector<Drawing> drawings = {Drop(1.0, 1.0), Drop(1.6, 0.7)};
   ComeshOptions guard;
   for (const Drawing& d : drawings) guard.outline_reference.push_back({d.outlines[0].points});
-  ExpectResumedRunEqualsUninterrupted(BuildMultimesh(drawings, MultimeshOptions{}),
-                                      /*slide_outline=*/true, &guard);
+  for (const double window : {0.0, 0.15}) {
+    SCOPED_TRACE(::testing::Message() << "slide_window " << window);
+    ExpectResumedRunEqualsUninterrupted(BuildMultimesh(drawings, MultimeshOptions{}),
+                                        /*slide_outline=*/true, &guard, window);
+  }
 }
 
 }  // namespace
