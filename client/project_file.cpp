@@ -201,7 +201,7 @@ absl::Status ParseMeshing(const Node& node, v1::MeshingParameters* out) {
 absl::Status ParseComesh(const Node& node, v1::ComeshParameters* out) {
   if (absl::Status s = node.CheckKeys(
           {"map_weight", "max_outer_iterations", "max_inner_iterations", "tolerance",
-           "outer_tolerance", "outline_corner_degrees", "min_quality"});
+           "outer_tolerance", "outline_corner_degrees", "min_quality", "slide_window"});
       !s.ok()) {
     return s;
   }
@@ -232,6 +232,10 @@ absl::Status ParseComesh(const Node& node, v1::ComeshParameters* out) {
   if (node.Has("min_quality")) {
     PROJECT_ASSIGN_OR_RETURN(v, node.Child("min_quality").Number(0.0, 0.999));
     out->set_min_quality(v);
+  }
+  if (node.Has("slide_window")) {
+    PROJECT_ASSIGN_OR_RETURN(v, node.Child("slide_window").Number(0.0, 100.0));
+    out->set_slide_window(v);
   }
   return absl::OkStatus();
 }
@@ -542,6 +546,7 @@ json ProjectToJson(const Project& project, const std::filesystem::path& base_dir
   if (c.tolerance() > 0) comesh["tolerance"] = c.tolerance();
   if (c.has_outer_tolerance()) comesh["outer_tolerance"] = c.outer_tolerance();
   if (c.has_min_quality()) comesh["min_quality"] = c.min_quality();
+  if (c.has_slide_window()) comesh["slide_window"] = c.slide_window();
   if (c.has_outline_corner_degrees()) {
     comesh["outline_corner_degrees"] = c.outline_corner_degrees();
   }

@@ -52,6 +52,12 @@ absl::Status ValidateComesh(const inbetween::v1::ComeshParameters& comesh,
       return s;
     }
   }
+  if (comesh.has_slide_window()) {
+    if (auto s = CheckRange(comesh.slide_window(), 0, 100, false, field, "slide_window");
+        !s.ok()) {
+      return s;
+    }
+  }
   if (comesh.has_min_quality()) {
     if (!(std::isfinite(comesh.min_quality()) && comesh.min_quality() >= 0 &&
           comesh.min_quality() < 1)) {
@@ -229,6 +235,7 @@ solver::ComeshOptions ToComeshOptions(const inbetween::v1::ComeshParameters& com
     if (options.slide_outline) options.outline_corner_degrees = comesh.outline_corner_degrees();
   }
   if (comesh.has_min_quality()) options.min_quality = comesh.min_quality();  // unset: 0.02
+  if (comesh.has_slide_window()) options.slide_window = comesh.slide_window();  // unset: 0
   return options;
 }
 

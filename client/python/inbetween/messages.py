@@ -149,7 +149,8 @@ def comesh_parameters(
         tolerance: Optional[float] = None,
         outer_tolerance: Optional[float] = None,
         outline_corner_degrees: Optional[float] = None,
-        min_quality: Optional[float] = None) -> "pb.ComeshParameters":
+        min_quality: Optional[float] = None,
+        slide_window: Optional[float] = None) -> "pb.ComeshParameters":
     """ComeshParameters: ``base`` with every argument that is not None set over it."""
     out = pb.ComeshParameters()
     if base is not None:
@@ -158,7 +159,7 @@ def comesh_parameters(
                         ("max_inner_iterations", max_inner_iterations), ("tolerance", tolerance),
                         ("outer_tolerance", outer_tolerance),
                         ("outline_corner_degrees", outline_corner_degrees),
-                        ("min_quality", min_quality)):
+                        ("min_quality", min_quality), ("slide_window", slide_window)):
         if value is not None:
             setattr(out, name, value)
     return out

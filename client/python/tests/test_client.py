@@ -83,7 +83,8 @@ class ClientTest(unittest.TestCase):
         self.assertGreater(events[-1].stats.vertices, 0)
         built = events[-1].session
         events = list(self.client.stream_optimize(
-            built, comesh=inbetween.comesh_parameters(max_outer_iterations=1, min_quality=0.02)))
+            built, comesh=inbetween.comesh_parameters(max_outer_iterations=1, min_quality=0.02,
+                                                     slide_window=0.15)))
         result = events[-1]
         self.assertIsInstance(result, pb.OptimizeComeshResult)
         inner = [e.inner for e in events if isinstance(e, pb.ComeshIteration)]

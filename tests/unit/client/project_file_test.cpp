@@ -30,7 +30,7 @@ TEST(ProjectFileTest, FullProjectRoundTrips) {
     "import": {"gap_tolerance": 0.01, "min_area_fraction": 0},
     "meshing": {"boundary_vertices": 96, "shape_bound": 0.1, "corner_matching": "always"},
     "comesh": {"map_weight": 0.3, "max_outer_iterations": 7, "outline_corner_degrees": 40,
-               "min_quality": 0.05},
+               "min_quality": 0.05, "slide_window": 0.15},
     "inbetween": {"method": "alexa", "frames": 30, "timing": "ease_in_out", "ease": [0.5],
                   "stiffness": [{"polygon": [[0,0],[1,0],[1,1]], "kappa": 10}],
                   "lambda": 2, "tau": 0.2, "alpha": 0.25, "epsilon": 0.5, "rho": 3,
@@ -44,6 +44,7 @@ TEST(ProjectFileTest, FullProjectRoundTrips) {
   EXPECT_DOUBLE_EQ(p->parameters.comesh().map_weight(), 0.3);
   EXPECT_DOUBLE_EQ(p->parameters.comesh().outline_corner_degrees(), 40.0);
   EXPECT_DOUBLE_EQ(p->parameters.comesh().min_quality(), 0.05);
+  EXPECT_DOUBLE_EQ(p->parameters.comesh().slide_window(), 0.15);
   EXPECT_EQ(p->parameters.meshing().corner_matching(), v1::CORNER_MATCHING_ALWAYS);
   EXPECT_EQ(p->drawings[0].cuts.size(), 1u);
   EXPECT_EQ(p->drawings[1].openings[0].size(), 3u);

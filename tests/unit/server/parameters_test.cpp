@@ -132,6 +132,20 @@ TEST(ParametersTest, OutlineCornerDegreesIsCheckedAndReachesTheOptimizer) {
   EXPECT_EQ(ValidateComesh(c, "comesh").code(), absl::StatusCode::kInvalidArgument);
 }
 
+TEST(ParametersTest, SlideWindowIsCheckedAndReachesTheOptimizer) {
+  v1::ComeshParameters c;
+  EXPECT_EQ(ToComeshOptions(c).slide_window, 0.0);  // unset: unbounded
+  c.set_slide_window(0.15);
+  ASSERT_TRUE(ValidateComesh(c, "comesh").ok());
+  EXPECT_DOUBLE_EQ(ToComeshOptions(c).slide_window, 0.15);
+  c.set_slide_window(-1.0);
+  const absl::Status s = ValidateComesh(c, "comesh");
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(s.message()), HasSubstr("comesh.slide_window = -1"));
+  c.set_slide_window(std::numeric_limits<double>::infinity());
+  EXPECT_EQ(ValidateComesh(c, "comesh").code(), absl::StatusCode::kInvalidArgument);
+}
+
 TEST(ParametersTest, MinQualityIsCheckedAndReachesTheOptimizer) {
   v1::ComeshParameters c;
   EXPECT_DOUBLE_EQ(ToComeshOptions(c).min_quality, 0.02);  // unset: the solver's default
