@@ -53,8 +53,7 @@ absl::Status ValidateComesh(const inbetween::v1::ComeshParameters& comesh,
     }
   }
   if (comesh.has_slide_window()) {
-    if (auto s = CheckRange(comesh.slide_window(), 0, 100, false, field, "slide_window");
-        !s.ok()) {
+    if (auto s = CheckRange(comesh.slide_window(), 0, 100, false, field, "slide_window"); !s.ok()) {
       return s;
     }
   }

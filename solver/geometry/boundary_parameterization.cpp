@@ -229,7 +229,8 @@ double CarriedMisfit(const Curve& a, const Curve& b, const Affine& carry, double
   constexpr int kSamples = 64;
   double sum = 0.0;
   for (int k = 0; k < kSamples; ++k) {
-    sum += (carry(a.At(a.length() * k / kSamples)) - b.At(start + b.length() * k / kSamples)).norm();
+    sum +=
+        (carry(a.At(a.length() * k / kSamples)) - b.At(start + b.length() * k / kSamples)).norm();
   }
   return sum / kSamples / b.length();
 }
@@ -279,8 +280,9 @@ class OutlineMap {
 };
 
 // The mean distance from drawing 1's loop carried point by point into drawing d (`carried`) to
-// drawing d's loop `b`, relative to b's length.
-double CarriedDistance(const Points& carried, const Curve& b) {
+// drawing d's loop `b`, relative to b's length. (Not boundary_loop_matching.cpp's
+// CarriedDistance, a mean squared distance between arc-length samples that scores matchings.)
+double MeanDistanceToLoop(const Points& carried, const Curve& b) {
   const Curve c = MakeCurve(carried);
   constexpr int kSamples = 64;
   double sum = 0.0;
@@ -394,7 +396,8 @@ bool AlignCarriedOutline(const GroupedLoops& loops, int g, int d, double start,
   AlignFeatures(loops, g, d, start, corner_angle_degrees, &carried, &trial);
   const OutlineMap map(loops.curve(0, g), param.param[0][g], loops.curve(d, g), trial);
   for (int h : HoleGroups(loops, g)) {
-    if (!(CarriedDistance(Carried(loops, h, map), loops.curve(d, h)) < kHoleMisfit)) return false;
+    if (!(MeanDistanceToLoop(Carried(loops, h, map), loops.curve(d, h)) < kHoleMisfit))
+      return false;
   }
   *p = std::move(trial);
   return true;
@@ -409,7 +412,7 @@ bool AlignCarriedHole(const GroupedLoops& loops, int h, int d, double start,
   if (!param.aligned[d][g]) return false;
   const OutlineMap map(loops.curve(0, g), param.param[0][g], loops.curve(d, g), param.param[d][g]);
   const Points carried = Carried(loops, h, map);
-  if (!(CarriedDistance(carried, loops.curve(d, h)) < kHoleMisfit)) return false;
+  if (!(MeanDistanceToLoop(carried, loops.curve(d, h)) < kHoleMisfit)) return false;
   AlignFeatures(loops, h, d, start, corner_angle_degrees, &carried, p);
   return true;
 }

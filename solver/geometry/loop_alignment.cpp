@@ -373,9 +373,8 @@ void RebaseOntoA(const ArcPath& path, const Sampled& sa, const Sampled& sb, doub
 // more sparsely (corners are kept), and the kFullStarts cheapest go on (ties: the earlier).
 // Corners decide the start, and the coarse samples keep every one; the coarse pass costs about
 // 1/16 of a full one per start.
-std::vector<int> FinestStarts(const Points& a_loop, const Points& b_loop, const Sampled& sa,
-                              int a0, const Sampled& sb, double hint,
-                              const LoopAlignmentOptions& options) {
+std::vector<int> FinestStarts(const Points& a_loop, const Points& b_loop, const Sampled& sa, int a0,
+                              const Sampled& sb, double hint, const LoopAlignmentOptions& options) {
   constexpr int kFullStarts = 12, kCoarsening = 4;
   std::vector<int> starts = StartsOnB(sa, a0, sb, hint, options);
   if (static_cast<int>(starts.size()) <= kFullStarts) return starts;

@@ -51,8 +51,8 @@ inline ComeshBenchArgs ParseComeshBenchArgs(int argc, char** argv, bool with_max
   auto usage = [&] {
     std::fprintf(stderr,
                  "usage: %s %s[--threads T] [--max-outer K] [--weight W] [--blend B] [--no-cure] "
-                 "[--no-corner-swaps] [--no-boundary-splits] [--no-outline-sliding] [--slide-window W] "
-                 "[--outline-corner DEGREES] [--min-quality Q] "
+                 "[--no-corner-swaps] [--no-boundary-splits] [--no-outline-sliding] "
+                 "[--slide-window W] [--outline-corner DEGREES] [--min-quality Q] "
                  "[--cure-keep C] [--double-substitutions] [--mips-damping D] [--step-fraction F] "
                  "[--outer-inner K] "
                  "[--scale-by-inverse] [--history M] [--tolerance R] [--laplacian] [--refresh K] "
