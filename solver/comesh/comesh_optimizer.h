@@ -105,7 +105,7 @@ struct ComeshOptions {
   // boundary correspondence pairs it (comesh_pairing.h): sliding evens the mesh out locally but
   // cannot undo the built pairing, which the map energy alone slides toward a conformal but
   // area-distorting one. 0 (the default): unbounded. The trade, measured
-  // (docs/benchmarks.md, "Boundary correspondence against a known truth"): 0.15 brings two more
+  // (docs/benchmarks.md, "Boundary correspondence against a known truth"): 0.15 brings three more
   // of the 49 known-truth cases within 10% of the true pairing's middle-frame distortion, but
   // ends 20 of the 31 examples of "outline sliding" more than 1% above the unbounded objective
   // (8% on average, a star-to-pentagon pair 70%), where the paper's objective is the measure.

@@ -36,8 +36,8 @@ constexpr double kSameT = 1e-9;
 // beside another breakpoint that it did not snap to) is refused naming the mark: it would reach
 // the mesher as a cusp.
 constexpr double kMarkSliverRelative = 1e-6;
-// Corners of different drawings closer than this fraction of a drawing's diagonal share one
-// breakpoint (NearBreak).
+// Corners closer than this fraction of a drawing's diagonal share one breakpoint (NearBreak);
+// with the outline tolerance in force, corners closer than the tolerance do too.
 constexpr double kCornerMergeRelative = 1e-4;
 
 // One side of a cut/opening run of a drawing: arc lengths [a0, a1] on loop `group`, collocated
@@ -128,43 +128,114 @@ double ChordDeviation(const Curve& c, double a0, double a1, double* farthest) {
   return worst;
 }
 
-// Common parameters `ts` (increasing, the interval's vertices, ending before `t1`) with points
-// added until, in every drawing d, the outline between consecutive vertices (and the last and
-// t1) lies within tol[d] of their chord: each chord that strays is split at its drawing's
-// farthest vertex (by that drawing's parameterization), else halved. A rounded tip drawn with
-// many small turns gets vertices along it, where the corner test (a turn above
-// corner_angle_degrees in one step) saw none.
+// Whether, in every drawing d, the outline between common parameters lo < hi lies within tol[d]
+// of the chord between its ends.
+bool WithinTolerance(double lo, double hi, const std::vector<const Curve*>& curves,
+                     const std::vector<const Param*>& params, const std::vector<double>& tol) {
+  for (size_t d = 0; d < curves.size(); ++d) {
+    double far;
+    if (ChordDeviation(*curves[d], params[d]->Forward(lo), params[d]->Forward(hi), &far) > tol[d]) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// The common parameters in (t0, t1) of every drawing's outline vertices, sorted, with those
+// closer than `min_gap` to the previous one (or to t0, t1) left out.
+std::vector<double> OutlineVertexParams(double t0, double t1,
+                                        const std::vector<const Curve*>& curves,
+                                        const std::vector<const Param*>& params, double min_gap) {
+  std::vector<double> all;
+  for (size_t d = 0; d < curves.size(); ++d) {
+    const Curve& c = *curves[d];
+    const Param& p = *params[d];
+    const double length = c.length(), a0 = p.Forward(t0), a1 = p.Forward(t1);
+    const int n = static_cast<int>(c.p.size());
+    const double base = std::floor(a0 / length) * length;
+    int k =
+        static_cast<int>(std::upper_bound(c.cum.begin(), c.cum.end(), a0 - base) - c.cum.begin());
+    for (int steps = 0; steps < n; ++steps, ++k) {
+      const double arc = base + (k / n) * length + c.cum[k % n];
+      if (arc >= a1) break;
+      if (arc <= a0) continue;
+      const double t = Wrap01(p.Inverse(arc));
+      all.push_back(t < t0 ? t + 1.0 : t);
+    }
+  }
+  std::sort(all.begin(), all.end());
+  std::vector<double> out;
+  double last = t0;
+  for (double t : all) {
+    if (t - last >= min_gap && t1 - t >= min_gap) out.push_back(t), last = t;
+  }
+  return out;
+}
+
+// Common parameters for the interval [ts[0], t1) whose even vertices `ts` leave some drawing's
+// outline farther than tol[d] from a chord. The even ones are kept where they suffice (an outline
+// already within the tolerance samples as before). Otherwise the vertices are placed greedily:
+// from each vertex, the farthest of every drawing's outline vertices (as common parameters) up to
+// which all drawings stay within the tolerance of the chord, and never farther than the even
+// spacing. A rounded tip drawn with many small turns gets vertices along it by each drawing's own
+// curvature, where the corner test (a turn above corner_angle_degrees in one step) saw none.
+// Halving each strayed chord at its farthest vertex instead adds about a quarter more vertices
+// where it adds any, and their meshes more still (`scripts/bench correspondence --icons`,
+// docs/benchmarks.md). The last two pieces are then evened out, so that no sliver edge ends the
+// interval.
 std::vector<double> RefineToTolerance(const std::vector<double>& ts, double t1,
                                       const std::vector<const Curve*>& curves,
                                       const std::vector<const Param*>& params,
                                       const std::vector<double>& tol) {
-  std::vector<double> out;
-  // Depth-first over the pieces, in order; a piece narrower than kMinPiece in t is left as it is
-  // (coincident vertices would follow).
+  bool even_ok = true;
+  for (size_t k = 0; k < ts.size() && even_ok; ++k) {
+    even_ok = WithinTolerance(ts[k], k + 1 < ts.size() ? ts[k + 1] : t1, curves, params, tol);
+  }
+  if (even_ok) return ts;
+  // Pieces narrower than kMinPiece in t are not made (coincident vertices would follow).
   constexpr double kMinPiece = 1e-7;
-  for (size_t k = 0; k < ts.size(); ++k) {
-    const double end = k + 1 < ts.size() ? ts[k + 1] : t1;
-    std::vector<std::pair<double, double>> stack = {{ts[k], end}};
-    while (!stack.empty()) {
-      const auto [lo, hi] = stack.back();
-      stack.pop_back();
-      double split = -1.0;
-      for (size_t d = 0; d < curves.size() && split < 0.0; ++d) {
-        const double a0 = params[d]->Forward(lo), a1 = params[d]->Forward(hi);
-        double far;
-        if (ChordDeviation(*curves[d], a0, a1, &far) > tol[d]) {
-          const double t = Wrap01(params[d]->Inverse(far));
-          // Inverse wraps into [0, 1); the piece may end at 1.
-          const double tt = t < lo ? t + 1.0 : t;
-          split = tt > lo + kMinPiece && tt < hi - kMinPiece ? tt : 0.5 * (lo + hi);
-        }
+  const double t0 = ts[0];
+  const double max_step = (t1 - t0) / static_cast<double>(ts.size());
+  const std::vector<double> cand = OutlineVertexParams(t0, t1, curves, params, kMinPiece);
+  std::vector<double> out = {t0};
+  size_t next = 0;  // first candidate past the current vertex
+  for (;;) {
+    const double cur = out.back();
+    const double reach = cur + max_step;
+    if (t1 <= reach && WithinTolerance(cur, t1, curves, params, tol)) break;
+    while (next < cand.size() && cand[next] <= cur) ++next;
+    double best = -1.0;
+    size_t k = next;
+    for (; k < cand.size() && cand[k] <= reach; ++k) {
+      if (!WithinTolerance(cur, cand[k], curves, params, tol)) break;
+      best = cand[k];
+    }
+    const bool all_fit = k == cand.size() || cand[k] > reach;
+    if (all_fit && reach < t1 - kMinPiece && WithinTolerance(cur, reach, curves, params, tol)) {
+      best = reach;
+    }
+    // Between two neighbouring candidates no drawing has an outline vertex, so the first one
+    // always fits; it is taken even if it does not (a piece narrower than kMinPiece).
+    if (best < 0.0) best = next < cand.size() ? cand[next] : 0.5 * (cur + t1);
+    if (best >= t1 - kMinPiece) break;
+    out.push_back(best);
+  }
+  // Even out the last two pieces: the last vertex moves to the candidate (or the midpoint) that
+  // keeps both pieces within the tolerance and the shorter one longest.
+  if (out.size() >= 2) {
+    const double lo = out[out.size() - 2];
+    double& last = out.back();
+    auto shorter = [&](double t) { return std::min(t - lo, t1 - t); };
+    std::vector<double> options = {0.5 * (lo + t1)};
+    for (double t : cand) {
+      if (t > lo && t < t1) options.push_back(t);
+    }
+    for (double t : options) {
+      if (shorter(t) > shorter(last) && t - lo <= max_step && t1 - t <= max_step &&
+          WithinTolerance(lo, t, curves, params, tol) &&
+          WithinTolerance(t, t1, curves, params, tol)) {
+        last = t;
       }
-      if (split < 0.0 || hi - lo < 2 * kMinPiece) {
-        out.push_back(lo);
-        continue;
-      }
-      stack.push_back({split, hi});  // after the first half
-      stack.push_back({lo, split});
     }
   }
   return out;
@@ -278,12 +349,18 @@ bool CompatibleSampling::AddBreak(int g, double t) {
   return true;
 }
 
-// Whether a corner at t lies within kCornerMergeRelative of a neighbouring breakpoint of group
-// g in some drawing. Two drawings' corners that the correspondence puts a hair apart would make
-// a sliver interval that every drawing repeats (the mesher refuses it as a cusp), so such a
-// corner is left to the breakpoint; its drawing's vertex then sits that close to the corner, far
-// inside the outline tolerance.
+// Whether a corner at t lies within kCornerMergeRelative (or the outline tolerance, when the
+// sampling refines to it) of a neighbouring breakpoint of group g in some drawing. Two drawings'
+// corners that the correspondence puts a hair apart would make a sliver interval that every
+// drawing repeats (the mesher refuses it as a cusp), and so would two corners of one drawing a
+// notch apart (a tip flattened into several sharp turns): such a corner is left to the
+// breakpoint; its drawing's vertex then sits that close to the corner, within the outline
+// tolerance (which the refinement checks, and meets with a vertex of its own where it must).
+// The sliver's triangles were what the middle frame's worst distortion measured on a face's
+// eye corner (`scripts/bench correspondence`, principles_appeal).
 bool CompatibleSampling::NearBreak(int g, double t) const {
+  const bool refine = options_.tolerance > 0.0 && options_.vertices <= 0;
+  const double merge = std::max(kCornerMergeRelative, refine ? options_.tolerance : 0.0);
   bool near = false;
   const std::vector<double>& b = breaks_[g];
   auto it = std::lower_bound(b.begin(), b.end(), t);
@@ -292,7 +369,7 @@ bool CompatibleSampling::NearBreak(int g, double t) const {
     for (int e = 0; e < num_shapes_ && !near; ++e) {
       const Param& p = param(e, g);
       const double gap = std::abs(p.Forward(Wrap01(t)) - p.Forward(Wrap01(other)));
-      near = std::min(gap, p.length - gap) < kCornerMergeRelative * scale(e);
+      near = std::min(gap, p.length - gap) < merge * scale(e);
     }
   }
   return near;

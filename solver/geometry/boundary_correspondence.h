@@ -43,15 +43,17 @@ struct BoundaryCorrespondenceOptions {
   // 1's loop carried into the other drawing's frame as for the start.
   enum class Alignment { kArcLength, kFeatures };
   Alignment alignment = Alignment::kArcLength;
-  // Outline tolerance, relative to each drawing's bounding-box diagonal: the vertices per
-  // interval between breakpoints (spread evenly in the common parameter, `vertices` or the
-  // automatic budget) are refined, every drawing at once, until in every drawing the polyline
+  // Outline tolerance, relative to each drawing's bounding-box diagonal: an interval between
+  // breakpoints whose even vertices (`vertices` or the automatic budget) leave some drawing's
+  // outline farther than this from a chord is sampled again, every drawing at once, greedily to
+  // the tolerance (no piece longer than the even spacing), so that in every drawing the polyline
   // lies within the tolerance of the drawing's outline (Hausdorff, both ways: the outline between
   // two vertices strays at most this far from their chord). A rounded tip drawn with many small
   // turns, which no single turn marks as a corner, keeps its shape. The vertices are common
   // parameters, so the correspondence between drawings is the one chosen above; an interval gets
-  // what the drawing that needs most needs. 0, or a fixed `vertices`: no refinement. Intervals on
-  // a cut or opening keep the even spacing.
+  // what the drawing that needs most needs. Corners closer than the tolerance share one
+  // breakpoint. 0, or a fixed `vertices`: no refinement. Intervals on a cut or opening keep the
+  // even spacing.
   double tolerance = 0.0;
 };
 
