@@ -82,6 +82,11 @@ struct BoundaryCorrespondenceOptions {
 // its length off (a bend) and the aligned outline carries every hole onto its match; each hole
 // then follows: carried through the outline's correspondence (mean value coordinates) and
 // aligned as carried. Otherwise the component's loops keep arc length from the carried starts.
+// Last, where an affine map (fitted to that pairing, refined by point-to-line ICP on the outline
+// and its holes) carries drawing 1's outline within 0.2% of its match's length, the outline, and
+// each hole of the component that the map carries as closely, pair through the map: drawing 1's
+// vertices carried onto the nearest points of the match. Loops along a cut or an opening keep the
+// pairing above.
 struct BoundaryCorrespondence {
   // Loop g's vertices are the global indices loop_start[g] .. loop_start[g + 1] - 1; edge e joins
   // vertex e to the next vertex of its loop.

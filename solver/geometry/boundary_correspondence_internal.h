@@ -109,6 +109,9 @@ struct LoopGroups {
   // carry[g][d]: the affine map of the component that carried its holes (none without holes,
   // for drawing 1, or a degenerate fit), which aligns the loops' starts.
   std::vector<std::vector<std::optional<Affine>>> carry;
+  // Per group: some drawing's loop runs along a cut or an opening (its sides are sampled as
+  // their twins are, so the loop keeps the pairing that mirrors them).
+  std::vector<bool> seamed;
   int size() const { return static_cast<int>(loops.size()); }
 };
 
@@ -146,6 +149,9 @@ struct Parameterization {
   std::vector<std::vector<double>> pinned_t;
   // aligned[d][g]: paired by the feature alignment or by matched corners (not marks).
   std::vector<std::vector<bool>> aligned;
+  // affine[d][g], for an outline group: the affine map that explains the component's outline in
+  // drawing d and pairs it (PairThroughAffine), which then pairs the component's holes.
+  std::vector<std::vector<std::optional<Affine>>> affine;
   int corner_matched_loops = 0;
 };
 

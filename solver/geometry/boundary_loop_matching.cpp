@@ -759,6 +759,14 @@ absl::StatusOr<LoopGroups> MatchLoopGroups(const std::vector<BoundaryGraph>& gra
       return s;
     }
   }
+  groups.seamed.assign(groups.size(), false);
+  for (int g = 0; g < groups.size(); ++g) {
+    for (int d = 0; d < num_shapes; ++d) {
+      for (const auto& [loop, edge] : graphs[d].loops[groups.loops[g][d]].twin) {
+        groups.seamed[g] = groups.seamed[g] || loop >= 0;
+      }
+    }
+  }
   return groups;
 }
 
