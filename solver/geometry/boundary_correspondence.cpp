@@ -303,6 +303,14 @@ class CompatibleSampling {
   int NextInLoop(int gi) const;
   UnionFind LinkTwinIntervals();
   void CountVertices(UnionFind* classes);
+  struct GroupOutlines {
+    std::vector<const Curve*> curves;
+    std::vector<const Param*> params;
+    std::vector<double> tol;
+  };
+  GroupOutlines OutlinesOf(int g) const;
+  bool EvenWithinTolerance(int g, int i, int count) const;
+  void RefineTwinClasses(UnionFind* classes);
   void PlaceVertices();
   void SampleLoops(int d, Points* flat, double* achieved) const;
   void CollocateTwins(int d, Points* flat, std::vector<int>* edge_twin) const;
@@ -592,10 +600,70 @@ void CompatibleSampling::CountVertices(UnionFind* classes) {
   for (int i = 0; i < num_intervals; ++i) count_[i] = class_count[classes->Find(i)];
 }
 
+// Whether `count` vertices spread evenly over interval i of group g leave every drawing's outline
+// within the tolerance of their chords.
+bool CompatibleSampling::EvenWithinTolerance(int g, int i, int count) const {
+  const GroupOutlines o = OutlinesOf(g);
+  const double t0 = breaks_[g][i], t1 = IntervalEnd(g, i);
+  for (int k = 0; k < count; ++k) {
+    if (!WithinTolerance(t0 + (t1 - t0) * k / count, t0 + (t1 - t0) * (k + 1) / count, o.curves,
+                         o.params, o.tol)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Group g's loop in every drawing, its parameterization and its outline tolerance (absolute).
+CompatibleSampling::GroupOutlines CompatibleSampling::OutlinesOf(int g) const {
+  GroupOutlines o;
+  for (int d = 0; d < num_shapes_; ++d) {
+    o.curves.push_back(&curve(d, g)), o.params.push_back(&param(d, g));
+    o.tol.push_back(options_.tolerance * scale(d));
+  }
+  return o;
+}
+
+// Intervals on a cut or an opening (and their twins across it, one class) with a tolerance and
+// no fixed vertex count: the class's common count raised (by a quarter at a time, up to
+// kMaxTwinRefinement times) until its even spacing leaves every member's outline within the
+// tolerance in every drawing. Even spacing, since each side repeats its twin's vertices
+// mirrored (CollocateTwins); a lip that opens from a straight slit into a curve needs more than
+// the slit's count.
+void CompatibleSampling::RefineTwinClasses(UnionFind* classes) {
+  if (!(options_.tolerance > 0.0 && options_.vertices <= 0)) return;
+  constexpr int kMaxTwinRefinement = 64;
+  const int num_intervals = interval_start_.back();
+  std::vector<bool> has_twin(num_intervals, false);
+  for (int d = 0; d < num_shapes_; ++d) {
+    for (int i = 0; i < num_intervals; ++i) has_twin[i] = has_twin[i] || twin_interval_[d][i] >= 0;
+  }
+  std::vector<std::vector<std::pair<int, int>>> members(num_intervals);  // by class root
+  for (int g = 0; g < num_groups_; ++g) {
+    for (int i = 0; i < static_cast<int>(breaks_[g].size()); ++i) {
+      const int gi = interval_start_[g] + i;
+      if (has_twin[gi]) members[classes->Find(gi)].push_back({g, i});
+    }
+  }
+  for (const std::vector<std::pair<int, int>>& list : members) {
+    if (list.empty()) continue;
+    const int first = count_[interval_start_[list[0].first] + list[0].second];
+    int n = first;
+    auto fits = [&](int count) {
+      for (const auto& [g, i] : list) {
+        if (!EvenWithinTolerance(g, i, count)) return false;
+      }
+      return true;
+    };
+    while (!fits(n) && n < kMaxTwinRefinement * first) n += std::max(1, n / 4);
+    for (const auto& [g, i] : list) count_[interval_start_[g] + i] = n;
+  }
+}
+
 // Each interval's vertices as common parameters: `count` evenly spaced, then (with a
 // tolerance, and no fixed vertex count) refined until every drawing's polyline lies within the
 // tolerance of its outline (RefineToTolerance). Intervals of a cut or opening keep the even
-// spacing, which their twins repeat.
+// spacing, which their twins repeat (RefineTwinClasses chose its count).
 void CompatibleSampling::PlaceVertices() {
   const int num_intervals = interval_start_.back();
   interval_t_.assign(num_intervals, {});
@@ -611,14 +679,8 @@ void CompatibleSampling::PlaceVertices() {
       std::vector<double>& ts = interval_t_[gi];
       for (int k = 0; k < count_[gi]; ++k) ts.push_back(t0 + (t1 - t0) * k / count_[gi]);
       if (!refine || has_twin[gi]) continue;
-      std::vector<const Curve*> cs;
-      std::vector<const Param*> ps;
-      std::vector<double> tol;
-      for (int d = 0; d < num_shapes_; ++d) {
-        cs.push_back(&curve(d, g)), ps.push_back(&param(d, g));
-        tol.push_back(options_.tolerance * scale(d));
-      }
-      ts = RefineToTolerance(ts, t1, cs, ps, tol);
+      const GroupOutlines o = OutlinesOf(g);
+      ts = RefineToTolerance(ts, t1, o.curves, o.params, o.tol);
       count_[gi] = static_cast<int>(ts.size());
     }
   }
@@ -687,6 +749,7 @@ void CompatibleSampling::Sample(BoundaryCorrespondence* out) {
   CountVertices(&classes);
   const int num_intervals = interval_start_.back();
   for (int i = 0; i < num_intervals; ++i) out->base_vertices += count_[i];
+  RefineTwinClasses(&classes);
   PlaceVertices();
   // Vertex numbering: intervals in order, loop by loop.
   first_vertex_.assign(num_intervals + 1, 0);

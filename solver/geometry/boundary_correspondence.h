@@ -52,8 +52,9 @@ struct BoundaryCorrespondenceOptions {
   // turns, which no single turn marks as a corner, keeps its shape. The vertices are common
   // parameters, so the correspondence between drawings is the one chosen above; an interval gets
   // what the drawing that needs most needs. Corners closer than the tolerance share one
-  // breakpoint. 0, or a fixed `vertices`: no refinement. Intervals on a cut or opening keep the
-  // even spacing.
+  // breakpoint. 0, or a fixed `vertices`: no refinement. Intervals on a cut or opening stay
+  // evenly spaced (each side repeats its twin's vertices), their class's count raised until
+  // every drawing is within the tolerance.
   double tolerance = 0.0;
 };
 

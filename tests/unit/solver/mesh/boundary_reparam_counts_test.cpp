@@ -1088,6 +1088,34 @@ TEST(BoundaryReparamCountsTest, OpeningSlitAndHoleCountsMatch) {
   }
 }
 
+// A mouth that opens from a slit into a round hole: the slit's two sides are one class of
+// intervals (each repeats the other's vertices), and the even count that suits the slit leaves
+// the open mouth's round lips off by their chords. The class's count grows until every drawing's
+// loops lie within the outline tolerance (MultimeshOptions' 0.1% of the diagonal); the sides
+// still pair up collocated.
+TEST(BoundaryReparamCountsTest, OpeningSidesAreRefinedToTheTolerance) {
+  Drawing closed, open;
+  closed.outlines = {{Circle({0, 0}, 10, 64)}};
+  closed.openings = {{{-5, 2}, {0, 2.2}, {5, 2}}};
+  open.outlines = {{Circle({0, 0}, 10, 64)}};
+  Points lips;
+  for (int k = 0; k < 96; ++k) {  // clockwise, through the slit's ends
+    const double t = -2 * std::numbers::pi * k / 96;
+    lips.emplace_back(5 * std::cos(t), 2 + 3.5 * std::sin(t));
+  }
+  open.outlines.push_back(Outline{lips});
+  for (const bool closed_first : {true, false}) {
+    SCOPED_TRACE(closed_first ? "closed first" : "open first");
+    const std::vector<Drawing> drawings =
+        closed_first ? std::vector<Drawing>{closed, open} : std::vector<Drawing>{open, closed};
+    absl::StatusOr<Stage> s = Correspond(drawings, {});
+    ASSERT_TRUE(s.ok()) << s.status();
+    EXPECT_TRUE(CheckAll(s->views));
+    EXPECT_TRUE(CheckTwins(s->bc));
+    EXPECT_LE(s->bc.achieved_tolerance, MultimeshOptions().boundary_tolerance * (1 + 1e-9));
+  }
+}
+
 // Real projects with their own marks (data-corr) and cuts: the bird (3 drawings, 1 mark) and the
 // walk cycle (16 drawings), at the correspondence stage and in their multimeshes.
 TEST(BoundaryReparamCountsTest, ExamplesWithMarks) {
