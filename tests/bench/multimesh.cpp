@@ -2,9 +2,9 @@
 // default) built by BuildMultimesh (default options) against its affine copy (the icon corpus's
 // transform, matrix(1.2 0.35 -0.25 1.1 30 -4): sheared, turned, scaled, moved), and, as the
 // baseline measured in the same run, against itself (the same meshing and loop matching, a map
-// with nothing to pull). Prints both times, their ratio, the vertex count and the overlays; the
-// copy's map pulls the mesh onto boundaries whose arc-length correspondence slides the holes'
-// corners along their sides (docs/benchmarks.md, "Multimesh construction").
+// with nothing to pull). Prints both times, their ratio, the vertex count and the overlays. The
+// copy's loops pair through the affine map fitted to them, so its map costs about what the map
+// onto the drawing itself costs (docs/benchmarks.md, "Multimesh construction").
 // Usage: multimesh [--max-holes N (grids up to N x N)] [--json FILE] (one JSON row per case:
 // {"case", "vertices", "seconds", "seconds_itself", "ratio", "overlays"}).
 #include <algorithm>
