@@ -141,6 +141,27 @@ bool WithinTolerance(double lo, double hi, const std::vector<const Curve*>& curv
   return true;
 }
 
+// Whether every piece between consecutive common parameters `ts` (and from the last to t1) lies
+// within the tolerance in every drawing (WithinTolerance).
+bool PiecesWithinTolerance(const std::vector<double>& ts, double t1,
+                           const std::vector<const Curve*>& curves,
+                           const std::vector<const Param*>& params,
+                           const std::vector<double>& tol) {
+  for (size_t k = 0; k < ts.size(); ++k) {
+    if (!WithinTolerance(ts[k], k + 1 < ts.size() ? ts[k + 1] : t1, curves, params, tol)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// `count` common parameters spread evenly from t0 towards t1 (t1 itself not among them).
+std::vector<double> EvenParams(double t0, double t1, int count) {
+  std::vector<double> ts;
+  for (int k = 0; k < count; ++k) ts.push_back(t0 + (t1 - t0) * k / count);
+  return ts;
+}
+
 // The common parameters in (t0, t1) of every drawing's outline vertices, sorted, with those
 // closer than `min_gap` to the previous one (or to t0, t1) left out.
 std::vector<double> OutlineVertexParams(double t0, double t1,
@@ -187,11 +208,7 @@ std::vector<double> RefineToTolerance(const std::vector<double>& ts, double t1,
                                       const std::vector<const Curve*>& curves,
                                       const std::vector<const Param*>& params,
                                       const std::vector<double>& tol) {
-  bool even_ok = true;
-  for (size_t k = 0; k < ts.size() && even_ok; ++k) {
-    even_ok = WithinTolerance(ts[k], k + 1 < ts.size() ? ts[k + 1] : t1, curves, params, tol);
-  }
-  if (even_ok) return ts;
+  if (PiecesWithinTolerance(ts, t1, curves, params, tol)) return ts;
   // Pieces narrower than kMinPiece in t are not made (coincident vertices would follow).
   constexpr double kMinPiece = 1e-7;
   const double t0 = ts[0];
@@ -309,6 +326,8 @@ class CompatibleSampling {
     std::vector<double> tol;
   };
   GroupOutlines OutlinesOf(int g) const;
+  bool Refines() const;
+  std::vector<bool> HasTwin() const;
   bool EvenWithinTolerance(int g, int i, int count) const;
   void RefineTwinClasses(UnionFind* classes);
   void PlaceVertices();
@@ -367,8 +386,7 @@ bool CompatibleSampling::AddBreak(int g, double t) {
 // The sliver's triangles were what the middle frame's worst distortion measured on a face's
 // eye corner (`scripts/bench correspondence`, principles_appeal).
 bool CompatibleSampling::NearBreak(int g, double t) const {
-  const bool refine = options_.tolerance > 0.0 && options_.vertices <= 0;
-  const double merge = std::max(kCornerMergeRelative, refine ? options_.tolerance : 0.0);
+  const double merge = std::max(kCornerMergeRelative, Refines() ? options_.tolerance : 0.0);
   bool near = false;
   const std::vector<double>& b = breaks_[g];
   auto it = std::lower_bound(b.begin(), b.end(), t);
@@ -604,14 +622,23 @@ void CompatibleSampling::CountVertices(UnionFind* classes) {
 // within the tolerance of their chords.
 bool CompatibleSampling::EvenWithinTolerance(int g, int i, int count) const {
   const GroupOutlines o = OutlinesOf(g);
-  const double t0 = breaks_[g][i], t1 = IntervalEnd(g, i);
-  for (int k = 0; k < count; ++k) {
-    if (!WithinTolerance(t0 + (t1 - t0) * k / count, t0 + (t1 - t0) * (k + 1) / count, o.curves,
-                         o.params, o.tol)) {
-      return false;
-    }
+  const double t1 = IntervalEnd(g, i);
+  return PiecesWithinTolerance(EvenParams(breaks_[g][i], t1, count), t1, o.curves, o.params, o.tol);
+}
+
+// Whether the sampling refines to the outline tolerance: a tolerance, and no fixed vertex count.
+bool CompatibleSampling::Refines() const {
+  return options_.tolerance > 0.0 && options_.vertices <= 0;
+}
+
+// Per interval: whether it is some drawing's side of a cut or an opening (it has a twin).
+std::vector<bool> CompatibleSampling::HasTwin() const {
+  const int num_intervals = interval_start_.back();
+  std::vector<bool> has_twin(num_intervals, false);
+  for (int d = 0; d < num_shapes_; ++d) {
+    for (int i = 0; i < num_intervals; ++i) has_twin[i] = has_twin[i] || twin_interval_[d][i] >= 0;
   }
-  return true;
+  return has_twin;
 }
 
 // Group g's loop in every drawing, its parameterization and its outline tolerance (absolute).
@@ -631,13 +658,10 @@ CompatibleSampling::GroupOutlines CompatibleSampling::OutlinesOf(int g) const {
 // mirrored (CollocateTwins); a lip that opens from a straight slit into a curve needs more than
 // the slit's count.
 void CompatibleSampling::RefineTwinClasses(UnionFind* classes) {
-  if (!(options_.tolerance > 0.0 && options_.vertices <= 0)) return;
+  if (!Refines()) return;
   constexpr int kMaxTwinRefinement = 64;
   const int num_intervals = interval_start_.back();
-  std::vector<bool> has_twin(num_intervals, false);
-  for (int d = 0; d < num_shapes_; ++d) {
-    for (int i = 0; i < num_intervals; ++i) has_twin[i] = has_twin[i] || twin_interval_[d][i] >= 0;
-  }
+  const std::vector<bool> has_twin = HasTwin();
   std::vector<std::vector<std::pair<int, int>>> members(num_intervals);  // by class root
   for (int g = 0; g < num_groups_; ++g) {
     for (int i = 0; i < static_cast<int>(breaks_[g].size()); ++i) {
@@ -667,17 +691,14 @@ void CompatibleSampling::RefineTwinClasses(UnionFind* classes) {
 void CompatibleSampling::PlaceVertices() {
   const int num_intervals = interval_start_.back();
   interval_t_.assign(num_intervals, {});
-  std::vector<bool> has_twin(num_intervals, false);
-  for (int d = 0; d < num_shapes_; ++d) {
-    for (int i = 0; i < num_intervals; ++i) has_twin[i] = has_twin[i] || twin_interval_[d][i] >= 0;
-  }
-  const bool refine = options_.tolerance > 0.0 && options_.vertices <= 0;
+  const std::vector<bool> has_twin = HasTwin();
+  const bool refine = Refines();
   for (int g = 0; g < num_groups_; ++g) {
     for (int i = 0; i < static_cast<int>(breaks_[g].size()); ++i) {
       const int gi = interval_start_[g] + i;
       const double t0 = breaks_[g][i], t1 = IntervalEnd(g, i);
       std::vector<double>& ts = interval_t_[gi];
-      for (int k = 0; k < count_[gi]; ++k) ts.push_back(t0 + (t1 - t0) * k / count_[gi]);
+      ts = EvenParams(t0, t1, count_[gi]);
       if (!refine || has_twin[gi]) continue;
       const GroupOutlines o = OutlinesOf(g);
       ts = RefineToTolerance(ts, t1, o.curves, o.params, o.tol);

@@ -109,8 +109,8 @@ struct LoopGroups {
   // carry[g][d]: the affine map of the component that carried its holes (none without holes,
   // for drawing 1, or a degenerate fit), which aligns the loops' starts.
   std::vector<std::vector<std::optional<Affine>>> carry;
-  // Per group: some drawing's loop runs along a cut or an opening (its sides are sampled as
-  // their twins are, so the loop keeps the pairing that mirrors them).
+  // Per group: some drawing's loop runs along a cut or an opening (ParameterizeGroup then leaves
+  // its pairing to the alignment: no affine pairing).
   std::vector<bool> seamed;
   int size() const { return static_cast<int>(loops.size()); }
 };

@@ -434,7 +434,7 @@ std::pair<Point, Point> NearestWithDirection(const Curve& c, const Point& q) {
   for (size_t i = 0; i < n; ++i) {
     const Point& a = c.p[i];
     const Point& b = c.p[(i + 1) % n];
-    const Point x = a + SegmentParameter(q, a, b) * (b - a);
+    const Point x = NearestOnSegment(q, a, b);
     const double dist = (x - q).squaredNorm();
     if (dist < best && (b - a).squaredNorm() > 0) best = dist, at = x, dir = (b - a).normalized();
   }
@@ -540,9 +540,7 @@ std::optional<Affine> PairThroughAffine(const GroupedLoops& loops, int g, int d,
 // where that map carries it within kAffineMisfit of drawing d's hole. Not refitted to the hole:
 // a round hole fits any turn of itself.
 void PairHoleThroughAffine(const GroupedLoops& loops, int h, int d, const Affine& carry, Param* p) {
-  Points carried;
-  for (const Point& q : loops.curve(0, h).p) carried.push_back(carry(q));
-  if (!(MeanDistanceToLoop(carried, loops.curve(d, h)) < kAffineMisfit)) return;
+  if (!(MeanDistanceToLoop(Carried(loops, h, carry), loops.curve(d, h)) < kAffineMisfit)) return;
   Param projected = ProjectThrough(loops, h, d, carry);
   if (projected.t.size() >= 3) *p = std::move(projected);
 }
@@ -633,15 +631,15 @@ absl::Status ParameterizeGroup(const GroupedLoops& loops, int g,
     } else if (!align) {
       if (absl::Status s = KnotsAtPins(pins, d, len0, &p); !s.ok()) return s;
     }
-    if (features && loops.groups.seamed[g]) {
-      // A loop along a cut or an opening keeps its pairing: a part cut from a whole fits the
-      // part drawn apart within kAffineMisfit without being its affine image, and the near fit
-      // puts the whole's corners a hair off the part's, where they merge (NearBreak) and the
-      // whole's boundary edges cut them beside the cut's ends.
-    } else if (features && loops.groups.outer[g]) {
+    // A loop along a cut or an opening keeps its pairing: a part cut from a whole fits the part
+    // drawn apart within kAffineMisfit without being its affine image, and the near fit puts the
+    // whole's corners a hair off the part's, where they merge (NearBreak) and the whole's
+    // boundary edges cut them beside the cut's ends.
+    if (!features || loops.groups.seamed[g]) continue;
+    if (loops.groups.outer[g]) {
       out->affine[d][g] = PairThroughAffine(loops, g, d, out->param[0][g], &p);
-    } else if (features && out->affine[d][OutlineGroup(loops, g)].has_value()) {
-      PairHoleThroughAffine(loops, g, d, *out->affine[d][OutlineGroup(loops, g)], &p);
+    } else if (const std::optional<Affine>& map = out->affine[d][OutlineGroup(loops, g)]) {
+      PairHoleThroughAffine(loops, g, d, *map, &p);
     }
   }
   return absl::OkStatus();
